@@ -1,0 +1,34 @@
+// Small geometric types shared by every stage. Eigen is the project's vector library; these
+// aliases keep the spelling short and the precision choice in one place.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace sb {
+
+using Vec2 = Eigen::Vector2d;
+using Vec3 = Eigen::Vector3d;
+using Vec2f = Eigen::Vector2f;
+using Vec3f = Eigen::Vector3f;
+using Mat3 = Eigen::Matrix3d;
+using Affine3 = Eigen::Affine3d;
+
+struct Bounds3 {
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+  Vec3 hi = Vec3::Constant(-std::numeric_limits<double>::infinity());
+
+  void extend(const Vec3& p) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  void extend(const Bounds3& b) {
+    lo = lo.cwiseMin(b.lo);
+    hi = hi.cwiseMax(b.hi);
+  }
+  bool empty() const { return (hi.array() < lo.array()).any(); }
+  Vec3 centre() const { return 0.5 * (lo + hi); }
+  double diagonal() const { return empty() ? 0.0 : (hi - lo).norm(); }
+};
+
+}  // namespace sb

@@ -1,0 +1,24 @@
+// A float image in lightmap layout: row 0 is v = 1, pixel (x, y) covers
+// u in [x/w, (x+1)/w], v in [1-(y+1)/h, 1-y/h]. Channels are interleaved.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+namespace sb {
+
+struct Image {
+  int width = 0;
+  int height = 0;
+  int channels = 3;
+  std::vector<float> pixels;  // width * height * channels, row-major, interleaved
+
+  Image() = default;
+  Image(int w, int h, int c, float fill = 0.0f)
+      : width(w), height(h), channels(c), pixels(std::size_t(w) * h * c, fill) {}
+
+  float* at(int x, int y) { return &pixels[(std::size_t(y) * width + x) * channels]; }
+  const float* at(int x, int y) const { return &pixels[(std::size_t(y) * width + x) * channels]; }
+};
+
+}  // namespace sb

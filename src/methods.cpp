@@ -1,0 +1,12 @@
+// The registry of bake method names, so the scene reader and the CLI can reject an unknown
+// method with the list of known ones.
+#include "scene.h"
+
+namespace sb {
+
+const std::vector<std::string>& known_methods() {
+  static const std::vector<std::string> names = {"reference"};
+  return names;
+}
+
+}  // namespace sb

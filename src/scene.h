@@ -1,0 +1,74 @@
+// The scene as the user describes it: bake settings, objects (meshes with flags and transforms)
+// and area lights. Read from a TOML file by load_scene (scene_file.cpp); docs/scene-format.md is
+// the user's reference for every key.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "error.h"
+#include "geometry.h"
+
+namespace sb {
+
+enum class Quantity { visibility, irradiance };
+
+// Names of the methods this build knows, in the order docs/methods.md lists them.
+const std::vector<std::string>& known_methods();
+
+struct BakeSettings {
+  int resolution = 512;            // texels per side of each receiver's lightmap
+  std::string method = "reference";
+  Quantity quantity = Quantity::visibility;
+  int samples = 256;               // light samples per texel, for sampling methods
+  int margin = 4;                  // texels of dilation around UV charts
+  std::uint64_t seed = 0;          // sampling seed; same seed, same bytes
+};
+
+struct ObjectDesc {
+  std::string name;                // unique; the output file stem
+  std::filesystem::path mesh;      // resolved against the scene file's folder
+  bool receiver = true;
+  bool blocker = true;
+  int uv_channel = 0;
+  Affine3 transform = Affine3::Identity();  // scale, then rotate (X, Y, Z), then translate
+  int line = 0;                    // line of the [[object]] table in the scene file, for errors
+};
+
+enum class LightShape { rectangle, disk, sphere };
+
+struct LightDesc {
+  std::string name;
+  LightShape shape = LightShape::rectangle;
+  Vec3 position = Vec3::Zero();    // centre, metres
+  Vec3 normal = Vec3(0, 0, -1);    // unit; the side it emits into (rectangle, disk)
+  Vec3 up = Vec3(0, 1, 0);         // unit, made orthogonal to normal by the reader; height axis
+  double width = 0;                // rectangle only, across up; metres
+  double height = 0;               // rectangle only; metres
+  double radius = 0;               // disk and sphere; metres
+  Vec3 color = Vec3(1, 1, 1);      // per-channel scale of the emitted power
+  double power = 0;                // watts (for colour (1,1,1))
+  int line = 0;
+};
+
+struct Scene {
+  std::filesystem::path file;      // the scene file, as given
+  BakeSettings bake;
+  std::vector<ObjectDesc> objects;
+  std::vector<LightDesc> lights;
+};
+
+// Reads and validates a scene file. Every problem is an Error naming the file, the line, the item
+// and what is wrong; unknown keys are errors, not ignored.
+Expected<Scene> load_scene(const std::filesystem::path& file);
+
+// Builds an object's transform from the optional keys: scale, then rotation about X, then Y,
+// then Z (degrees; Blender's "XYZ Euler"), then translation.
+Affine3 object_transform(const Vec3& translate, const Vec3& rotate_deg, const Vec3& scale);
+
+const char* to_string(Quantity q);
+const char* to_string(LightShape s);
+
+}  // namespace sb
