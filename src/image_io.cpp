@@ -1,0 +1,108 @@
+#include "image_io.h"
+
+#include <OpenImageIO/imageio.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <system_error>
+
+namespace sb {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// A sibling of `path` that no other writer uses: hidden, with the process id.
+fs::path temporary_sibling(const fs::path& path) {
+  // Built by appending: GCC 12 gives a false -Wrestrict on `"." + std::string` at -O3.
+  std::string name(".");
+  name.append(path.filename().string()).append(".tmp").append(std::to_string(::getpid()));
+  return path.parent_path() / name;
+}
+
+}  // namespace
+
+Expected<fs::path> stage_image(const fs::path& path, const Image& image, PixelFormat format) {
+  const fs::path tmp = temporary_sibling(path);
+  // The format comes from the final name's extension; the temporary name has none OIIO knows.
+  auto out = OIIO::ImageOutput::create(path.string());
+  if (!out) {
+    return output_error(path.string() + ": cannot write images of this type: " + OIIO::geterror());
+  }
+  const auto type = format == PixelFormat::float32 ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8;
+  OIIO::ImageSpec spec(image.width, image.height, image.channels, type);
+  if (format == PixelFormat::float32) spec.attribute("compression", "zip");
+  if (!out->open(tmp.string(), spec)) {
+    std::string why = out->geterror();
+    discard_file(tmp);
+    return output_error(path.string() + ": cannot write: " + why);
+  }
+  bool ok;
+  if (format == PixelFormat::float32) {
+    ok = out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data());
+  } else {
+    std::vector<std::uint8_t> bytes(image.pixels.size());
+    std::transform(image.pixels.begin(), image.pixels.end(), bytes.begin(), [](float v) {
+      const float c = std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
+      return std::uint8_t(std::lround(c * 255.0f));
+    });
+    ok = out->write_image(OIIO::TypeDesc::UINT8, bytes.data());
+  }
+  ok = out->close() && ok;
+  if (!ok) {
+    std::string why = out->geterror();
+    discard_file(tmp);
+    return output_error(path.string() + ": cannot write: " + why);
+  }
+  return tmp;
+}
+
+Expected<fs::path> stage_text(const fs::path& path, const std::string& text) {
+  const fs::path tmp = temporary_sibling(path);
+  std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+  if (out) out << text;
+  if (out) out.close();
+  if (!out) {
+    discard_file(tmp);
+    return output_error(path.string() + ": cannot write: " + std::strerror(errno));
+  }
+  return tmp;
+}
+
+Status commit_file(const fs::path& staged, const fs::path& path) {
+  std::error_code ec;
+  fs::rename(staged, path, ec);
+  if (ec) {
+    discard_file(staged);
+    return output_error(path.string() + ": cannot write: " + ec.message());
+  }
+  return Ok{};
+}
+
+void discard_file(const fs::path& staged) {
+  std::error_code ec;
+  fs::remove(staged, ec);
+}
+
+Status write_image(const fs::path& path, const Image& image, PixelFormat format) {
+  auto staged = stage_image(path, image, format);
+  if (!staged) return staged.error();
+  return commit_file(*staged, path);
+}
+
+Expected<Image> read_image(const fs::path& path) {
+  auto in = OIIO::ImageInput::open(path.string());
+  if (!in) return input_error(path.string() + ": cannot read image: " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  Image image(spec.width, spec.height, spec.nchannels);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data())) {
+    return input_error(path.string() + ": cannot read image: " + in->geterror());
+  }
+  return image;
+}
+
+}  // namespace sb

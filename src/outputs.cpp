@@ -1,0 +1,135 @@
+#include "outputs.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <system_error>
+#include <utility>
+#include <vector>
+
+#include "image_io.h"
+
+namespace sb {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+double srgb_encode(double linear) {
+  linear = std::clamp(linear, 0.0, 1.0);
+  return linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
+}
+
+}  // namespace
+
+Image tone_map_irradiance(const Image& irradiance, double white) {
+  // Extended Reinhard, L·(1 + L/Lw²)/(1 + L), with irradiance measured in quarters of the white
+  // point (L = 4·v/white, Lw = 4): the white point maps to 1, a quarter of it to about 0.53.
+  constexpr double kLw = 4.0;
+  Image out = irradiance;
+  const double scale = white > 0 ? kLw / white : 0.0;
+  for (float& v : out.pixels) {
+    const double l = std::isfinite(v) ? std::max(0.0, double(v)) * scale : 0.0;
+    v = float(srgb_encode(l * (1.0 + l / (kLw * kLw)) / (1.0 + l)));
+  }
+  return out;
+}
+
+double irradiance_white_point(const BakeResult& result) {
+  std::vector<float> values;
+  for (const auto& r : result.receivers)
+    for (std::size_t i = 0; i < r.image.pixels.size(); ++i)
+      if (r.image.pixels[i] > 0) values.push_back(r.image.pixels[i]);
+  if (values.empty()) return 1.0;
+  const std::size_t k = std::min(values.size() - 1, std::size_t(0.99 * double(values.size())));
+  std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(k), values.end());
+  return std::max(1e-12, double(values[k]));
+}
+
+Status write_outputs(const fs::path& dir, const Scene& scene, const BakeSettings& effective,
+                     const BakeResult& result) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir)) {
+    return output_error(dir.string() + ": cannot create the output folder: " +
+                        (ec ? ec.message() : std::string("not a folder")));
+  }
+
+  std::vector<std::pair<fs::path, fs::path>> staged;  // (temporary, final)
+  auto discard_all = [&] {
+    for (auto& [tmp, final_path] : staged) discard_file(tmp);
+  };
+  auto stage = [&](Expected<fs::path> tmp, const fs::path& final_path) -> bool {
+    if (!tmp) return false;
+    staged.emplace_back(*tmp, final_path);
+    return true;
+  };
+
+  const bool irradiance = effective.quantity == Quantity::irradiance;
+  const double white = irradiance ? irradiance_white_point(result) : 1.0;
+
+  nlohmann::ordered_json manifest;
+  manifest["shadowbake"] = SHADOWBAKE_VERSION;
+  manifest["scene"] = scene.file.string();
+  manifest["method"] = effective.method;
+  manifest["quantity"] = to_string(effective.quantity);
+  manifest["resolution"] = effective.resolution;
+  manifest["samples"] = effective.samples;
+  manifest["seed"] = effective.seed;
+  manifest["margin"] = effective.margin;
+  manifest["lights"] = nlohmann::ordered_json::array();
+  for (const auto& l : scene.lights) {
+    manifest["lights"].push_back({{"name", l.name}, {"shape", to_string(l.shape)}});
+  }
+  if (irradiance) manifest["png_white_point"] = white;
+  manifest["receivers"] = nlohmann::ordered_json::array();
+
+  for (const auto& r : result.receivers) {
+    const fs::path exr = dir / (r.name + ".exr");
+    const fs::path png = dir / (r.name + ".png");
+    auto tmp_exr = stage_image(exr, r.image, PixelFormat::float32);
+    if (!stage(tmp_exr, exr)) {
+      discard_all();
+      return tmp_exr.error();
+    }
+    const Image preview = irradiance ? tone_map_irradiance(r.image, white) : r.image;
+    auto tmp_png = stage_image(png, preview, PixelFormat::uint8);
+    if (!stage(tmp_png, png)) {
+      discard_all();
+      return tmp_png.error();
+    }
+    manifest["receivers"].push_back({
+        {"name", r.name},
+        {"files", {{"exr", exr.filename().string()}, {"png", png.filename().string()}}},
+        {"uv_channel", r.uv_channel},
+        {"resolution", {r.image.width, r.image.height}},
+        {"method", effective.method},
+        {"quantity", to_string(effective.quantity)},
+        {"samples", effective.samples},
+        {"covered_texels", r.covered_texels},
+        {"seconds", r.seconds},
+    });
+  }
+  manifest["warnings"] = result.warnings;
+  manifest["load_seconds"] = result.load_seconds;
+  manifest["bake_seconds"] = result.bake_seconds;
+  manifest["shadow_rays"] = result.shadow_rays;
+
+  const fs::path manifest_path = dir / "manifest.json";
+  auto tmp_manifest = stage_text(manifest_path, manifest.dump(2) + "\n");
+  if (!stage(tmp_manifest, manifest_path)) {
+    discard_all();
+    return tmp_manifest.error();
+  }
+  for (std::size_t i = 0; i < staged.size(); ++i) {
+    auto ok = commit_file(staged[i].first, staged[i].second);
+    if (!ok) {
+      for (std::size_t j = i + 1; j < staged.size(); ++j) discard_file(staged[j].first);
+      return ok.error();
+    }
+  }
+  return Ok{};
+}
+
+}  // namespace sb

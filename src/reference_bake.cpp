@@ -1,0 +1,88 @@
+// The ray-traced reference (design-notes §1 and §7): the ground truth every other method is
+// measured against. For each covered texel and each light, `samples` stratified points on the
+// light, one shadow ray each; the light's visibility is the ratio estimate Σ w·v / Σ w (lights.cpp
+// says why), its unoccluded irradiance H0 is exact, and H = H0 · V. Parallel over texels with
+// oneTBB; each texel has its own random stream, so the result is the same for any thread count.
+#include "reference_bake.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "sampling.h"
+
+namespace sb {
+
+Image bake_reference(const TexelSpace& space, const ReferenceInputs& in,
+                     std::int64_t* rays_traced) {
+  Image out(space.width, space.height, 3, 0.0f);
+  const auto& lights = *in.lights;
+  const RayScene& rays = *in.rays;
+  const double offset = rays.surface_offset();
+  std::atomic<std::int64_t> traced{0};
+
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, space.texels.size(), 64),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        std::vector<Vec2> strata;
+        std::vector<Vec3> origins(in.samples), directions(in.samples);
+        std::vector<double> lengths(in.samples), weights(in.samples);
+        std::vector<std::uint8_t> hit(in.samples);
+        std::int64_t local_rays = 0;
+        for (std::size_t t = range.begin(); t != range.end(); ++t) {
+          const Texel& texel = space.texels[t];
+          Vec3 h_sum = Vec3::Zero(), h0_sum = Vec3::Zero();
+          const Vec3 origin = texel.position + offset * texel.geometric_normal;
+          for (std::size_t l = 0; l < lights.size(); ++l) {
+            const Vec3 h0 = lights[l].unoccluded_irradiance(texel.position, texel.normal);
+            if (h0.maxCoeff() <= 0) continue;
+            Rng rng(stream_seed(in.seed, (in.stream << 32) ^ l,
+                                std::uint64_t(texel.y) * space.width + texel.x));
+            stratified_samples(in.samples, rng, strata);
+            int n = 0;
+            double weight_sum = 0;
+            for (int s = 0; s < in.samples; ++s) {
+              const LightSample ls = lights[l].sample(texel.position, texel.normal, strata[s]);
+              if (ls.weight <= 0) continue;
+              const Vec3 d = ls.point - origin;
+              const double len = d.norm();
+              if (len <= 2 * offset) continue;
+              origins[n] = origin;
+              directions[n] = d;
+              // Stop short of the light's own surface, which may lie on a blocker (a panel
+              // on a ceiling).
+              lengths[n] = 1.0 - offset / len;
+              weights[n] = ls.weight;
+              weight_sum += ls.weight;
+              ++n;
+            }
+            if (n == 0 || weight_sum <= 0) continue;
+            rays.occluded(n, origins.data(), directions.data(), lengths.data(), hit.data());
+            local_rays += n;
+            double visible = 0;
+            for (int s = 0; s < n; ++s)
+              if (!hit[s]) visible += weights[s];
+            h_sum += h0 * (visible / weight_sum);
+            h0_sum += h0;
+          }
+          float* px = out.at(texel.x, texel.y);
+          for (int c = 0; c < 3; ++c) {
+            double v = 0;
+            if (in.quantity == Quantity::irradiance) {
+              v = h_sum[c];
+            } else if (h0_sum[c] > 0) {
+              v = h_sum[c] / h0_sum[c];
+            }
+            px[c] = float(v);
+          }
+        }
+        traced += local_rays;
+        if (in.texels_done) {
+          const auto done = (*in.texels_done += std::int64_t(range.size()));
+          if (in.progress) in.progress(double(done));
+        }
+      });
+  if (rays_traced) *rays_traced += traced.load();
+  return out;
+}
+
+}  // namespace sb
