@@ -56,6 +56,17 @@ Status write_outputs(const fs::path& dir, const Scene& scene, const BakeSettings
                         (ec ? ec.message() : std::string("not a folder")));
   }
 
+  // A folder standing where a file must go would make its rename fail after others were
+  // published; refuse before writing anything.
+  for (const auto& r : result.receivers) {
+    for (const char* ext : {".exr", ".png"}) {
+      const fs::path p = dir / (r.name + ext);
+      if (fs::is_directory(p, ec)) {
+        return output_error(p.string() + ": cannot write: a folder of that name is in the way");
+      }
+    }
+  }
+
   std::vector<std::pair<fs::path, fs::path>> staged;  // (temporary, final)
   auto discard_all = [&] {
     for (auto& [tmp, final_path] : staged) discard_file(tmp);

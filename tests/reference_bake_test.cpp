@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "closed_forms.h"
 #include "reference_bake.h"
 
 namespace sb {
@@ -93,35 +94,6 @@ TEST(Reference, UnoccludedFloorIsFullyVisibleAndExact) {
   }
 }
 
-// Parallel planes (design-notes §2): light 0.5 wide at z = 1.5, blocker 0.6 wide at z = 0.5
-// (d_b = 1), floor at z = 0 (d_r = 1.5), α = 2/3. Seen from floor point y, the blocker covers
-// the light-plane square of half-width 0.3/(1−α) = 0.9 centred at −α·y/(1−α) = −2y.
-bool light_point_hidden(double sx, double sy, double yx, double yy) {
-  return std::abs(sx + 2 * yx) < 0.9 && std::abs(sy + 2 * yy) < 0.9;
-}
-
-double unweighted_visibility(double yx, double yy) {
-  auto overlap = [](double c) {  // [−0.25, 0.25] ∩ [c − 0.9, c + 0.9]
-    return std::max(0.0, std::min(0.25, c + 0.9) - std::max(-0.25, c - 0.9));
-  };
-  return 1.0 - overlap(-2 * yx) * overlap(-2 * yy) / 0.25;
-}
-
-double weighted_visibility(double yx, double yy) {
-  const int k = 2000;
-  double visible = 0, total = 0;
-  for (int i = 0; i < k; ++i)
-    for (int j = 0; j < k; ++j) {
-      const double sx = -0.25 + 0.5 * (i + 0.5) / k, sy = -0.25 + 0.5 * (j + 0.5) / k;
-      const double dx = sx - yx, dy = sy - yy, dz = 1.5;
-      const double r2 = dx * dx + dy * dy + dz * dz;
-      const double w = dz * dz / (r2 * r2);  // cosθ_x cosθ_y / r² with both cosines dz/r
-      total += w;
-      if (!light_point_hidden(sx, sy, yx, yy)) visible += w;
-    }
-  return visible / total;
-}
-
 TEST(Reference, ParallelPlanesMatchWeightedClosedForm) {
   const Mesh blocker = horizontal_square(0.3, 0.5);
   auto rays = RayScene::build({&blocker});
@@ -134,11 +106,11 @@ TEST(Reference, ParallelPlanesMatchWeightedClosedForm) {
   const Image vis = run(s, lights, *rays, Quantity::visibility, 1024);
   double sq = 0, max_err = 0, sq_split = 0;
   for (std::size_t i = 0; i < xs.size(); ++i) {
-    const double v = weighted_visibility(xs[i], y0);
+    const double v = closed_forms::parallel_weighted_visibility(xs[i], y0);
     const double err = vis.at(int(i), 0)[0] - v;
     sq += err * err;
     max_err = std::max(max_err, std::abs(err));
-    const double split = unweighted_visibility(xs[i], y0) - v;
+    const double split = closed_forms::parallel_unweighted_visibility(xs[i], y0) - v;
     sq_split += split * split;
   }
   const double rmse = std::sqrt(sq / xs.size());
