@@ -31,7 +31,7 @@ Image bake_reference(const TexelSpace& space, const ReferenceInputs& in,
         for (std::size_t t = range.begin(); t != range.end(); ++t) {
           const Texel& texel = space.texels[t];
           Vec3 h_sum = Vec3::Zero(), h0_sum = Vec3::Zero();
-          const Vec3 origin = texel.position + offset * texel.geometric_normal;
+          const Vec3 origin = texel.shadow_origin + offset * texel.geometric_normal;
           for (std::size_t l = 0; l < lights.size(); ++l) {
             const Vec3 h0 = lights[l].unoccluded_irradiance(texel.position, texel.normal);
             if (h0.maxCoeff() <= 0) continue;

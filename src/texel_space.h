@@ -13,17 +13,21 @@
 namespace sb {
 
 struct Texel {
-  int x = 0, y = 0;        // pixel; row 0 is v = 1
-  Vec3 position;           // world space, on the triangle
-  Vec3 normal;             // interpolated shading normal, unit
-  Vec3 geometric_normal;   // the triangle's face normal, unit, on the side of `normal`
-  int face = -1;           // index of the covering triangle
+  int x = 0, y = 0;       // pixel; row 0 is v = 1
+  Vec3 position;          // world space, on the triangle
+  Vec3 normal;            // interpolated shading normal, unit
+  Vec3 geometric_normal;  // the triangle's face normal, unit, on the side of `normal`
+  // Where shadow rays leave from: `position` lifted onto the smooth surface the vertex normals
+  // describe (uv_rasterizer.cpp), so a coarsely tessellated curved object does not shadow
+  // itself along its terminator. Equal to `position` on flat faces.
+  Vec3 shadow_origin;
+  int face = -1;  // index of the covering triangle
 };
 
 struct TexelSpace {
   int width = 0, height = 0;
-  std::vector<Texel> texels;             // covered texels, in row-major order
-  std::vector<std::uint8_t> covered;     // width * height; 1 where a texel of `texels` lies
+  std::vector<Texel> texels;          // covered texels, in row-major order
+  std::vector<std::uint8_t> covered;  // width * height; 1 where a texel of `texels` lies
 };
 
 // Rasterises mesh's triangles in UV space at width × height. A texel whose centre lies inside a

@@ -1,7 +1,7 @@
 // Rasterises a receiver's triangles in lightmap UV space: for each texel of a width × height
 // lightmap, whether the UV layout covers it and, if so, the surface point it stands for (world
-// position, interpolated shading normal, face normal, face). The bake methods shade exactly these
-// points, so every later image is only as complete as this coverage.
+// position, interpolated shading normal, face normal, face, shadow-ray origin). The bake methods
+// shade exactly these points, so every later image is only as complete as this coverage.
 //
 // Two passes per row of texels:
 //  1. Centre sampling. A texel whose centre lies inside a triangle or on its edge takes the point
@@ -214,6 +214,15 @@ Texel make_texel(const FaceSurface& s, int face, int x, int y, const double bary
   t.normal =
       unit_or(bary[0] * s.normal[0] + bary[1] * s.normal[1] + bary[2] * s.normal[2], s.face_normal);
   t.geometric_normal = t.normal.dot(s.face_normal) < 0.0 ? Vec3(-s.face_normal) : s.face_normal;
+  // Shadow-terminator offset (Hanika, "Hacking the Shadow Terminator", Ray Tracing Gems II,
+  // ch. 4, 2021): a flat triangle of a curved mesh lies inside the smooth surface its vertex
+  // normals describe, so rays towards a grazing light hit the neighbouring triangles. Lift the
+  // point by the barycentric mean of its heights below each vertex's tangent plane.
+  t.shadow_origin = t.position;
+  for (int i = 0; i < 3; ++i) {
+    const double below = (s.position[i] - t.position).dot(s.normal[i]);
+    if (below > 0) t.shadow_origin += bary[i] * below * s.normal[i];
+  }
   return t;
 }
 

@@ -41,7 +41,7 @@ TexelSpace floor_texels(const std::vector<double>& xs, double y0) {
     Texel t;
     t.x = int(i);
     t.y = 0;
-    t.position = Vec3(xs[i], y0, 0);
+    t.position = t.shadow_origin = Vec3(xs[i], y0, 0);
     t.normal = t.geometric_normal = Vec3::UnitZ();
     s.texels.push_back(t);
   }

@@ -407,3 +407,31 @@ TEST(UvRasterizer, SameResultOnAnyThreadCount) {
 
 }  // namespace
 }  // namespace sb
+
+namespace sb {
+namespace {
+
+TEST(UvRasterizer, ShadowOriginIsThePositionOnFlatFaces) {
+  const TexelSpace space = rasterise_texels(full_quad(), 16, 16);
+  for (const Texel& t : space.texels) EXPECT_EQ(t.shadow_origin, t.position);
+}
+
+TEST(UvRasterizer, ShadowOriginLiftsOntoTheSmoothSurface) {
+  // A flat triangle whose vertex normals lean outwards, as on a coarse sphere: its interior lies
+  // below the vertices' tangent planes, and the shadow origin is lifted along +z, never lowered,
+  // and not at all at the vertices.
+  const Vec3 n0 = Vec3(-1, -1, 2).normalized(), n1 = Vec3(1, -1, 2).normalized(),
+             n2 = Vec3(0, 1, 2).normalized();
+  const Mesh mesh = make_mesh({flat(0, 0, n0), flat(1, 0, n1), flat(0.5, 1, n2)}, {{0, 1, 2}});
+  const TexelSpace space = rasterise_texels(mesh, 32, 32);
+  double highest = 0;
+  for (const Texel& t : space.texels) {
+    const Vec3 lift = t.shadow_origin - t.position;
+    EXPECT_GE(lift.z(), 0.0);
+    highest = std::max(highest, lift.z());
+  }
+  EXPECT_GT(highest, 0.05);
+}
+
+}  // namespace
+}  // namespace sb
