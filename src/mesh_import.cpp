@@ -1,0 +1,293 @@
+// Mesh import: reads one object's mesh file with Assimp (any format it knows: OBJ, PLY, glTF,
+// FBX, ...) and builds the project's working mesh (mesh.h) in world space.
+//
+// Why each choice:
+// - Assimp post-processing triangulates, joins identical vertices (so OpenMesh sees shared
+//   vertices and connectivity), pre-transforms vertices (node transforms applied; all meshes of
+//   the file become one object) and generates smooth normals only where the file has none. It is
+//   not asked to remove degenerate triangles (we count them, so the user is told) nor to convert
+//   axes (world coordinates are the file's own; the scene's transform places the object).
+// - obj.transform is applied here, in double precision: points by the affine map, normals by the
+//   inverse transpose of its linear part. A mirroring transform (negative determinant) reverses
+//   every triangle's winding so that the winding-derived face normals keep agreeing with the
+//   transformed vertex normals (both stay on the file's outward side). Assimp's pre-transform
+//   does not do the same for a mirroring node transform inside the file, so any triangle whose
+//   winding disagrees with its vertex normals is reversed too: the normals say which side is out.
+// - OpenMesh refuses non-manifold faces; such a face is added on fresh copies of its vertices so
+//   no triangle, hence no blocker or receiver surface, is ever lost.
+// - Bad input (unreadable file, no triangles, non-finite positions, only degenerate triangles, a
+//   receiver without its UV channel) is an Error, never a crash or an exception.
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <assimp/Importer.hpp>
+
+#include <cmath>
+#include <exception>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <system_error>
+#include <utility>
+#include <vector>
+
+#include "mesh.h"
+
+namespace sb {
+namespace {
+
+// A triangle smaller than this fraction of the squared bounding-box diagonal has no area worth
+// shading or tracing; it is skipped and counted.
+constexpr double kDegenerateAreaFraction = 1e-12;
+
+// One vertex of the file after Assimp's post-processing, in world space.
+struct ImportedVertex {
+  Vec3 position;
+  Vec3 normal;  // unit, or zero when the file's normal is unusable (fixed after face normals)
+  Vec2 uv = Vec2::Zero();
+};
+
+class ErrorPrefix {
+ public:
+  ErrorPrefix(const ObjectDesc& obj, const std::filesystem::path& scene_file)
+      : prefix_(scene_file.string() + ":" + std::to_string(obj.line) + ": object '" + obj.name +
+                "': ") {}
+  Error operator()(const std::string& problem) const { return scene_error(prefix_ + problem); }
+
+ private:
+  std::string prefix_;
+};
+
+// Assimp's messages may span lines and quote bytes of a broken file; errors are one line.
+std::string one_line(std::string text) {
+  for (char& c : text) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = ' ';
+  }
+  while (!text.empty() && text.back() == ' ') text.pop_back();
+  return text;
+}
+
+// obj.mesh is resolved against the scene file's folder by the scene reader; a path still
+// relative to that folder (an ObjectDesc built by hand) is accepted too.
+std::filesystem::path mesh_path(const ObjectDesc& obj, const std::filesystem::path& scene_file) {
+  std::error_code ec;
+  if (obj.mesh.is_absolute() || std::filesystem::exists(obj.mesh, ec)) return obj.mesh;
+  const std::filesystem::path beside_scene = scene_file.parent_path() / obj.mesh;
+  if (std::filesystem::exists(beside_scene, ec)) return beside_scene;
+  return obj.mesh;
+}
+
+std::string format_vec(const Vec3& v) {
+  std::ostringstream out;
+  out << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
+  return out.str();
+}
+
+// Adds triangle (a, b, c) to mesh. OpenMesh's add_face refuses a face that would make a vertex or
+// an edge non-manifold (and prints why); the checks below are its own, done first to keep it
+// quiet. A refused face is added on three fresh copies of its vertices.
+void add_triangle(TriMesh& mesh, TriMesh::VertexHandle a, TriMesh::VertexHandle b,
+                  TriMesh::VertexHandle c) {
+  const TriMesh::VertexHandle corners[3] = {a, b, c};
+  bool manifold = true;
+  for (int i = 0; i < 3 && manifold; ++i) {
+    const auto from = corners[i];
+    const auto to = corners[(i + 1) % 3];
+    if (!mesh.is_boundary(from)) manifold = false;
+    const auto he = mesh.find_halfedge(from, to);
+    if (he.is_valid() && !mesh.is_boundary(he)) manifold = false;
+  }
+  if (manifold && mesh.add_face(a, b, c).is_valid()) return;
+
+  TriMesh::VertexHandle copies[3];
+  for (int i = 0; i < 3; ++i) {
+    copies[i] = mesh.add_vertex(mesh.point(corners[i]));
+    mesh.set_normal(copies[i], mesh.normal(corners[i]));
+    mesh.set_texcoord2D(copies[i], mesh.texcoord2D(corners[i]));
+  }
+  mesh.add_face(copies[0], copies[1], copies[2]);
+}
+
+Expected<Mesh> build_mesh(const aiScene& scene, const ObjectDesc& obj, const std::string& path,
+                          const ErrorPrefix& error) {
+  Mesh result;
+  result.name = obj.name;
+
+  std::size_t triangle_count = 0;
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh* am = scene.mMeshes[m];
+    for (unsigned f = 0; f < am->mNumFaces; ++f) {
+      if (am->mFaces[f].mNumIndices == 3) ++triangle_count;
+    }
+  }
+  if (triangle_count == 0) {
+    return error("'" + path + "' has no triangles (an object needs a surface)");
+  }
+
+  // UV channel: every Assimp mesh must carry it for the object to have lightmap UVs.
+  const bool channel_in_range =
+      obj.uv_channel >= 0 && obj.uv_channel < static_cast<int>(AI_MAX_NUMBER_OF_TEXTURECOORDS);
+  result.has_uv = channel_in_range;
+  const aiMesh* mesh_without_uv = nullptr;
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh* am = scene.mMeshes[m];
+    if (!channel_in_range || !am->HasTextureCoords(static_cast<unsigned>(obj.uv_channel))) {
+      result.has_uv = false;
+      if (!mesh_without_uv) mesh_without_uv = am;
+    }
+  }
+
+  // Vertices in world space, all meshes concatenated. UVs are copied only when every mesh has
+  // the channel, so has_uv says what the texcoords hold.
+  const Mat3 linear = obj.transform.linear();
+  const Mat3 normal_matrix = linear.inverse().transpose();
+  const bool mirrors = linear.determinant() < 0;
+  std::vector<ImportedVertex> vertices;
+  std::vector<std::size_t> first_vertex(scene.mNumMeshes);
+  bool uvs_finite = true;
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh* am = scene.mMeshes[m];
+    first_vertex[m] = vertices.size();
+    for (unsigned i = 0; i < am->mNumVertices; ++i) {
+      ImportedVertex v;
+      const aiVector3D& p = am->mVertices[i];
+      const Vec3 file_position(p.x, p.y, p.z);
+      if (!file_position.allFinite()) {
+        return error("'" + path + "': vertex " + std::to_string(vertices.size()) +
+                     " (as Assimp numbers them) has a non-finite position " +
+                     format_vec(file_position) + "; fix the mesh file");
+      }
+      v.position = obj.transform * file_position;
+      v.normal = Vec3::Zero();
+      if (am->HasNormals()) {
+        const aiVector3D& n = am->mNormals[i];
+        const Vec3 world_normal = normal_matrix * Vec3(n.x, n.y, n.z);
+        const double length = world_normal.norm();
+        if (std::isfinite(length) && length > 0) v.normal = world_normal / length;
+      }
+      if (result.has_uv) {
+        const aiVector3D& t = am->mTextureCoords[obj.uv_channel][i];
+        v.uv = Vec2(t.x, t.y);
+        if (!v.uv.allFinite()) {
+          if (obj.receiver) {
+            return error("'" + path + "': vertex " + std::to_string(vertices.size()) +
+                         " (as Assimp numbers them) has a non-finite UV in channel " +
+                         std::to_string(obj.uv_channel) + "; fix the mesh file");
+          }
+          uvs_finite = false;
+        }
+      }
+      vertices.push_back(v);
+    }
+  }
+  if (!uvs_finite) {  // a blocker's unusable UVs are dropped: it needs none
+    result.has_uv = false;
+    for (ImportedVertex& v : vertices) v.uv = Vec2::Zero();
+  }
+  if (obj.receiver && !result.has_uv) {
+    const unsigned channels = mesh_without_uv ? mesh_without_uv->GetNumUVChannels() : 0;
+    const std::string channel = std::to_string(obj.uv_channel);
+    return error("a receiver needs lightmap UVs in channel " + channel + " (uv = " + channel +
+                 ") but '" + path + "' has " +
+                 (channels == 0 ? std::string("no UVs")
+                                : "only " + std::to_string(channels) + " UV channel(s)") +
+                 "; add a lightmap UV set or set 'uv' to an existing channel");
+  }
+
+  // Degenerate threshold relative to the object's size, from the vertices faces use.
+  Bounds3 bounds;
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh* am = scene.mMeshes[m];
+    for (unsigned f = 0; f < am->mNumFaces; ++f) {
+      const aiFace& face = am->mFaces[f];
+      if (face.mNumIndices != 3) continue;
+      for (unsigned k = 0; k < 3; ++k) {
+        bounds.extend(vertices[first_vertex[m] + face.mIndices[k]].position);
+      }
+    }
+  }
+  const double diagonal = bounds.diagonal();
+  const double min_area = kDegenerateAreaFraction * diagonal * diagonal;
+
+  TriMesh& mesh = result.mesh;
+  std::vector<TriMesh::VertexHandle> handle(vertices.size());  // made on first use
+  auto vertex = [&](std::size_t index) {
+    if (!handle[index].is_valid()) {
+      const ImportedVertex& v = vertices[index];
+      handle[index] =
+          mesh.add_vertex(TriMesh::Point(v.position.x(), v.position.y(), v.position.z()));
+      mesh.set_normal(handle[index], TriMesh::Normal(v.normal.x(), v.normal.y(), v.normal.z()));
+      mesh.set_texcoord2D(handle[index], TriMesh::TexCoord2D(v.uv.x(), v.uv.y()));
+    }
+    return handle[index];
+  };
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh* am = scene.mMeshes[m];
+    for (unsigned f = 0; f < am->mNumFaces; ++f) {
+      const aiFace& face = am->mFaces[f];
+      if (face.mNumIndices != 3) continue;  // points and lines have no surface
+      std::size_t index[3];
+      for (int k = 0; k < 3; ++k) index[k] = first_vertex[m] + face.mIndices[k];
+      if (mirrors) std::swap(index[1], index[2]);
+      const Vec3& a = vertices[index[0]].position;
+      const Vec3& b = vertices[index[1]].position;
+      const Vec3& c = vertices[index[2]].position;
+      const Vec3 winding_normal = (b - a).cross(c - a);
+      const double area = 0.5 * winding_normal.norm();
+      const Vec3 normal_sum =
+          vertices[index[0]].normal + vertices[index[1]].normal + vertices[index[2]].normal;
+      if (winding_normal.dot(normal_sum) < 0) std::swap(index[1], index[2]);
+      if (!(area > min_area) || area == 0 || index[0] == index[1] || index[1] == index[2] ||
+          index[0] == index[2]) {
+        ++result.skipped_degenerate;
+        continue;
+      }
+      add_triangle(mesh, vertex(index[0]), vertex(index[1]), vertex(index[2]));
+    }
+  }
+  if (mesh.n_faces() == 0) {
+    return error("every one of the " + std::to_string(triangle_count) + " triangles of '" + path +
+                 "' has zero area; fix the mesh file or its scale");
+  }
+  mesh.update_face_normals();
+
+  // A vertex whose file normal was missing or unusable takes the area-weighted mean of its faces'.
+  for (auto v : mesh.vertices()) {
+    if (mesh.normal(v).sqrnorm() > 0) continue;
+    TriMesh::Normal sum(0, 0, 0);
+    for (auto f : mesh.vf_range(v)) sum += mesh.calc_face_normal(f) * mesh.calc_face_area(f);
+    const double length = sum.norm();
+    mesh.set_normal(v, length > 0 ? sum / length : TriMesh::Normal(0, 0, 1));
+  }
+  return result;
+}
+
+}  // namespace
+
+Expected<Mesh> import_mesh(const ObjectDesc& obj, const std::filesystem::path& scene_file) {
+  const ErrorPrefix error(obj, scene_file);
+  const std::filesystem::path file = mesh_path(obj, scene_file);
+  const std::string path = file.string();
+  try {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(file, ec)) {
+      return error("cannot read mesh '" + path + "': " +
+                   (std::filesystem::exists(file, ec) ? "not a regular file" : "no such file"));
+    }
+    Assimp::Importer importer;
+    const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                           aiProcess_PreTransformVertices | aiProcess_GenSmoothNormals |
+                           aiProcess_ValidateDataStructure;
+    const aiScene* scene = importer.ReadFile(path, flags);
+    if (!scene) {
+      return error("cannot read mesh '" + path + "': " + one_line(importer.GetErrorString()));
+    }
+    if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || scene->mNumMeshes == 0) {
+      return error("'" + path + "' has no triangles (an object needs a surface)");
+    }
+    return build_mesh(*scene, obj, path, error);
+  } catch (const std::exception& e) {
+    return error("cannot import mesh '" + path + "': " + one_line(e.what()));
+  }
+}
+
+}  // namespace sb
