@@ -44,6 +44,8 @@ TEST(Bake, ParallelSceneMatchesClosedFormWithOffsetBlocker) {
   const double rmse = std::sqrt(sq / (img.width * img.height));
   EXPECT_LT(rmse, 0.005);
   EXPECT_LT(max_err, 0.04);
+  RecordProperty("rmse", std::to_string(rmse));
+  RecordProperty("max_error", std::to_string(max_err));
   // The umbra is in the upper half of the image (v > 0.5) and the right half (u > 0.5).
   EXPECT_EQ(img.at(20, 9)[0], 0.0f);
 }
