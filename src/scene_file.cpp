@@ -527,6 +527,26 @@ std::string one_line(std::string_view text) {
   return out;
 }
 
+// Reads each [[kind]] table with `read` and refuses a name used twice.
+template <class Desc, class Tables, class Reader>
+Expected<std::vector<Desc>> read_unique(const std::filesystem::path& file, const Tables& tables,
+                                        const char* kind, Reader read) {
+  std::vector<Desc> out;
+  std::map<std::string, int> lines;
+  for (std::size_t i = 0; i < tables.size(); ++i) {
+    Expected<Desc> desc = read(file, *tables[i], i);
+    if (!desc) return desc.error();
+    const auto [first, inserted] = lines.emplace(desc->name, desc->line);
+    if (!inserted) {
+      return located_error(file, desc->line, item_name(kind, desc->name),
+                           fmt::format("{} names must be unique: {} is also defined at line {}",
+                                       kind, single_quoted(desc->name), first->second));
+    }
+    out.push_back(std::move(*desc));
+  }
+  return out;
+}
+
 }  // namespace
 
 Expected<Scene> load_scene(const std::filesystem::path& file) {
@@ -569,31 +589,12 @@ Expected<Scene> load_scene(const std::filesystem::path& file) {
     }
   }
 
-  std::map<std::string, int> object_lines;
-  for (std::size_t i = 0; i < object_tables.size(); ++i) {
-    Expected<ObjectDesc> obj = read_object(file, *object_tables[i], i);
-    if (!obj) return obj.error();
-    const auto [first, inserted] = object_lines.emplace(obj->name, obj->line);
-    if (!inserted) {
-      return located_error(file, obj->line, item_name("object", obj->name),
-                           fmt::format("object names must be unique: {} is also defined at line {}",
-                                       single_quoted(obj->name), first->second));
-    }
-    scene.objects.push_back(std::move(*obj));
-  }
-
-  std::map<std::string, int> light_lines;
-  for (std::size_t i = 0; i < light_tables.size(); ++i) {
-    Expected<LightDesc> light = read_light(file, *light_tables[i], i);
-    if (!light) return light.error();
-    const auto [first, inserted] = light_lines.emplace(light->name, light->line);
-    if (!inserted) {
-      return located_error(file, light->line, item_name("light", light->name),
-                           fmt::format("light names must be unique: {} is also defined at line {}",
-                                       single_quoted(light->name), first->second));
-    }
-    scene.lights.push_back(std::move(*light));
-  }
+  auto objects = read_unique<ObjectDesc>(file, object_tables, "object", read_object);
+  if (!objects) return objects.error();
+  scene.objects = std::move(*objects);
+  auto lights = read_unique<LightDesc>(file, light_tables, "light", read_light);
+  if (!lights) return lights.error();
+  scene.lights = std::move(*lights);
 
   if (scene.objects.empty()) {
     return located_error(file, 0, "scene", "no [[object]] table; a scene needs at least one");

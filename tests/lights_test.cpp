@@ -105,31 +105,25 @@ std::vector<Point> probe_points() {
   };
 }
 
-TEST(Lambert, RectangleMatchesNumericalIntegration) {
-  const Light light(rectangle(0.5, 0.3));
+void expect_matches_numerical_integration(const LightDesc& desc) {
+  const Light light(desc);
   for (const auto& p : probe_points()) {
     const double exact = light.form_factor(p.y, p.n);
     const double numeric = numeric_form_factor(light, p.y, p.n);
     EXPECT_NEAR(exact, numeric, 2e-5 + 1e-4 * numeric) << p.y.transpose();
   }
+}
+
+TEST(Lambert, RectangleMatchesNumericalIntegration) {
+  expect_matches_numerical_integration(rectangle(0.5, 0.3));
 }
 
 TEST(Lambert, DiskMatchesNumericalIntegration) {
-  const Light light(tilted_disk(0.25));
-  for (const auto& p : probe_points()) {
-    const double exact = light.form_factor(p.y, p.n);
-    const double numeric = numeric_form_factor(light, p.y, p.n);
-    EXPECT_NEAR(exact, numeric, 2e-5 + 1e-4 * numeric) << p.y.transpose();
-  }
+  expect_matches_numerical_integration(tilted_disk(0.25));
 }
 
 TEST(Lambert, SphereMatchesNumericalIntegration) {
-  const Light light(sphere(0.2));
-  for (const auto& p : probe_points()) {
-    const double exact = light.form_factor(p.y, p.n);
-    const double numeric = numeric_form_factor(light, p.y, p.n);
-    EXPECT_NEAR(exact, numeric, 2e-5 + 1e-4 * numeric) << p.y.transpose();
-  }
+  expect_matches_numerical_integration(sphere(0.2));
 }
 
 TEST(Lambert, DiskOnAxisIsClassicFormula) {
