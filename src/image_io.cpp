@@ -36,6 +36,9 @@ Expected<fs::path> stage_image(const fs::path& path, const Image& image, PixelFo
   const auto type = format == PixelFormat::float32 ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8;
   OIIO::ImageSpec spec(image.width, image.height, image.channels, type);
   if (format == PixelFormat::float32) spec.attribute("compression", "zip");
+  // OIIO stamps EXR files with the current time unless DateTime is set; an empty one writes
+  // none, so the same bake gives the same bytes.
+  spec.attribute("DateTime", "");
   if (!out->open(tmp.string(), spec)) {
     std::string why = out->geterror();
     discard_file(tmp);

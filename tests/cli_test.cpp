@@ -10,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include "image_io.h"
 
@@ -122,6 +123,8 @@ TEST_F(Cli, SameSceneSameSeedSameBytes) {
   write("scene.toml", scene());
   const std::string s = (dir_ / "scene.toml").string();
   ASSERT_EQ(run("bake " + s + " -o " + (dir_ / "a").string() + " --threads 1").code, 0);
+  // A second apart, so a timestamp written into a file would show.
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));
   ASSERT_EQ(run("bake " + s + " -o " + (dir_ / "b").string() + " --threads 2").code, 0);
   for (const char* f : {"floor.exr", "floor.png"}) {
     EXPECT_EQ(slurp(dir_ / "a" / f), slurp(dir_ / "b" / f)) << f;
