@@ -43,11 +43,19 @@ class ProgressBar {
  public:
   explicit ProgressBar(std::string label) : label_(std::move(label)) {}
   void update(double fraction) {
-    std::unique_lock lock(mutex_, std::try_to_lock);
-    if (!lock) return;
+    const bool final_update = fraction >= 1.0;
+    // The final update must not be lost to a busy lock; the others may be.
+    std::unique_lock lock(mutex_, std::defer_lock);
+    if (final_update) {
+      lock.lock();
+    } else if (!lock.try_lock()) {
+      return;
+    }
+    if (finished_) return;
     const auto now = std::chrono::steady_clock::now();
-    if (fraction < 1.0 && now - last_ < std::chrono::milliseconds(100)) return;
+    if (!final_update && now - last_ < std::chrono::milliseconds(100)) return;
     last_ = now;
+    finished_ = final_update;
     constexpr int kWidth = 40;
     const int filled = int(fraction * kWidth + 0.5);
     std::fprintf(stderr, "\r%s [%s%s] %3d%%", label_.c_str(), std::string(filled, '#').c_str(),
@@ -60,6 +68,7 @@ class ProgressBar {
   std::string label_;
   std::mutex mutex_;
   std::chrono::steady_clock::time_point last_{};
+  bool finished_ = false;
 };
 
 struct BakeArgs {

@@ -149,6 +149,20 @@ TEST_F(Cli, OverridesReachTheManifest) {
   EXPECT_GT(exr->at(0, 0)[0], 1.0f);
 }
 
+TEST_F(Cli, WarnsAboutDegenerateTriangles) {
+  // The blocker gains a zero-area triangle (three collinear points): skipped, with a warning.
+  write("blocker.obj",
+        "v -0.3 -0.3 0.5\nv 0.3 -0.3 0.5\nv 0.3 0.3 0.5\nv -0.3 0.3 0.5\nv 0 0 0.5\n"
+        "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n"
+        "f 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\nf 1/1/1 5/1/1 3/3/1\n");
+  write("scene.toml", scene());
+  const CliRun r = run("bake " + (dir_ / "scene.toml").string() + " -o " + (dir_ / "out").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("warning"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("blocker"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("degenerate"), std::string::npos) << r.err;
+}
+
 // A bad scene: exit code 3, one line on stderr naming the file and the item, and no output.
 void expect_scene_error(const CliRun& r, const std::vector<std::string>& words) {
   EXPECT_EQ(r.code, 3) << r.err;
