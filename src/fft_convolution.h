@@ -1,0 +1,53 @@
+// Linear 2D convolution of a blocker image with a source kernel through FFTW's real transforms
+// (single precision). design-notes §2: the occluded fraction is the source image, scaled and
+// mirrored, convolved with the blocker image; the FFT turns that into a pointwise product of
+// spectra. FFTW's types stay in fft_convolution.cpp.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+namespace sb {
+
+// The spectrum of a kernel padded to a transform size; opaque, shareable between threads.
+struct KernelSpectrum;
+
+class FftConvolver {
+ public:
+  // The process-wide instance: plans are created once per transform size and reused by every
+  // receiver and light (FFTW's planner is not thread-safe; this class serialises it, and the
+  // plans are then executed from any thread on fresh arrays).
+  static FftConvolver& shared();
+
+  // The smallest size >= n whose prime factors are all 2, 3, 5 or 7 (sizes FFTW is fast at).
+  static int fast_size(int n);
+
+  // Spectrum of `kernel` (kw × kh floats, row-major, both odd; its centre pixel (kw/2, kh/2) is
+  // the origin) for transforms of size tw × th (tw >= kw, th >= kh). Cached: a second call with
+  // the same kernel values and sizes returns the same spectrum without transforming again.
+  std::shared_ptr<const KernelSpectrum> kernel_spectrum(const std::vector<float>& kernel, int kw,
+                                                        int kh, int tw, int th);
+
+  // out(x, y) = Σ_u kernel(u) · image((x, y) − u), with the image taken as 0 outside its
+  // w × h pixels, for the whole w × h output. Uses a transform of the spectrum's size, which must
+  // be at least w × h: values within (kw−1)/2, (kh−1)/2 of the border of a tw × th transform may
+  // wrap around, so callers that need exact values everywhere make tw >= w + kw − 1 (and
+  // likewise th), and callers that pad their image by the kernel radius use the interior only.
+  // `out` is resized to w·h.
+  void convolve(const std::vector<float>& image, int w, int h, const KernelSpectrum& kernel,
+                std::vector<float>& out);
+
+  // Number of FFTW threads used for one transform (default: all cores). Call before baking.
+  void set_threads(int threads);
+
+  FftConvolver(const FftConvolver&) = delete;
+  FftConvolver& operator=(const FftConvolver&) = delete;
+  ~FftConvolver();
+
+ private:
+  FftConvolver();
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace sb
