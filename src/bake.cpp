@@ -8,7 +8,11 @@
 #include <atomic>
 #include <chrono>
 #include <memory>
+#include <optional>
+#include <thread>
 
+#include "convolution_bake.h"
+#include "fft_convolution.h"
 #include "lights.h"
 #include "mesh.h"
 #include "ray_scene.h"
@@ -38,6 +42,9 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     thread_limit = std::make_unique<tbb::global_control>(
         tbb::global_control::max_allowed_parallelism, std::size_t(options.threads));
   }
+  FftConvolver::shared().set_threads(options.threads > 0
+                                         ? options.threads
+                                         : int(std::max(1u, std::thread::hardware_concurrency())));
 
   BakeResult result;
   const auto load_start = std::chrono::steady_clock::now();
@@ -57,10 +64,21 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   std::vector<const Mesh*> blockers;
   for (std::size_t i = 0; i < meshes.size(); ++i)
     if (scene.objects[i].blocker) blockers.push_back(&meshes[i]);
-  auto rays = RayScene::build(blockers);
-  if (!rays) return rays.error();
-  const std::vector<Light> lights = make_lights(scene.lights);
+  const bool ray_traced = scene.bake.method == "reference";
+  std::optional<RayScene> rays;
+  if (ray_traced) {
+    auto built = RayScene::build(blockers);
+    if (!built) return built.error();
+    rays.emplace(std::move(*built));
+  }
+  auto lights_or = make_lights(scene.lights, scene.file);
+  if (!lights_or) return lights_or.error();
+  const std::vector<Light>& lights = *lights_or;
 
+  result.load_seconds = seconds_since(load_start);
+
+  // The bake proper, timed from here: texel space, the method, dilation.
+  const auto bake_start = std::chrono::steady_clock::now();
   const int res = scene.bake.resolution;
   std::vector<std::size_t> receivers;
   std::vector<TexelSpace> spaces;
@@ -74,9 +92,7 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     raster_seconds.push_back(seconds_since(start));
     total_texels += std::int64_t(spaces.back().texels.size());
   }
-  result.load_seconds = seconds_since(load_start);
 
-  const auto bake_start = std::chrono::steady_clock::now();
   std::atomic<std::int64_t> texels_done{0};
   ProgressFn progress;
   if (options.progress && total_texels > 0) {
@@ -85,20 +101,36 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   for (std::size_t r = 0; r < receivers.size(); ++r) {
     const auto start = std::chrono::steady_clock::now();
     const ObjectDesc& obj = scene.objects[receivers[r]];
-    ReferenceInputs in;
-    in.lights = &lights;
-    in.rays = &*rays;
-    in.quantity = scene.bake.quantity;
-    in.samples = scene.bake.samples;
-    in.seed = scene.bake.seed;
-    in.stream = receivers[r];
-    in.texels_done = &texels_done;
-    in.progress = progress;
     ReceiverBake out;
+    out.seconds_texels = raster_seconds[r];
     out.name = obj.name;
     out.uv_channel = obj.uv_channel;
-    out.image = bake_reference(spaces[r], in, &result.shadow_rays);
+    if (ray_traced) {
+      ReferenceInputs in;
+      in.lights = &lights;
+      in.rays = &*rays;
+      in.quantity = scene.bake.quantity;
+      in.samples = scene.bake.samples;
+      in.seed = scene.bake.seed;
+      in.stream = receivers[r];
+      in.texels_done = &texels_done;
+      in.progress = progress;
+      out.image = bake_reference(spaces[r], in, &result.shadow_rays);
+    } else {
+      ConvolutionInputs in;
+      in.lights = &lights;
+      in.receiver = &meshes[receivers[r]];
+      for (const Mesh* b : blockers)
+        if (b != in.receiver) in.blockers.push_back(b);
+      in.quantity = scene.bake.quantity;
+      out.image = bake_convolution(spaces[r], in, &out.pairs);
+      texels_done += std::int64_t(spaces[r].texels.size());
+      if (progress) progress(double(texels_done.load()));
+    }
+    out.seconds_method = seconds_since(start);
+    const auto dilate_start = std::chrono::steady_clock::now();
     dilate(out.image, spaces[r].covered, scene.bake.margin);
+    out.seconds_dilate = seconds_since(dilate_start);
     out.covered_texels = std::int64_t(spaces[r].texels.size());
     out.seconds = raster_seconds[r] + seconds_since(start);
     result.receivers.push_back(std::move(out));

@@ -1,6 +1,7 @@
 #include "image_io.h"
 
 #include <OpenImageIO/imageio.h>
+#include <OpenImageIO/strutil.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -97,13 +98,21 @@ Status write_image(const fs::path& path, const Image& image, PixelFormat format)
   return commit_file(*staged, path);
 }
 
-Expected<Image> read_image(const fs::path& path) {
+Expected<Image> read_image(const fs::path& path, bool linearise) {
   auto in = OIIO::ImageInput::open(path.string());
   if (!in) return input_error(path.string() + ": cannot read image: " + OIIO::geterror());
   const OIIO::ImageSpec& spec = in->spec();
   Image image(spec.width, spec.height, spec.nchannels);
   if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data())) {
     return input_error(path.string() + ": cannot read image: " + in->geterror());
+  }
+  if (linearise && OIIO::Strutil::iequals(spec.get_string_attribute("oiio:ColorSpace"), "sRGB")) {
+    const int alpha = spec.alpha_channel;
+    for (std::size_t i = 0; i < image.pixels.size(); ++i) {
+      if (int(i % std::size_t(spec.nchannels)) == alpha) continue;
+      float& v = image.pixels[i];
+      v = v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+    }
   }
   return image;
 }

@@ -27,7 +27,9 @@ Expected<std::filesystem::path> stage_text(const std::filesystem::path& path,
 Status commit_file(const std::filesystem::path& staged, const std::filesystem::path& path);
 void discard_file(const std::filesystem::path& staged);
 
-// Reads any OIIO-readable image as float, keeping its channel count.
-Expected<Image> read_image(const std::filesystem::path& path);
+// Reads any OIIO-readable image as float, keeping its channel count. With `linearise`, values
+// of an image whose colour space OIIO reports as sRGB (8-bit PNG, JPEG, ...) are decoded to
+// linear, so they can be used as emission.
+Expected<Image> read_image(const std::filesystem::path& path, bool linearise = false);
 
 }  // namespace sb

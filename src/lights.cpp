@@ -19,6 +19,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "image_io.h"
+
 namespace sb {
 
 namespace {
@@ -76,6 +78,31 @@ double disk_form_factor(const Vec3& c, const Vec3& m, const Vec3& right, const V
   return polygon_form_factor(std::move(poly), n);
 }
 
+// RGB of pixel (x, y): grey images repeat their one channel; alpha is ignored.
+Vec3 pixel_rgb(const Image& image, int x, int y) {
+  const float* p = image.at(x, y);
+  return image.channels >= 3 ? Vec3(p[0], p[1], p[2]) : Vec3::Constant(p[0]);
+}
+
+Vec3 texture_mean(const Image& image) {
+  Vec3 sum = Vec3::Zero();
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) sum += pixel_rgb(image, x, y);
+  return sum / (double(image.width) * image.height);
+}
+
+// Bilinear lookup at (u, v) ∈ [0, 1]², v up (row 0 is v = 1), clamped at the border.
+Vec3 bilinear_rgb(const Image& image, double u, double v) {
+  const double fx = std::clamp(u, 0.0, 1.0) * image.width - 0.5;
+  const double fy = (1.0 - std::clamp(v, 0.0, 1.0)) * image.height - 0.5;
+  const int x0 = std::clamp(int(std::floor(fx)), 0, image.width - 1);
+  const int y0 = std::clamp(int(std::floor(fy)), 0, image.height - 1);
+  const int x1 = std::min(x0 + 1, image.width - 1), y1 = std::min(y0 + 1, image.height - 1);
+  const double tx = std::clamp(fx - x0, 0.0, 1.0), ty = std::clamp(fy - y0, 0.0, 1.0);
+  return (1 - ty) * ((1 - tx) * pixel_rgb(image, x0, y0) + tx * pixel_rgb(image, x1, y0)) +
+         ty * ((1 - tx) * pixel_rgb(image, x0, y1) + tx * pixel_rgb(image, x1, y1));
+}
+
 // Any unit vector orthogonal to m.
 Vec3 orthogonal(const Vec3& m) {
   const Vec3 a = std::abs(m.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
@@ -100,7 +127,8 @@ double polygon_form_factor(std::vector<Vec3> polygon, const Vec3& n) {
   return std::abs(sum) / (2.0 * kPi);
 }
 
-Light::Light(const LightDesc& desc) : desc_(desc) {
+Light::Light(const LightDesc& desc, std::shared_ptr<const Image> texture)
+    : desc_(desc), texture_(std::move(texture)) {
   if (desc_.shape == LightShape::sphere) {
     up_ = Vec3::UnitZ();
     right_ = Vec3::UnitX();
@@ -109,6 +137,61 @@ Light::Light(const LightDesc& desc) : desc_(desc) {
     right_ = up_.cross(desc_.normal).normalized();
   }
   exitance_ = desc_.color * (desc_.power / area());
+  if (texture_) exitance_ = exitance_.cwiseProduct(texture_mean(*texture_));
+}
+
+Vec3 Light::tint(const Vec2& local) const {
+  if (!texture_) return Vec3::Ones();
+  // Texture coordinates over the light's bounding rectangle: u along right, v along up.
+  const double w = desc_.shape == LightShape::rectangle ? desc_.width : 2 * desc_.radius;
+  const double h = desc_.shape == LightShape::rectangle ? desc_.height : 2 * desc_.radius;
+  return bilinear_rgb(*texture_, local.x() / w + 0.5, local.y() / h + 0.5);
+}
+
+double Light::extent_across(const Vec3& axis) const {
+  switch (desc_.shape) {
+    case LightShape::rectangle: {
+      // The longer diagonal of the parallelogram the rectangle projects to.
+      const Vec3 a = 0.5 * desc_.width * right_, b = 0.5 * desc_.height * up_;
+      auto across = [&](const Vec3& v) { return (v - v.dot(axis) * axis).norm(); };
+      return 2 * std::max(across(a + b), across(a - b));
+    }
+    case LightShape::disk:
+    case LightShape::sphere:
+      return 2 * desc_.radius;  // an ellipse's major axis, or the sphere's outline
+  }
+  return 0;
+}
+
+Vec2 Light::half_extents(const Vec3& e1, const Vec3& e2) const {
+  auto along = [&](const Vec3& e) {
+    switch (desc_.shape) {
+      case LightShape::rectangle:
+        return 0.5 * (desc_.width * std::abs(right_.dot(e)) + desc_.height * std::abs(up_.dot(e)));
+      case LightShape::disk:
+        return desc_.radius * std::sqrt(std::max(0.0, 1.0 - std::pow(desc_.normal.dot(e), 2)));
+      case LightShape::sphere:
+        return desc_.radius;
+    }
+    return 0.0;
+  };
+  return Vec2(along(e1), along(e2));
+}
+
+Vec3 Light::source_image(const Vec3& offset, const Vec3& axis) const {
+  if (desc_.shape == LightShape::sphere) {
+    return (offset - offset.dot(axis) * axis).norm() <= desc_.radius ? Vec3::Ones() : Vec3::Zero();
+  }
+  // Slide along the axis onto the light's plane.
+  const double facing = axis.dot(desc_.normal);
+  if (std::abs(facing) < 1e-9) return Vec3::Zero();  // seen edge-on: no area
+  const Vec3 on_light = offset - axis * (offset.dot(desc_.normal) / facing);
+  const Vec2 local(on_light.dot(right_), on_light.dot(up_));
+  const bool inside =
+      desc_.shape == LightShape::rectangle
+          ? std::abs(local.x()) <= 0.5 * desc_.width && std::abs(local.y()) <= 0.5 * desc_.height
+          : local.squaredNorm() <= desc_.radius * desc_.radius;
+  return inside ? tint(local) : Vec3::Zero();
 }
 
 double Light::area() const {
@@ -147,6 +230,32 @@ double Light::form_factor(const Vec3& y, const Vec3& n) const {
   return 0.0;
 }
 
+bool Light::reaches(const Vec3& y, const Vec3& n) const {
+  const Vec3 c = desc_.position - y;
+  switch (desc_.shape) {
+    case LightShape::rectangle: {
+      if (c.dot(desc_.normal) >= 0) return false;
+      // The horizon clips a positive area off the rectangle as soon as one corner is above it.
+      const double hw = 0.5 * desc_.width * std::abs(n.dot(right_));
+      const double hh = 0.5 * desc_.height * std::abs(n.dot(up_));
+      return n.dot(c) + hw + hh > 0;
+    }
+    case LightShape::disk:
+      return c.dot(desc_.normal) < 0 &&
+             n.dot(c) + desc_.radius * (n - n.dot(desc_.normal) * desc_.normal).norm() > 0;
+    case LightShape::sphere: {
+      const double d = c.norm(), r = desc_.radius;
+      if (d <= r) return false;
+      // The silhouette disk, as in form_factor.
+      const Vec3 axis = -c / d;
+      const Vec3 sil_centre = c * (1.0 - r * r / (d * d));
+      const double sil_radius = r * std::sqrt(d * d - r * r) / d;
+      return n.dot(sil_centre) + sil_radius * (n - n.dot(axis) * axis).norm() > 0;
+    }
+  }
+  return false;
+}
+
 Vec3 Light::unoccluded_irradiance(const Vec3& y, const Vec3& n) const {
   return exitance_ * form_factor(y, n);
 }
@@ -173,6 +282,7 @@ LightSample Light::sample(const Vec3& y, const Vec3& n, const Vec2& u) const {
         local = desc_.radius * r * Vec2(std::cos(phi), std::sin(phi));
       }
       s.point = desc_.position + local.x() * right_ + local.y() * up_;
+      s.tint = tint(local);
       const Vec3 d = s.point - y;
       const double dist2 = d.squaredNorm();
       if (dist2 <= 0) return s;
@@ -205,10 +315,24 @@ LightSample Light::sample(const Vec3& y, const Vec3& n, const Vec2& u) const {
   return s;
 }
 
-std::vector<Light> make_lights(const std::vector<LightDesc>& descs) {
+Expected<std::vector<Light>> make_lights(const std::vector<LightDesc>& descs,
+                                         const std::filesystem::path& scene_file) {
   std::vector<Light> lights;
   lights.reserve(descs.size());
-  for (const auto& d : descs) lights.emplace_back(d);
+  for (const auto& d : descs) {
+    std::shared_ptr<const Image> texture;
+    if (!d.texture.empty()) {
+      auto image = read_image(d.texture, /*linearise=*/true);
+      const std::string where = scene_file.string() + ":" + std::to_string(d.line) + ": light '" +
+                                d.name + "': texture: ";
+      if (!image) return scene_error(where + image.error().message);
+      if (image->width < 1 || image->height < 1 || texture_mean(*image).maxCoeff() <= 0) {
+        return scene_error(where + d.texture.string() + ": the image is empty or black");
+      }
+      texture = std::make_shared<const Image>(std::move(*image));
+    }
+    lights.emplace_back(d, std::move(texture));
+  }
   return lights;
 }
 

@@ -2,9 +2,13 @@
 // (design-notes §1) and stratified sampling for the ray-traced reference.
 #pragma once
 
+#include <filesystem>
+#include <memory>
 #include <vector>
 
+#include "error.h"
 #include "geometry.h"
+#include "image.h"
 #include "scene.h"
 
 namespace sb {
@@ -14,19 +18,38 @@ namespace sb {
 struct LightSample {
   Vec3 point;
   double weight = 0;  // 0: the sample cannot contribute (behind the light or below the horizon)
+  Vec3 tint = Vec3::Ones();  // the emission texture at the point (ones for an untextured light)
 };
 
 class Light {
  public:
-  explicit Light(const LightDesc& desc);
+  // `texture`, if given, is the emission image mapped over a rectangle or disk (linear RGB or
+  // grey; row 0 is the top, along `up`).
+  explicit Light(const LightDesc& desc, std::shared_ptr<const Image> texture = nullptr);
 
   const LightDesc& desc() const { return desc_; }
   LightShape shape() const { return desc_.shape; }
   Vec3 centre() const { return desc_.position; }
   // Emitting surface area in m² (a sphere's whole surface; a rectangle or disk's one side).
   double area() const;
-  // Radiant exitance per channel, W/m²: color · power / area.
+  // Radiant exitance per channel, W/m², averaged over the light: color · power / area, times the
+  // texture's mean for a textured light.
   Vec3 exitance() const { return exitance_; }
+  bool textured() const { return texture_ != nullptr; }
+  // The texture's value (bilinear) at a point given in metres in the light's (right, up) frame;
+  // ones for an untextured light.
+  Vec3 tint(const Vec2& local) const;
+  // Largest distance across the light seen along `axis`: the length that the penumbra error
+  // metric multiplies (design-notes §4), metres.
+  double extent_across(const Vec3& axis) const;
+  // Half the light's extent along each of two unit directions e1, e2 across the axis of
+  // projection (the bounding box of its outline seen along that axis), metres.
+  Vec2 half_extents(const Vec3& e1, const Vec3& e2) const;
+  // What the source image of design-notes §2 holds at a point of the plane through the centre
+  // perpendicular to `axis` (given as an offset from the centre): the light's relative emission
+  // (per channel, tint times 1) where the line through the point along `axis` meets the light,
+  // 0 where it misses. A sphere is a uniform disk of its radius.
+  Vec3 source_image(const Vec3& offset, const Vec3& axis) const;
   // Unit axes of a rectangle or disk: right = up × normal; the normal is the emitting side.
   const Vec3& right() const { return right_; }
   const Vec3& up() const { return up_; }
@@ -36,8 +59,12 @@ class Light {
   // H0 = E · F where F is the form factor from the point to the light, clipped to the point's
   // horizon. Rectangle: Lambert's polygon formula (exact). Disk, and a sphere through the disk of
   // its silhouette: the elementary closed form when the disk is wholly above the horizon, and a
-  // 128-gon of equal area, clipped, otherwise (relative error < 1e-4, tested).
+  // 128-gon of equal area, clipped, otherwise (relative error < 1e-4, tested). A textured light
+  // uses its mean exitance: exact for a uniform texture, the far-field value otherwise.
   Vec3 unoccluded_irradiance(const Vec3& y, const Vec3& n) const;
+  // Whether any of the light lies above the horizon of (y, n) and faces y, i.e. F > 0; much
+  // cheaper than F itself.
+  bool reaches(const Vec3& y, const Vec3& n) const;
   // The form factor F alone (dimensionless, H0 = E · F).
   double form_factor(const Vec3& y, const Vec3& n) const;
 
@@ -51,9 +78,13 @@ class Light {
   LightDesc desc_;
   Vec3 right_, up_;
   Vec3 exitance_;
+  std::shared_ptr<const Image> texture_;
 };
 
-std::vector<Light> make_lights(const std::vector<LightDesc>& descs);
+// The scene's lights, with their textures read (through OpenImageIO, sRGB decoded to linear).
+// An unreadable texture is an error naming scene_file, the light and the image.
+Expected<std::vector<Light>> make_lights(const std::vector<LightDesc>& descs,
+                                         const std::filesystem::path& scene_file);
 
 // Lambert's formula for the form factor of a planar polygon (vertices relative to the point,
 // either winding) seen from a point with unit normal n, after clipping the polygon to the

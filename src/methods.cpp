@@ -5,7 +5,7 @@
 namespace sb {
 
 const std::vector<std::string>& known_methods() {
-  static const std::vector<std::string> names = {"reference"};
+  static const std::vector<std::string> names = {"convolution", "reference"};
   return names;
 }
 

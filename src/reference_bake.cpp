@@ -1,7 +1,9 @@
 // The ray-traced reference (design-notes §1 and §7): the ground truth every other method is
 // measured against. For each covered texel and each light, `samples` stratified points on the
 // light, one shadow ray each; the light's visibility is the ratio estimate Σ w·v / Σ w (lights.cpp
-// says why), its unoccluded irradiance H0 is exact, and H = H0 · V. Parallel over texels with
+// says why), per colour channel with w scaled by the light's texture at the sample, its
+// unoccluded irradiance H0 is exact (for a textured light, see Light::unoccluded_irradiance),
+// and H = H0 · V. Parallel over texels with
 // oneTBB; each texel has its own random stream, so the result is the same for any thread count.
 #include "reference_bake.h"
 
@@ -25,7 +27,8 @@ Image bake_reference(const TexelSpace& space, const ReferenceInputs& in,
       [&](const tbb::blocked_range<std::size_t>& range) {
         std::vector<Vec2> strata;
         std::vector<Vec3> origins(in.samples), directions(in.samples);
-        std::vector<double> lengths(in.samples), weights(in.samples);
+        std::vector<double> lengths(in.samples);
+        std::vector<Vec3> weights(in.samples);  // per channel: w · tint
         std::vector<std::uint8_t> hit(in.samples);
         std::int64_t local_rays = 0;
         for (std::size_t t = range.begin(); t != range.end(); ++t) {
@@ -39,7 +42,7 @@ Image bake_reference(const TexelSpace& space, const ReferenceInputs& in,
                                 std::uint64_t(texel.y) * space.width + texel.x));
             stratified_samples(in.samples, rng, strata);
             int n = 0;
-            double weight_sum = 0;
+            Vec3 weight_sum = Vec3::Zero();
             for (int s = 0; s < in.samples; ++s) {
               const LightSample ls = lights[l].sample(texel.position, texel.normal, strata[s]);
               if (ls.weight <= 0) continue;
@@ -51,17 +54,19 @@ Image bake_reference(const TexelSpace& space, const ReferenceInputs& in,
               // Stop short of the light's own surface, which may lie on a blocker (a panel
               // on a ceiling).
               lengths[n] = 1.0 - offset / len;
-              weights[n] = ls.weight;
-              weight_sum += ls.weight;
+              weights[n] = ls.weight * ls.tint;
+              weight_sum += weights[n];
               ++n;
             }
-            if (n == 0 || weight_sum <= 0) continue;
+            if (n == 0 || weight_sum.maxCoeff() <= 0) continue;
             rays.occluded(n, origins.data(), directions.data(), lengths.data(), hit.data());
             local_rays += n;
-            double visible = 0;
+            Vec3 visible = Vec3::Zero();
             for (int s = 0; s < n; ++s)
               if (!hit[s]) visible += weights[s];
-            h_sum += h0 * (visible / weight_sum);
+            for (int c = 0; c < 3; ++c) {
+              if (weight_sum[c] > 0) h_sum[c] += h0[c] * (visible[c] / weight_sum[c]);
+            }
             h0_sum += h0;
           }
           float* px = out.at(texel.x, texel.y);

@@ -19,22 +19,22 @@ enum class Quantity { visibility, irradiance };
 const std::vector<std::string>& known_methods();
 
 struct BakeSettings {
-  int resolution = 512;            // texels per side of each receiver's lightmap
-  std::string method = "reference";
+  int resolution = 512;  // texels per side of each receiver's lightmap
+  std::string method = "convolution";
   Quantity quantity = Quantity::visibility;
-  int samples = 256;               // light samples per texel, for sampling methods
-  int margin = 4;                  // texels of dilation around UV charts
-  std::uint64_t seed = 0;          // sampling seed; same seed, same bytes
+  int samples = 256;       // light samples per texel, for sampling methods
+  int margin = 4;          // texels of dilation around UV charts
+  std::uint64_t seed = 0;  // sampling seed; same seed, same bytes
 };
 
 struct ObjectDesc {
-  std::string name;                // unique; the output file stem
-  std::filesystem::path mesh;      // resolved against the scene file's folder
+  std::string name;            // unique; the output file stem
+  std::filesystem::path mesh;  // resolved against the scene file's folder
   bool receiver = true;
   bool blocker = true;
   int uv_channel = 0;
   Affine3 transform = Affine3::Identity();  // scale, then rotate (X, Y, Z), then translate
-  int line = 0;                    // line of the [[object]] table in the scene file, for errors
+  int line = 0;  // line of the [[object]] table in the scene file, for errors
 };
 
 enum class LightShape { rectangle, disk, sphere };
@@ -42,19 +42,20 @@ enum class LightShape { rectangle, disk, sphere };
 struct LightDesc {
   std::string name;
   LightShape shape = LightShape::rectangle;
-  Vec3 position = Vec3::Zero();    // centre, metres
-  Vec3 normal = Vec3(0, 0, -1);    // unit; the side it emits into (rectangle, disk)
-  Vec3 up = Vec3(0, 1, 0);         // unit, made orthogonal to normal by the reader; height axis
-  double width = 0;                // rectangle only, across up; metres
-  double height = 0;               // rectangle only; metres
-  double radius = 0;               // disk and sphere; metres
-  Vec3 color = Vec3(1, 1, 1);      // per-channel scale of the emitted power
-  double power = 0;                // watts (for colour (1,1,1))
+  Vec3 position = Vec3::Zero();   // centre, metres
+  Vec3 normal = Vec3(0, 0, -1);   // unit; the side it emits into (rectangle, disk)
+  Vec3 up = Vec3(0, 1, 0);        // unit, made orthogonal to normal by the reader; height axis
+  double width = 0;               // rectangle only, across up; metres
+  double height = 0;              // rectangle only; metres
+  double radius = 0;              // disk and sphere; metres
+  Vec3 color = Vec3(1, 1, 1);     // per-channel scale of the emitted power
+  double power = 0;               // watts (for colour (1,1,1) and a white texture)
+  std::filesystem::path texture;  // optional emission image over a rectangle or disk; resolved
   int line = 0;
 };
 
 struct Scene {
-  std::filesystem::path file;      // the scene file, as given
+  std::filesystem::path file;  // the scene file, as given
   BakeSettings bake;
   std::vector<ObjectDesc> objects;
   std::vector<LightDesc> lights;

@@ -325,6 +325,28 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
   return bake;
 }
 
+// A path key naming an existing regular file, resolved against the scene file's folder.
+std::optional<std::filesystem::path> existing_file(TableReader& r,
+                                                   const std::filesystem::path& file,
+                                                   std::string_view key, std::string_view what) {
+  auto name = r.string(key);
+  if (!name) return std::nullopt;
+  const std::filesystem::path resolved = file.parent_path() / *name;
+  std::error_code ec;
+  std::filesystem::path looked_for = std::filesystem::absolute(resolved, ec).lexically_normal();
+  if (ec) looked_for = resolved;
+  const std::string shown = single_quoted(*name);
+  if (name->empty()) {
+    r.fail(key, fmt::format("'{}' must not be empty", key));
+  } else if (!std::filesystem::exists(looked_for, ec)) {
+    r.fail(key, fmt::format("{} {} not found (looked for {})", what, shown, looked_for.string()));
+  } else if (!std::filesystem::is_regular_file(looked_for, ec)) {
+    r.fail(key, fmt::format("{} {} is not a regular file (looked for {})", what, shown,
+                            looked_for.string()));
+  }
+  return looked_for;
+}
+
 Expected<ObjectDesc> read_object(const std::filesystem::path& file, const toml::table& table,
                                  std::size_t index) {
   TableReader r(file, table, fmt::format("[[object]] #{}", index + 1));
@@ -344,23 +366,7 @@ Expected<ObjectDesc> read_object(const std::filesystem::path& file, const toml::
   r.check_known_keys(
       {"name", "mesh", "receiver", "blocker", "uv", "translate", "rotate_deg", "scale"});
   r.require("mesh");
-  if (auto mesh = r.string("mesh")) {
-    const std::filesystem::path resolved = file.parent_path() / *mesh;
-    std::error_code ec;
-    std::filesystem::path looked_for = std::filesystem::absolute(resolved, ec).lexically_normal();
-    if (ec) looked_for = resolved;
-    const std::string shown = single_quoted(*mesh);
-    if (mesh->empty()) {
-      r.fail("mesh", "'mesh' must not be empty");
-    } else if (!std::filesystem::exists(looked_for, ec)) {
-      r.fail("mesh",
-             fmt::format("mesh file {} not found (looked for {})", shown, looked_for.string()));
-    } else if (!std::filesystem::is_regular_file(looked_for, ec)) {
-      r.fail("mesh", fmt::format("mesh file {} is not a regular file (looked for {})", shown,
-                                 looked_for.string()));
-    }
-    obj.mesh = looked_for;
-  }
+  if (auto mesh = existing_file(r, file, "mesh", "mesh file")) obj.mesh = *mesh;
   if (auto v = r.boolean("receiver")) obj.receiver = *v;
   if (auto v = r.boolean("blocker")) obj.blocker = *v;
   if (auto v = r.integer("uv", 0, std::numeric_limits<int>::max())) {
@@ -399,7 +405,7 @@ Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::ta
     }
   }
   r.check_known_keys(
-      {"name", "shape", "position", "normal", "up", "size", "radius", "color", "power"});
+      {"name", "shape", "position", "normal", "up", "size", "radius", "color", "power", "texture"});
   if (r.require("shape")) {
     if (auto shape = r.string("shape")) {
       if (*shape == "rectangle") {
@@ -482,6 +488,11 @@ Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::ta
 
   if (r.require("power")) {
     if (auto v = r.number("power", "a finite number > 0 (watts)", is_positive)) light.power = *v;
+  }
+  if (is_sphere) {
+    r.forbid("texture", "applies only to rectangle and disk lights, not sphere");
+  } else if (r.find("texture")) {
+    if (auto texture = existing_file(r, file, "texture", "texture image")) light.texture = *texture;
   }
   if (r.failed()) return r.error();
   return light;

@@ -102,7 +102,7 @@ TEST_F(Cli, BakesFilesAndManifest) {
   EXPECT_EQ(floor["files"]["png"], "floor.png");
   EXPECT_EQ(floor["uv_channel"], 0);
   EXPECT_EQ(floor["resolution"], nlohmann::json::array({32, 32}));
-  EXPECT_EQ(floor["method"], "reference");
+  EXPECT_EQ(floor["method"], "convolution");  // the default
   EXPECT_EQ(floor["quantity"], "visibility");
   EXPECT_EQ(floor["samples"], 16);
   EXPECT_GE(floor["seconds"].get<double>(), 0.0);
@@ -120,7 +120,7 @@ TEST_F(Cli, BakesFilesAndManifest) {
 }
 
 TEST_F(Cli, SameSceneSameSeedSameBytes) {
-  write("scene.toml", scene());
+  write("scene.toml", scene("method = \"reference\"\n"));
   const std::string s = (dir_ / "scene.toml").string();
   ASSERT_EQ(run("bake " + s + " -o " + (dir_ / "a").string() + " --threads 1").code, 0);
   // A second apart, so a timestamp written into a file would show.
@@ -131,6 +131,16 @@ TEST_F(Cli, SameSceneSameSeedSameBytes) {
   }
   ASSERT_EQ(run("bake " + s + " -o " + (dir_ / "c").string() + " --seed 9").code, 0);
   EXPECT_NE(slurp(dir_ / "a" / "floor.exr"), slurp(dir_ / "c" / "floor.exr"));
+  // The convolution method, which draws no random numbers, likewise.
+  ASSERT_EQ(
+      run("bake " + s + " -o " + (dir_ / "d").string() + " --method convolution --threads 1").code,
+      0);
+  ASSERT_EQ(
+      run("bake " + s + " -o " + (dir_ / "e").string() + " --method convolution --threads 2").code,
+      0);
+  for (const char* f : {"floor.exr", "floor.png"}) {
+    EXPECT_EQ(slurp(dir_ / "d" / f), slurp(dir_ / "e" / f)) << f;
+  }
 }
 
 TEST_F(Cli, OverridesReachTheManifest) {

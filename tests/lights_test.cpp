@@ -126,6 +126,23 @@ TEST(Lambert, SphereMatchesNumericalIntegration) {
   expect_matches_numerical_integration(sphere(0.2));
 }
 
+TEST(Lambert, ReachesIsFormFactorPositive) {
+  Rng rng(5);
+  for (const LightDesc& d : {rectangle(0.5, 0.3), tilted_disk(0.25), sphere(0.2)}) {
+    const Light light(d);
+    for (int i = 0; i < 20000; ++i) {
+      const Vec3 y(4 * rng.next_double() - 2, 4 * rng.next_double() - 2, 3 * rng.next_double() - 1);
+      const Vec3 n = Vec3(rng.next_double() - 0.5, rng.next_double() - 0.5, rng.next_double() - 0.5)
+                         .normalized();
+      const double f = light.form_factor(y, n);
+      // Points that graze the horizon may have F below double precision noise: skip them.
+      if (f > 0 && f < 1e-9) continue;
+      EXPECT_EQ(light.reaches(y, n), f > 0)
+          << to_string(d.shape) << " " << y.transpose() << " / " << n.transpose() << " F = " << f;
+    }
+  }
+}
+
 TEST(Lambert, DiskOnAxisIsClassicFormula) {
   // On the axis of a disk of radius R at height h, facing it: F = R² / (R² + h²).
   LightDesc d = tilted_disk(0.4);

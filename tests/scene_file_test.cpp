@@ -177,7 +177,7 @@ TEST_F(SceneFile, AppliesDefaults) {
   const BakeSettings defaults;
   EXPECT_EQ(scene.bake.resolution, defaults.resolution);
   EXPECT_EQ(scene.bake.resolution, 512);
-  EXPECT_EQ(scene.bake.method, "reference");
+  EXPECT_EQ(scene.bake.method, "convolution");
   EXPECT_EQ(scene.bake.quantity, Quantity::visibility);
   EXPECT_EQ(scene.bake.samples, 256);
   EXPECT_EQ(scene.bake.margin, 4);
@@ -245,7 +245,7 @@ TEST_F(SceneFile, RejectsUnknownBakeKey) {
 
 TEST_F(SceneFile, RejectsUnknownMethod) {
   const std::string text = "[bake]\nmethod = \"foo\"\n" + object_floor + light_panel;
-  expect_error(text, "method", "[bake]", "unknown method 'foo' (known: reference)");
+  expect_error(text, "method", "[bake]", "unknown method 'foo' (known: convolution, reference)");
 }
 
 TEST_F(SceneFile, RejectsFloatWhereIntegerExpected) {
@@ -276,6 +276,21 @@ TEST_F(SceneFile, RejectsMissingMeshFile) {
   EXPECT_NE(error_of(text).find("(looked for " + (dir_ / "floor.obj").string() + ")"),
             std::string::npos)
       << error_of(text);
+}
+
+TEST_F(SceneFile, ReadsLightTexture) {
+  std::ofstream(dir_ / "panel.png") << "not read here";
+  const Scene scene = load_ok(object_floor + light_panel + "texture = \"panel.png\"\n");
+  EXPECT_EQ(scene.lights[0].texture, dir_ / "panel.png");
+  EXPECT_TRUE(load_ok(object_floor + light_panel).lights[0].texture.empty());
+}
+
+TEST_F(SceneFile, RejectsMissingOrMisplacedTexture) {
+  const std::string missing = object_floor + light_panel + "texture = \"nope.png\"\n";
+  expect_error(missing, "texture", "light 'panel'", "texture image 'nope.png' not found");
+  std::ofstream(dir_ / "t.png") << "x";
+  const std::string on_sphere = object_floor + light_bulb + "texture = \"t.png\"\n";
+  expect_error(on_sphere, "texture", "light 'bulb'", "'texture' applies only to rectangle");
 }
 
 TEST_F(SceneFile, RejectsMeshThatIsNotARegularFile) {

@@ -1,0 +1,48 @@
+// The blocker image of design-notes §2–3: blocker geometry projected from the light's centre onto
+// the blocker plane, as anti-aliased coverage on a regular grid (blocker_image.cpp).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "geometry.h"
+#include "mesh.h"
+#include "virtual_configuration.h"
+
+namespace sb {
+
+// A regular grid over the tangent plane of a ProjectionFrame: pixel (i, j) covers
+// [origin + (i, j)·pixel, origin + (i + 1, j + 1)·pixel]; i runs along e1, j along e2.
+struct TangentGrid {
+  Vec2 origin = Vec2::Zero();
+  double pixel = 1;
+  int width = 0, height = 0;
+  // Continuous pixel coordinates of a tangent point (pixel centres at integers).
+  Vec2 to_pixel(const Vec2& t) const { return (t - origin) / pixel - Vec2::Constant(0.5); }
+};
+
+// Blocker triangles clipped to a slab of depth and projected: convex polygons in tangent
+// coordinates with their depth range.
+struct ProjectedBlockers {
+  struct Polygon {
+    std::vector<Vec2> points;  // tangent coordinates, counter-clockwise
+    Vec2 lo, hi;               // bounding box
+    double depth_lo = 0, depth_hi = 0;
+  };
+  std::vector<Polygon> polygons;
+};
+
+// Clips every triangle of `blockers` to near <= depth <= far along the frame's axis and projects
+// what remains from the frame's origin. Blocker parts behind the light or beyond the receiver
+// cannot shadow it, and projecting a point at depth ≈ 0 would throw it to infinity.
+ProjectedBlockers project_blockers(const std::vector<const Mesh*>& blockers,
+                                   const ProjectionFrame& frame, double near, double far);
+
+// The depth range of the projected polygons whose bounding boxes overlap [lo, hi].
+DepthRange blocker_depths_over(const ProjectedBlockers& blockers, const Vec2& lo, const Vec2& hi);
+
+// Fraction of each grid pixel covered by the union of the polygons, from 4 × 4 sample points per
+// pixel (exact where a pixel is wholly inside or outside a polygon). Row-major, width × height.
+std::vector<float> blocker_coverage(const ProjectedBlockers& blockers, const TangentGrid& grid);
+
+}  // namespace sb
