@@ -7,8 +7,8 @@
 //
 // Threading: FFTW's planner is process-global and not thread-safe, so plans are made once per
 // (tw, th, FFTW threads) under a mutex and cached; execution is thread-safe, so convolve() runs
-// the cached plans through the new-array interface on arrays of its own. Those arrays come from
-// fftwf_malloc, like the arrays the plans were made on, because a plan may only be executed on
+// the cached plans through the new-array interface on the calling thread's own arrays. Those come
+// from fftwf_malloc, like the arrays the plans were made on, because a plan may only be executed on
 // arrays with the alignment it was planned for.
 #include "fft_convolution.h"
 
@@ -24,6 +24,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <new>
 #include <thread>
 #include <vector>
 
@@ -38,13 +39,13 @@ using ComplexBuffer = std::unique_ptr<fftwf_complex[], FftwFree>;
 
 RealBuffer alloc_real(std::size_t count) {
   RealBuffer buffer(fftwf_alloc_real(count));
-  assert(buffer);
+  if (!buffer) throw std::bad_alloc();
   return buffer;
 }
 
 ComplexBuffer alloc_complex(std::size_t count) {
   ComplexBuffer buffer(fftwf_alloc_complex(count));
-  assert(buffer);
+  if (!buffer) throw std::bad_alloc();
   return buffer;
 }
 
@@ -62,6 +63,31 @@ std::uint64_t hash_values(const std::vector<float>& values) {
     hash *= 1099511628211ull;
   }
   return hash;
+}
+
+// Work arrays of the calling thread for convolve(), kept between calls and grown as needed:
+// allocating them per call (tens of MiB, fresh pages) made a 2304² convolution cost twice the
+// bare transforms in tests/bench/fft_bench.cpp, against 1.2× with reuse. Each thread keeps the
+// largest pair it has needed until it ends.
+struct Scratch {
+  RealBuffer real;
+  ComplexBuffer spectrum;
+  std::size_t real_count = 0, spectrum_count = 0;
+};
+
+Scratch& thread_scratch(std::size_t real_count, std::size_t complex_count) {
+  thread_local Scratch scratch;
+  if (scratch.real_count < real_count) {
+    scratch.real.reset();  // before allocating, so the old and new arrays are never both held
+    scratch.real = alloc_real(real_count);
+    scratch.real_count = real_count;
+  }
+  if (scratch.spectrum_count < complex_count) {
+    scratch.spectrum.reset();
+    scratch.spectrum = alloc_complex(complex_count);
+    scratch.spectrum_count = complex_count;
+  }
+  return scratch;
 }
 
 // The cache keeps at most this many spectra, and at most this many bytes of them (a 4096²
@@ -97,8 +123,9 @@ struct FftConvolver::Impl {
   std::mutex planner_mutex;  // guards every FFTW planner call and `plans`
   std::map<PlanKey, Plans> plans;
 
-  std::mutex spectra_mutex;                                  // guards `spectra` and `spectra_bytes`
-  std::list<std::shared_ptr<const KernelSpectrum>> spectra;  // most recently used first
+  std::mutex spectra_mutex;  // guards `spectra` and `spectra_bytes`
+  // Most recently used first.
+  std::list<std::shared_ptr<const KernelSpectrum>> spectra;
   std::size_t spectra_bytes = 0;
 
   // The plans for a tw × th transform with the current thread count. The reference stays valid:
@@ -108,9 +135,11 @@ struct FftConvolver::Impl {
     std::lock_guard lock(planner_mutex);
     auto found = plans.find(key);
     if (found != plans.end()) return found->second;
-    // FFTW_ESTIMATE: a bake is one run of a command-line tool that transforms each size a few
-    // times, so FFTW_MEASURE's planning (it runs and times candidate plans, seconds at 2048²)
-    // could not pay for itself; see the benchmark in tests/bench/fft_bench.cpp.
+    // FFTW_ESTIMATE: a bake is one run of a command-line tool, and FFTW_MEASURE's planning (it
+    // runs and times candidate plans) cannot pay for itself there. Measured on 2 cores: planning
+    // an r2c + c2r pair takes ~4 ms with ESTIMATE, ~1.0 s (1024²) and ~1.9 s (2048²) with
+    // MEASURE, whose plans save ~2 ms and ~10 ms per round trip: hundreds of convolutions of one
+    // size before it breaks even (tests/bench/fft_bench.cpp). Saved wisdom would change that.
     fftwf_plan_with_nthreads(key.threads);
     RealBuffer real = alloc_real(std::size_t(tw) * std::size_t(th));
     ComplexBuffer complex = alloc_complex(spectrum_count(tw, th));
@@ -235,16 +264,19 @@ void FftConvolver::convolve(const std::vector<float>& image, int w, int h,
   const std::size_t row = std::size_t(tw);
   const Impl::Plans& plans = impl_->plans_for(tw, th);
 
-  RealBuffer padded = alloc_real(row * std::size_t(th));
-  ComplexBuffer spectrum = alloc_complex(spectrum_count(tw, th));
+  Scratch& scratch = thread_scratch(row * std::size_t(th), spectrum_count(tw, th));
+  float* padded = scratch.real.get();
+  fftwf_complex* spectrum = scratch.spectrum.get();
+  // The image top-left, zeros around it; the scratch holds the previous call's output, so every
+  // padding pixel is written.
   for (int y = 0; y < h; ++y) {
-    float* dst = padded.get() + std::size_t(y) * row;
+    float* dst = padded + std::size_t(y) * row;
     std::copy_n(image.data() + std::size_t(y) * std::size_t(w), w, dst);
     std::fill(dst + w, dst + tw, 0.0f);
   }
-  std::fill(padded.get() + std::size_t(h) * row, padded.get() + std::size_t(th) * row, 0.0f);
+  std::fill(padded + std::size_t(h) * row, padded + std::size_t(th) * row, 0.0f);
 
-  fftwf_execute_dft_r2c(plans.forward, padded.get(), spectrum.get());
+  fftwf_execute_dft_r2c(plans.forward, padded, spectrum);
   // Pointwise complex product, on interleaved (re, im) floats so the compiler vectorises it.
   float* a = &spectrum[0][0];
   const float* b = &kernel.values[0][0];
@@ -254,12 +286,11 @@ void FftConvolver::convolve(const std::vector<float>& image, int w, int h,
     a[i] = re;
     a[i + 1] = im;
   }
-  fftwf_execute_dft_c2r(plans.inverse, spectrum.get(), padded.get());
+  fftwf_execute_dft_c2r(plans.inverse, spectrum, padded);
 
   out.resize(std::size_t(w) * std::size_t(h));
   for (int y = 0; y < h; ++y)
-    std::copy_n(padded.get() + std::size_t(y) * row, w,
-                out.data() + std::size_t(y) * std::size_t(w));
+    std::copy_n(padded + std::size_t(y) * row, w, out.data() + std::size_t(y) * std::size_t(w));
 }
 
 }  // namespace sb
