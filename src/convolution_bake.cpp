@@ -70,20 +70,21 @@ namespace {
 // visibility[t] for each t in `texels`, and fills `report`.
 void convolve_part(const TexelSpace& space, const std::vector<std::size_t>& texels,
                    const Light& light, const ProjectionFrame& frame, double texel,
-                   const ConvolutionInputs& in, std::vector<Vec3>& visibility, PairReport& report) {
+                   const ConvolutionInputs& in, std::vector<Vec3f>& visibility, PairReport& report) {
   auto start = Clock::now();
   report.lit_texels = std::int64_t(texels.size());
   for (int k = 0; k < 3; ++k) report.axis[k] = frame.axis[k];
   DepthRange receiver_depths;
-  for (std::size_t t : texels) receiver_depths.extend(frame.depth(space.texels[t].position));
+  for (std::size_t t : texels)
+    receiver_depths.extend(frame.depth(space.texels[t].position.cast<double>()));
   // Texels this close to the light's plane across D (or behind it) cannot be projected; they
   // keep V = 1 and are counted. The caller's choice of frusta keeps them rare.
   const double near = std::max(1e-4, 1e-3 * receiver_depths.hi);
   Vec2 t_lo = Vec2::Constant(std::numeric_limits<double>::infinity()), t_hi = -t_lo;
   DepthRange projected_depths;
   for (std::size_t t : texels) {
-    const Vec3& p = space.texels[t].position;
-    visibility[t] = Vec3::Ones();
+    const Vec3 p = space.texels[t].position.cast<double>();
+    visibility[t] = Vec3f::Ones();
     if (frame.depth(p) <= near) {
       ++report.outside_texels;
       continue;
@@ -163,12 +164,12 @@ void convolve_part(const TexelSpace& space, const std::vector<std::size_t>& texe
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, texels.size(), 1024), [&](const auto& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
       const std::size_t t = texels[i];
-      const Vec3& p = space.texels[t].position;
+      const Vec3 p = space.texels[t].position.cast<double>();
       if (frame.depth(p) <= near) continue;
       const Vec2 at = grid.to_pixel(frame.tangent(p));
       for (int c = 0; c < 3; ++c) {
         const float o = bilinear(occluded[grey ? 0 : c], grid.width, grid.height, at);
-        visibility[t][c] = std::clamp(1.0 - double(o), 0.0, 1.0);
+        visibility[t][c] = std::clamp(1.0f - o, 0.0f, 1.0f);
       }
     }
   });
@@ -185,39 +186,28 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
                        std::vector<PairReport>* reports) {
   const auto& lights = *in.lights;
   const std::size_t n = space.texels.size();
-  Image out(space.width, space.height, 3, 0.0f);
   const double texel = texel_size(*in.receiver, space.width, space.height);
-
-  // Unoccluded irradiance per light and texel: the weights that combine lights, and the test of
-  // which texels a light reaches at all. One light's visibility needs no weights, only the test
-  // (and the light's colour, so that a channel it does not emit stays 0): the closed form is
-  // skipped then, which is most of the cost of this loop.
+  // Per texel, Σ_l w_l·V_l (accumulated in the output) and Σ_l w_l, where the weight w_l is H0_l.
+  // One light's visibility needs no closed form: its weight is its exitance where it reaches
+  // the texel (so that a channel it does not emit stays 0), which is much cheaper.
   const bool weights_needed = lights.size() > 1 || in.quantity == Quantity::irradiance;
-  std::vector<std::vector<Vec3>> h0(lights.size(), std::vector<Vec3>(n));
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& r) {
-    for (std::size_t t = r.begin(); t != r.end(); ++t) {
-      const Texel& texel = space.texels[t];
-      for (std::size_t l = 0; l < lights.size(); ++l) {
-        if (weights_needed) {
-          h0[l][t] = lights[l].unoccluded_irradiance(texel.position, texel.normal);
-        } else {
-          h0[l][t] =
-              lights[l].reaches(texel.position, texel.normal) ? lights[l].exitance() : Vec3::Zero();
-        }
-      }
-    }
-  });
-  std::vector<Vec3> h_sum(n, Vec3::Zero()), h0_sum(n, Vec3::Zero());
-  std::vector<Vec3> visibility(n, Vec3::Ones());
+  Image out(space.width, space.height, 3, 0.0f);
+  std::vector<Vec3f> weight_sum(n, Vec3f::Zero());
+  std::vector<Vec3f> visibility(n);
+  std::vector<std::uint8_t> reached(n);
+  auto position = [&](std::size_t t) { return Vec3(space.texels[t].position.cast<double>()); };
 
-  for (std::size_t l = 0; l < lights.size(); ++l) {
-    const Light& light = lights[l];
+  for (const Light& light : lights) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& r) {
+      for (std::size_t t = r.begin(); t != r.end(); ++t)
+        reached[t] = light.reaches(position(t), space.texels[t].normal.cast<double>());
+    });
     std::vector<std::size_t> lit;
     Bounds3 lit_bounds;
     for (std::size_t t = 0; t < n; ++t) {
-      if (h0[l][t].maxCoeff() <= 0) continue;
+      if (!reached[t]) continue;
       lit.push_back(t);
-      lit_bounds.extend(space.texels[t].position);
+      lit_bounds.extend(position(t));
     }
     auto add_report = [&](PairReport report, const char* part) {
       report.light = light.desc().name;
@@ -235,7 +225,7 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
     const ProjectionFrame central = frame_towards(light.centre(), lit_bounds.centre());
     double widest = 1.0;
     for (std::size_t t : lit) {
-      const Vec3 d = space.texels[t].position - light.centre();
+      const Vec3 d = position(t) - light.centre();
       const double len = d.norm();
       widest = std::min(widest, len > 0 ? d.dot(central.axis) / len : 1.0);
     }
@@ -247,7 +237,7 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
       static const char* kFaces[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
       std::array<std::vector<std::size_t>, 6> faces;
       for (std::size_t t : lit) {
-        const Vec3 d = space.texels[t].position - light.centre();
+        const Vec3 d = position(t) - light.centre();
         int axis;
         d.cwiseAbs().maxCoeff(&axis);
         faces[2 * axis + (d[axis] < 0 ? 1 : 0)].push_back(t);
@@ -262,20 +252,28 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
         add_report(std::move(report), kFaces[f]);
       }
     }
-    for (std::size_t t : lit) {
-      h_sum[t] += h0[l][t].cwiseProduct(visibility[t]);
-      h0_sum[t] += h0[l][t];
-    }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, lit.size(), 4096), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        const std::size_t t = lit[i];
+        const Texel& tx = space.texels[t];
+        const Vec3f w = (weights_needed ? light.unoccluded_irradiance(position(t),
+                                                                       tx.normal.cast<double>())
+                                        : light.exitance())
+                            .cast<float>();
+        float* px = out.at(tx.x, tx.y);
+        for (int c = 0; c < 3; ++c) px[c] += w[c] * visibility[t][c];
+        weight_sum[t] += w;
+      }
+    });
   }
 
-  for (std::size_t t = 0; t < n; ++t) {
-    float* px = out.at(space.texels[t].x, space.texels[t].y);
-    for (int c = 0; c < 3; ++c) {
-      const double v = in.quantity == Quantity::irradiance ? h_sum[t][c]
-                       : h0_sum[t][c] > 0                  ? h_sum[t][c] / h0_sum[t][c]
-                                                           : 0.0;
-      px[c] = float(v);
-    }
+  if (in.quantity == Quantity::visibility) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& r) {
+      for (std::size_t t = r.begin(); t != r.end(); ++t) {
+        float* px = out.at(space.texels[t].x, space.texels[t].y);
+        for (int c = 0; c < 3; ++c) px[c] = weight_sum[t][c] > 0 ? px[c] / weight_sum[t][c] : 0.0f;
+      }
+    });
   }
   return out;
 }

@@ -33,10 +33,13 @@ Image bake_reference(const TexelSpace& space, const ReferenceInputs& in,
         std::int64_t local_rays = 0;
         for (std::size_t t = range.begin(); t != range.end(); ++t) {
           const Texel& texel = space.texels[t];
+          const Vec3 position = texel.position.cast<double>();
+          const Vec3 normal = texel.normal.cast<double>();
           Vec3 h_sum = Vec3::Zero(), h0_sum = Vec3::Zero();
-          const Vec3 origin = texel.shadow_origin + offset * texel.geometric_normal;
+          const Vec3 origin = (texel.shadow_origin.cast<double>() +
+                               offset * texel.geometric_normal.cast<double>());
           for (std::size_t l = 0; l < lights.size(); ++l) {
-            const Vec3 h0 = lights[l].unoccluded_irradiance(texel.position, texel.normal);
+            const Vec3 h0 = lights[l].unoccluded_irradiance(position, normal);
             if (h0.maxCoeff() <= 0) continue;
             Rng rng(stream_seed(in.seed, (in.stream << 32) ^ l,
                                 std::uint64_t(texel.y) * space.width + texel.x));
@@ -44,7 +47,7 @@ Image bake_reference(const TexelSpace& space, const ReferenceInputs& in,
             int n = 0;
             Vec3 weight_sum = Vec3::Zero();
             for (int s = 0; s < in.samples; ++s) {
-              const LightSample ls = lights[l].sample(texel.position, texel.normal, strata[s]);
+              const LightSample ls = lights[l].sample(position, normal, strata[s]);
               if (ls.weight <= 0) continue;
               const Vec3 d = ls.point - origin;
               const double len = d.norm();

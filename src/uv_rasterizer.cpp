@@ -210,19 +210,23 @@ Texel make_texel(const FaceSurface& s, int face, int x, int y, const double bary
   t.x = x;
   t.y = y;
   t.face = face;
-  t.position = bary[0] * s.position[0] + bary[1] * s.position[1] + bary[2] * s.position[2];
-  t.normal =
+  const Vec3 position = bary[0] * s.position[0] + bary[1] * s.position[1] + bary[2] * s.position[2];
+  const Vec3 normal =
       unit_or(bary[0] * s.normal[0] + bary[1] * s.normal[1] + bary[2] * s.normal[2], s.face_normal);
-  t.geometric_normal = t.normal.dot(s.face_normal) < 0.0 ? Vec3(-s.face_normal) : s.face_normal;
+  t.position = position.cast<float>();
+  t.normal = normal.cast<float>();
+  t.geometric_normal =
+      (normal.dot(s.face_normal) < 0.0 ? Vec3(-s.face_normal) : s.face_normal).cast<float>();
   // Shadow-terminator offset (Hanika, "Hacking the Shadow Terminator", Ray Tracing Gems II,
   // ch. 4, 2021): a flat triangle of a curved mesh lies inside the smooth surface its vertex
   // normals describe, so rays towards a grazing light hit the neighbouring triangles. Lift the
   // point by the barycentric mean of its heights below each vertex's tangent plane.
-  t.shadow_origin = t.position;
+  Vec3 shadow_origin = position;
   for (int i = 0; i < 3; ++i) {
-    const double below = (s.position[i] - t.position).dot(s.normal[i]);
-    if (below > 0) t.shadow_origin += bary[i] * below * s.normal[i];
+    const double below = (s.position[i] - position).dot(s.normal[i]);
+    if (below > 0) shadow_origin += bary[i] * below * s.normal[i];
   }
+  t.shadow_origin = shadow_origin.cast<float>();
   return t;
 }
 

@@ -41,8 +41,8 @@ TexelSpace floor_texels(const std::vector<double>& xs, double y0) {
     Texel t;
     t.x = int(i);
     t.y = 0;
-    t.position = t.shadow_origin = Vec3(xs[i], y0, 0);
-    t.normal = t.geometric_normal = Vec3::UnitZ();
+    t.position = t.shadow_origin = Vec3f(float(xs[i]), float(y0), 0.0f);
+    t.normal = t.geometric_normal = Vec3f::UnitZ();
     s.texels.push_back(t);
   }
   return s;
@@ -143,7 +143,7 @@ TEST(Reference, FacingAwayIsZero) {
   ASSERT_TRUE(rays);
   const std::vector<Light> lights = {Light(square_light())};
   TexelSpace s = floor_texels({0.0, 0.5}, 0.0);
-  for (auto& t : s.texels) t.normal = t.geometric_normal = -Vec3::UnitZ();
+  for (auto& t : s.texels) t.normal = t.geometric_normal = -Vec3f::UnitZ();
   const Image vis = run(s, lights, *rays, Quantity::visibility, 16);
   EXPECT_EQ(vis.at(0, 0)[0], 0.0f);
   EXPECT_EQ(vis.at(1, 0)[0], 0.0f);

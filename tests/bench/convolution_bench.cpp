@@ -7,8 +7,10 @@
 //      --benchmark_report_aggregates_only=true
 // Counters are milliseconds per iteration of each stage, from the bake's own report.
 #include <benchmark/benchmark.h>
+#include <fftw3.h>
 
 #include <filesystem>
+#include <memory>
 #include <string>
 
 #include "bake.h"
@@ -58,6 +60,37 @@ void BM_ConvolutionBake(benchmark::State& state) {
   state.counters["fft_size"] = fft_size;
 }
 BENCHMARK(BM_ConvolutionBake)->Arg(512)->Arg(2048)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The floor under the FFT stage: one bare FFTW r2c + c2r of the padded size the bake above used
+// (found by baking once before timing), planned as the convolver plans (FFTW_ESTIMATE, all
+// cores), on arrays allocated once.
+void BM_BareFftOfBake(benchmark::State& state) {
+  const Scene scene = parallel_scene(int(state.range(0)), "convolution", 1);
+  auto result = bake(scene);
+  if (!result || result->receivers[0].pairs.empty()) {
+    state.SkipWithError("bake failed");
+    return;
+  }
+  const int w = result->receivers[0].pairs[0].fft_width;
+  const int h = result->receivers[0].pairs[0].fft_height;
+  const auto free = [](void* p) { fftwf_free(p); };
+  std::unique_ptr<float, decltype(free)> real(fftwf_alloc_real(std::size_t(w) * h), free);
+  std::unique_ptr<fftwf_complex, decltype(free)> spectrum(
+      fftwf_alloc_complex(std::size_t(h) * (w / 2 + 1)), free);
+  std::fill(real.get(), real.get() + std::size_t(w) * h, 0.5f);
+  // bake() has set FFTW's thread count for this process; plans below inherit it.
+  fftwf_plan forward = fftwf_plan_dft_r2c_2d(h, w, real.get(), spectrum.get(), FFTW_ESTIMATE);
+  fftwf_plan inverse = fftwf_plan_dft_c2r_2d(h, w, spectrum.get(), real.get(), FFTW_ESTIMATE);
+  for (auto _ : state) {
+    fftwf_execute(forward);
+    fftwf_execute(inverse);
+    benchmark::DoNotOptimize(real.get());
+  }
+  fftwf_destroy_plan(forward);
+  fftwf_destroy_plan(inverse);
+  state.counters["fft_size"] = w;
+}
+BENCHMARK(BM_BareFftOfBake)->Arg(512)->Arg(2048)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_ReferenceBake64(benchmark::State& state) {
   const Scene scene = parallel_scene(int(state.range(0)), "reference", 64);
