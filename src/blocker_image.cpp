@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 
 namespace sb {
 
@@ -50,14 +51,35 @@ struct Edges {
 }  // namespace
 
 ProjectedBlockers project_blockers(const std::vector<const Mesh*>& blockers,
-                                   const ProjectionFrame& frame, double near, double far) {
+                                   const ProjectionFrame& frame, double near, double far,
+                                   const ShadowCaster& caster) {
   ProjectedBlockers out;
+  const Vec3& lo = caster.receiver.lo;
+  const Vec3& hi = caster.receiver.hi;
+  const double scale = std::max(1.0, (hi - lo).norm());
   for (const Mesh* m : blockers) {
     for (auto f : m->mesh.faces()) {
       std::vector<Vec3> poly;
       for (auto v : m->mesh.fv_range(f)) {
         const auto& p = m->mesh.point(v);
         poly.emplace_back(p[0], p[1], p[2]);
+      }
+      const Vec3 normal = (poly[1] - poly[0]).cross(poly[2] - poly[0]);
+      if (normal.norm() > 0 && !caster.receiver.empty()) {
+        const Vec3 n = normal.normalized();
+        const double light_side = n.dot(frame.origin - poly[0]);
+        if (std::abs(light_side) > caster.light_radius) {
+          // The receiver's extreme distance to the plane on the side away from the light; the
+          // receiver may touch the plane (a box standing on the floor).
+          const double sign = light_side > 0 ? 1.0 : -1.0;
+          double lowest = std::numeric_limits<double>::infinity();
+          for (int corner = 0; corner < 8; ++corner) {
+            const Vec3 c(corner & 1 ? hi.x() : lo.x(), corner & 2 ? hi.y() : lo.y(),
+                         corner & 4 ? hi.z() : lo.z());
+            lowest = std::min(lowest, sign * n.dot(c - poly[0]));
+          }
+          if (lowest >= -1e-6 * scale) continue;  // light and receiver on one side
+        }
       }
       poly = clip_depth(poly, frame, near, +1.0);
       if (poly.size() >= 3) poly = clip_depth(poly, frame, far, -1.0);

@@ -32,11 +32,22 @@ struct ProjectedBlockers {
   std::vector<Polygon> polygons;
 };
 
-// Clips every triangle of `blockers` to near <= depth <= far along the frame's axis and projects
-// what remains from the frame's origin. Blocker parts behind the light or beyond the receiver
-// cannot shadow it, and projecting a point at depth ≈ 0 would throw it to infinity.
+// Which blocker triangles can shadow a receiver: a triangle whose plane has the whole light
+// (a sphere of light_radius around the frame's origin) and the whole receiver (its bounding box)
+// on one side cannot lie between them, since a segment never leaves a half-space that holds both
+// its ends. Exact in what it rejects; it keeps the floor under a box out of the box's shadows.
+struct ShadowCaster {
+  double light_radius = 0;
+  Bounds3 receiver;
+};
+
+// Clips every triangle of `blockers` that may shadow the receiver to near <= depth <= far along
+// the frame's axis, and projects what remains from the frame's origin. Blocker parts behind the
+// light or beyond the receiver cannot shadow it, and projecting a point at depth ≈ 0 would throw
+// it to infinity.
 ProjectedBlockers project_blockers(const std::vector<const Mesh*>& blockers,
-                                   const ProjectionFrame& frame, double near, double far);
+                                   const ProjectionFrame& frame, double near, double far,
+                                   const ShadowCaster& caster);
 
 // The depth range of the projected polygons whose bounding boxes overlap [lo, hi].
 DepthRange blocker_depths_over(const ProjectedBlockers& blockers, const Vec2& lo, const Vec2& hi);

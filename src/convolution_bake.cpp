@@ -95,8 +95,13 @@ void convolve_part(const TexelSpace& space, const std::vector<std::size_t>& texe
     t_hi = t_hi.cwiseMax(tc);
   }
   if (projected_depths.empty()) return;
+  ShadowCaster caster;
+  caster.light_radius = light.shape() == LightShape::rectangle
+                            ? 0.5 * std::hypot(light.desc().width, light.desc().height)
+                            : light.desc().radius;
+  for (std::size_t t : texels) caster.receiver.extend(space.texels[t].position.cast<double>());
   const ProjectedBlockers blockers =
-      project_blockers(in.blockers, frame, near, projected_depths.hi);
+      project_blockers(in.blockers, frame, near, projected_depths.hi, caster);
   const DepthRange blocker_depths = blocker_depths_over(blockers, t_lo, t_hi);
   const VirtualConfiguration config = choose_configuration(frame, blocker_depths, projected_depths,
                                                            light.extent_across(frame.axis));

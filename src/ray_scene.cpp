@@ -106,7 +106,10 @@ void RayScene::occluded(int count, const Vec3* origins, const Vec3* directions,
       rays.dir_x[i] = float(directions[k].x());
       rays.dir_y[i] = float(directions[k].y());
       rays.dir_z[i] = float(directions[k].z());
-      rays.tnear[i] = 0.0f;
+      // Skip the first surface_offset of the segment as well: a point exactly on another
+      // blocker's face (the bottom edge of a box standing on a floor) must not be shadowed by
+      // that face at t = 0.
+      rays.tnear[i] = float(impl_->offset / std::max(directions[k].norm(), 1e-30));
       rays.tfar[i] = float(lengths[k]);
       rays.time[i] = 0.0f;
       rays.mask[i] = 0xFFFFFFFFu;

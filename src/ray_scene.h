@@ -22,7 +22,8 @@ class RayScene {
   ~RayScene();
 
   // True when a blocker triangle (either side) lies on the segment origin + t·direction,
-  // t ∈ [0, length]. direction need not be unit; length is in units of |direction|.
+  // t ∈ [surface_offset() / |direction|, length]. direction need not be unit; length is in
+  // units of |direction|.
   bool occluded(const Vec3& origin, const Vec3& direction, double length) const;
 
   // Answers `count` segments at once (faster than one at a time). Writes 1 for an occluded

@@ -283,3 +283,34 @@ TEST(ConvolutionBake, ColouredLightGivesColouredPenumbrae) {
 
 }  // namespace
 }  // namespace sb
+
+namespace sb {
+namespace {
+
+// The box of the showcase stands on the floor, which is a blocker too: the floor lies behind the
+// box's faces as seen from the lights, so it must not shadow them (ShadowCaster culling). The box
+// is unshadowed in the reference; the convolution must agree.
+TEST(ConvolutionBake, BlockersBehindTheReceiverDoNotShadowIt) {
+  auto load_showcase = [](const std::string& method) {
+    auto scene = load_scene(std::string(SB_SOURCE_DIR) + "/scenes/showcase/scene.toml");
+    EXPECT_TRUE(scene) << scene.error().message;
+    scene->bake.resolution = 64;
+    scene->bake.method = method;
+    scene->bake.samples = 64;
+    scene->bake.margin = 0;
+    for (auto& o : scene->objects) o.receiver = o.name == "box";
+    return *scene;
+  };
+  auto conv = bake(load_showcase("convolution"));
+  auto ref = bake(load_showcase("reference"));
+  ASSERT_TRUE(conv && ref);
+  const Image& c = conv->receivers[0].image;
+  const Image& r = ref->receivers[0].image;
+  double worst = 0;
+  for (std::size_t i = 0; i < c.pixels.size(); ++i)
+    worst = std::max(worst, double(std::abs(c.pixels[i] - r.pixels[i])));
+  EXPECT_LT(worst, 0.05);
+}
+
+}  // namespace
+}  // namespace sb
