@@ -1,24 +1,14 @@
-// The shadowbake command line: parses arguments, calls the library, prints, and maps errors to
-// exit codes (docs/cli.md). No algorithm lives here.
-#include <fmt/core.h>
-#include <unistd.h>
-#include <CLI/CLI.hpp>
-
-#include <atomic>
-#include <chrono>
+// The shadowbake command line: each subcommand parses its arguments, calls the library, prints,
+// and maps errors to exit codes (docs/cli.md). No algorithm lives here; this file dispatches.
 #include <cstdio>
-#include <mutex>
-#include <optional>
+#include <exception>
 #include <string>
+#include <utility>
+#include <vector>
 
-#include "bake.h"
-#include "outputs.h"
-#include "scene.h"
+#include "commands.h"
 
-namespace {
-
-// Exit codes, documented in docs/cli.md.
-enum Exit : int { ok = 0, internal = 1, usage = 2, bad_input = 3, cannot_write = 4 };
+namespace sbcli {
 
 int exit_code(const sb::Error& e) {
   switch (e.kind) {
@@ -38,186 +28,31 @@ int fail(const sb::Error& e) {
   return exit_code(e);
 }
 
-// A one-line progress bar on stderr, redrawn at most ten times a second; any thread may call.
-class ProgressBar {
- public:
-  explicit ProgressBar(std::string label) : label_(std::move(label)) {}
-  void update(double fraction) {
-    const bool final_update = fraction >= 1.0;
-    // The final update must not be lost to a busy lock; the others may be.
-    std::unique_lock lock(mutex_, std::defer_lock);
-    if (final_update) {
-      lock.lock();
-    } else if (!lock.try_lock()) {
-      return;
-    }
-    if (finished_) return;
-    const auto now = std::chrono::steady_clock::now();
-    if (!final_update && now - last_ < std::chrono::milliseconds(100)) return;
-    last_ = now;
-    finished_ = final_update;
-    constexpr int kWidth = 40;
-    const int filled = int(fraction * kWidth + 0.5);
-    std::fprintf(stderr, "\r%s [%s%s] %3d%%", label_.c_str(), std::string(filled, '#').c_str(),
-                 std::string(kWidth - filled, ' ').c_str(), int(fraction * 100 + 0.5));
-    if (fraction >= 1.0) std::fprintf(stderr, "\n");
-    std::fflush(stderr);
-  }
-
- private:
-  std::string label_;
-  std::mutex mutex_;
-  std::chrono::steady_clock::time_point last_{};
-  bool finished_ = false;
-};
-
-struct BakeArgs {
-  std::string scene;
-  std::string out_dir;
-  std::optional<std::string> method, quantity;
-  std::optional<int> resolution, samples;
-  std::optional<std::uint64_t> seed;
-  int threads = 0;
-  bool quiet = false;
-  bool explain = false;
-};
-
-// --explain: what the convolution method chose for each light and receiver, and what it cost.
-void print_explanation(const sb::BakeResult& result) {
-  for (const auto& r : result.receivers) {
-    fmt::print("{}: texel space {:.1f} ms, method {:.1f} ms, dilation {:.1f} ms\n", r.name,
-               1e3 * r.seconds_texels, 1e3 * r.seconds_method, 1e3 * r.seconds_dilate);
-    for (const auto& p : r.pairs) {
-      fmt::print("{} <- {}{}{}: D = ({:.3f}, {:.3f}, {:.3f}), {} lit texels", p.receiver, p.light,
-                 p.part.empty() ? "" : " face ", p.part, p.axis[0], p.axis[1], p.axis[2],
-                 p.lit_texels);
-      if (p.outside_texels > 0)
-        fmt::print(" ({} beside the light, left unshadowed)", p.outside_texels);
-      fmt::print("\n");
-      if (p.image_width == 0) {
-        fmt::print("    no blocker between the light and the receiver\n");
-        continue;
-      }
-      fmt::print(
-          "    planes along D: source 0, blocker {:.3f} m (blockers {:.3f}..{:.3f}), receiver "
-          "{:.3f} m (receiver {:.3f}..{:.3f})\n",
-          p.blocker_plane, p.blocker_depth_lo, p.blocker_depth_hi, p.receiver_plane,
-          p.receiver_depth_lo, p.receiver_depth_hi);
-      fmt::print(
-          "    penumbra error: rho {:.3f} in [{:.3f}, {:.3f}], L = {:.3f} m -> {:.4f} m = {:.1f} "
-          "texels\n",
-          p.rho, p.rho_lo, p.rho_hi, p.light_extent, p.penumbra_error, p.penumbra_error_texels);
-      fmt::print("    images: blocker {}x{}, kernel {}x{}, FFT {}x{}, {} convolution(s)\n",
-                 p.image_width, p.image_height, p.kernel_width, p.kernel_height, p.fft_width,
-                 p.fft_height, p.convolutions);
-      fmt::print(
-          "    time: configure {:.1f} ms, source {:.1f} ms, blocker {:.1f} ms, FFT {:.1f} ms, "
-          "lookup {:.1f} ms\n",
-          1e3 * p.seconds_configure, 1e3 * p.seconds_source, 1e3 * p.seconds_blocker,
-          1e3 * p.seconds_fft, 1e3 * p.seconds_lookup);
-    }
-  }
-}
-
-int run_bake(const BakeArgs& args) {
-  const auto start = std::chrono::steady_clock::now();
-  auto scene = sb::load_scene(args.scene);
-  if (!scene) return fail(scene.error());
-  auto& settings = scene->bake;
-  if (args.method) settings.method = *args.method;
-  if (args.quantity)
-    settings.quantity =
-        *args.quantity == "irradiance" ? sb::Quantity::irradiance : sb::Quantity::visibility;
-  if (args.resolution) settings.resolution = *args.resolution;
-  if (args.samples) settings.samples = *args.samples;
-  if (args.seed) settings.seed = *args.seed;
-
-  const bool show_progress = !args.quiet && ::isatty(STDERR_FILENO);
-  ProgressBar bar("baking " + settings.method);
-  sb::BakeOptions options;
-  options.threads = args.threads;
-  if (show_progress) options.progress = [&bar](double f) { bar.update(f); };
-
-  auto result = sb::bake(*scene, options);
-  if (!result) return fail(result.error());
-  for (const auto& w : result->warnings)
-    std::fprintf(stderr, "shadowbake: warning: %s\n", w.c_str());
-
-  const auto write_start = std::chrono::steady_clock::now();
-  auto written = sb::write_outputs(args.out_dir, *scene, settings, *result);
-  if (!written) return fail(written.error());
-  const double write_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start).count();
-  const double total_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (args.explain) print_explanation(*result);
-
-  if (!args.quiet) {
-    for (const auto& r : result->receivers) {
-      fmt::print("  {:<16} {}/{}.exr, .png  ({} texels, {:.2f} s)\n", r.name, args.out_dir, r.name,
-                 r.covered_texels, r.seconds);
-    }
-    fmt::print(
-        "baked {} receiver(s) with '{}' at {}² into {}/ (manifest.json): load {:.2f} s, bake "
-        "{:.2f} s, write {:.2f} s, total {:.2f} s\n",
-        result->receivers.size(), settings.method, settings.resolution, args.out_dir,
-        result->load_seconds, result->bake_seconds, write_seconds, total_seconds);
-  }
-  return ok;
-}
-
-}  // namespace
+}  // namespace sbcli
 
 int main(int argc, char** argv) {
   CLI::App app{"shadowbake: bakes soft-shadow lightmaps for area lights (docs/cli.md)"};
   app.set_version_flag("--version", std::string("shadowbake ") + SHADOWBAKE_VERSION);
   app.require_subcommand(1);
-
-  BakeArgs bake_args;
-  std::string method, quantity;
-  int resolution = 0, samples = 0;
-  std::uint64_t seed = 0;
-  auto* bake = app.add_subcommand("bake", "bake every receiver of a scene into OUTDIR");
-  bake->add_option("scene", bake_args.scene, "scene file (TOML, docs/scene-format.md)")->required();
-  bake->add_option("-o,--output", bake_args.out_dir, "output folder (created if missing)")
-      ->required();
-  auto* method_opt = bake->add_option("--method", method, "bake method (overrides [bake] method)")
-                         ->check(CLI::IsMember(sb::known_methods()));
-  auto* quantity_opt = bake->add_option("--quantity", quantity, "visibility or irradiance")
-                           ->check(CLI::IsMember({"visibility", "irradiance"}));
-  auto* resolution_opt =
-      bake->add_option("--resolution", resolution, "texels per side")->check(CLI::Range(1, 16384));
-  auto* samples_opt = bake->add_option("--samples", samples, "light samples per texel")
-                          ->check(CLI::Range(1, 1 << 20));
-  auto* seed_opt = bake->add_option("--seed", seed, "sampling seed");
-  bake->add_option("--threads", bake_args.threads, "worker threads (0: all cores)")
-      ->check(CLI::Range(0, 1024));
-  bake->add_flag("-q,--quiet", bake_args.quiet, "no progress bar and no summary");
-  bake->add_flag("--explain", bake_args.explain,
-                 "print, per light and receiver, the convolution's direction, planes, error "
-                 "metric, image sizes and stage times");
-
+  const std::vector<std::pair<std::string, sbcli::Runner>> commands = {
+      {"bake", sbcli::add_bake_command(app)},
+  };
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     app.exit(e);
-    return usage;
+    return sbcli::usage;
   }
-
-  if (bake->parsed()) {
-    if (*method_opt) bake_args.method = method;
-    if (*quantity_opt) bake_args.quantity = quantity;
-    if (*resolution_opt) bake_args.resolution = resolution;
-    if (*samples_opt) bake_args.samples = samples;
-    if (*seed_opt) bake_args.seed = seed;
+  for (const auto& [name, run] : commands) {
+    if (!app.got_subcommand(name)) continue;
     try {
-      return run_bake(bake_args);
+      return run();
     } catch (const std::exception& e) {
       std::fprintf(stderr, "shadowbake: error: internal: %s\n", e.what());
-      return internal;
+      return sbcli::internal;
     }
   }
-  return usage;
+  return sbcli::usage;
 }

@@ -132,6 +132,7 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     dilate(out.image, spaces[r].covered, scene.bake.margin);
     out.seconds_dilate = seconds_since(dilate_start);
     out.covered_texels = std::int64_t(spaces[r].texels.size());
+    out.covered = spaces[r].covered;
     out.seconds = raster_seconds[r] + seconds_since(start);
     result.receivers.push_back(std::move(out));
   }

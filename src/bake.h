@@ -49,7 +49,8 @@ struct PairReport {
 struct ReceiverBake {
   std::string name;
   int uv_channel = 0;
-  Image image;  // RGB, width × height of the bake resolution, dilated
+  Image image;                        // RGB, width × height of the bake resolution, dilated
+  std::vector<std::uint8_t> covered;  // width × height: 1 where a triangle covers the texel
   std::int64_t covered_texels = 0;
   double seconds = 0;  // texel space + method + dilation, this receiver only
   double seconds_texels = 0, seconds_method = 0, seconds_dilate = 0;  // its parts

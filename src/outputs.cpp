@@ -59,7 +59,7 @@ Status write_outputs(const fs::path& dir, const Scene& scene, const BakeSettings
   // A folder standing where a file must go would make its rename fail after others were
   // published; refuse before writing anything.
   for (const auto& r : result.receivers) {
-    for (const char* ext : {".exr", ".png"}) {
+    for (const char* ext : {".exr", ".png", ".coverage.png"}) {
       const fs::path p = dir / (r.name + ext);
       if (fs::is_directory(p, ec)) {
         return output_error(p.string() + ": cannot write: a folder of that name is in the way");
@@ -110,9 +110,22 @@ Status write_outputs(const fs::path& dir, const Scene& scene, const BakeSettings
       discard_all();
       return tmp_png.error();
     }
+    // Which texels the receiver's triangles cover: `compare` and `report` count only these.
+    const fs::path coverage = dir / (r.name + ".coverage.png");
+    Image mask(r.image.width, r.image.height, 1, 0.0f);
+    for (std::size_t i = 0; i < r.covered.size() && i < mask.pixels.size(); ++i)
+      mask.pixels[i] = r.covered[i] ? 1.0f : 0.0f;
+    auto tmp_coverage = stage_image(coverage, mask, PixelFormat::uint8);
+    if (!stage(tmp_coverage, coverage)) {
+      discard_all();
+      return tmp_coverage.error();
+    }
     manifest["receivers"].push_back({
         {"name", r.name},
-        {"files", {{"exr", exr.filename().string()}, {"png", png.filename().string()}}},
+        {"files",
+         {{"exr", exr.filename().string()},
+          {"png", png.filename().string()},
+          {"coverage", coverage.filename().string()}}},
         {"uv_channel", r.uv_channel},
         {"resolution", {r.image.width, r.image.height}},
         {"method", effective.method},

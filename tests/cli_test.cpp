@@ -92,14 +92,15 @@ TEST_F(Cli, BakesFilesAndManifest) {
   write("scene.toml", scene());
   const CliRun r = run("bake " + (dir_ / "scene.toml").string() + " -o " + (dir_ / "out").string());
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(listing(dir_ / "out"),
-            (std::vector<std::string>{"floor.exr", "floor.png", "manifest.json"}));
+  EXPECT_EQ(listing(dir_ / "out"), (std::vector<std::string>{"floor.coverage.png", "floor.exr",
+                                                             "floor.png", "manifest.json"}));
   const auto manifest = nlohmann::json::parse(slurp(dir_ / "out" / "manifest.json"));
   ASSERT_EQ(manifest["receivers"].size(), 1u);
   const auto& floor = manifest["receivers"][0];
   EXPECT_EQ(floor["name"], "floor");
   EXPECT_EQ(floor["files"]["exr"], "floor.exr");
   EXPECT_EQ(floor["files"]["png"], "floor.png");
+  EXPECT_EQ(floor["files"]["coverage"], "floor.coverage.png");
   EXPECT_EQ(floor["uv_channel"], 0);
   EXPECT_EQ(floor["resolution"], nlohmann::json::array({32, 32}));
   EXPECT_EQ(floor["method"], "convolution");  // the default

@@ -1,0 +1,36 @@
+// What every shadowbake subcommand shares: exit codes, error printing, and the way a command
+// registers itself (one file per command; main.cpp only dispatches).
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+
+#include "error.h"
+
+namespace sbcli {
+
+// Exit codes, documented in docs/cli.md.
+enum Exit : int {
+  ok = 0,
+  internal = 1,
+  usage = 2,
+  bad_input = 3,
+  cannot_write = 4,
+  gate_failed = 5
+};
+
+// The exit code for a library error.
+int exit_code(const sb::Error& e);
+// Prints "shadowbake: error: <message>" on stderr and returns exit_code(e).
+int fail(const sb::Error& e);
+
+// A command adds its subcommand and options to the app and returns what to run once the command
+// line has parsed; that returns the exit code.
+using Runner = std::function<int()>;
+
+Runner add_bake_command(CLI::App& app);     // bake_command.cpp
+Runner add_compare_command(CLI::App& app);  // compare_command.cpp
+Runner add_report_command(CLI::App& app);   // report_command.cpp
+
+}  // namespace sbcli
