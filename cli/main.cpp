@@ -36,6 +36,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   const std::vector<std::pair<std::string, sbcli::Runner>> commands = {
       {"bake", sbcli::add_bake_command(app)},
+      {"compare", sbcli::add_compare_command(app)},
+      {"report", sbcli::add_report_command(app)},
   };
   try {
     app.parse(argc, argv);

@@ -70,7 +70,8 @@ namespace {
 // visibility[t] for each t in `texels`, and fills `report`.
 void convolve_part(const TexelSpace& space, const std::vector<std::size_t>& texels,
                    const Light& light, const ProjectionFrame& frame, double texel,
-                   const ConvolutionInputs& in, std::vector<Vec3f>& visibility, PairReport& report) {
+                   const ConvolutionInputs& in, std::vector<Vec3f>& visibility,
+                   PairReport& report) {
   auto start = Clock::now();
   report.lit_texels = std::int64_t(texels.size());
   for (int k = 0; k < 3; ++k) report.axis[k] = frame.axis[k];
@@ -261,10 +262,10 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
       for (std::size_t i = r.begin(); i != r.end(); ++i) {
         const std::size_t t = lit[i];
         const Texel& tx = space.texels[t];
-        const Vec3f w = (weights_needed ? light.unoccluded_irradiance(position(t),
-                                                                       tx.normal.cast<double>())
-                                        : light.exitance())
-                            .cast<float>();
+        const Vec3f w =
+            (weights_needed ? light.unoccluded_irradiance(position(t), tx.normal.cast<double>())
+                            : light.exitance())
+                .cast<float>();
         float* px = out.at(tx.x, tx.y);
         for (int c = 0; c < 3; ++c) px[c] += w[c] * visibility[t][c];
         weight_sum[t] += w;

@@ -12,13 +12,13 @@ namespace sb {
 
 // Errors of one channel, or of all channels pooled, over one set of texels.
 struct ChannelErrors {
-  std::int64_t count = 0;  // values compared
-  double rmse = 0;         // root mean square of (a − reference)
-  double mae = 0;          // mean of |a − reference|
-  double max_abs = 0;      // largest |a − reference| ...
+  std::int64_t count = 0;                        // values compared
+  double rmse = 0;                               // root mean square of (a − reference)
+  double mae = 0;                                // mean of |a − reference|
+  double max_abs = 0;                            // largest |a − reference| ...
   int max_x = -1, max_y = -1, max_channel = -1;  // ... and where (row 0 is the image's top)
-  double psnr = 0;         // 10·log10(peak² / MSE), dB; +inf when MSE is 0
-  double ssim = 0;         // mean SSIM over the set's texels (Wang et al. 2004)
+  double psnr = 0;                               // 10·log10(peak² / MSE), dB; +inf when MSE is 0
+  double ssim = 0;  // mean SSIM over the set's texels (Wang et al. 2004)
 };
 
 struct RegionErrors {
@@ -62,5 +62,11 @@ std::vector<double> ssim_map(const Image& a, const Image& b, int channel, double
 // below the image.
 Image difference_heat_map(const Image& a, const Image& reference,
                           const std::vector<std::uint8_t>& mask, double scale, bool colour_bar);
+
+// A readable saturation for difference_heat_map: the largest |mean over channels of
+// (a − reference)| over the texels of `mask` (all when empty) that are finite in both, rounded up
+// to 1, 2 or 5 × a power of ten, and at least 0.01. Needs images of the same size and channels.
+double heat_map_scale(const Image& a, const Image& reference,
+                      const std::vector<std::uint8_t>& mask);
 
 }  // namespace sb

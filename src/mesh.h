@@ -25,9 +25,9 @@ struct MeshTraits : public OpenMesh::DefaultTraits {
 using TriMesh = OpenMesh::TriMesh_ArrayKernelT<MeshTraits>;
 
 struct Mesh {
-  std::string name;          // the object's name
-  TriMesh mesh;              // world space; vertex texcoords are the lightmap UVs
-  bool has_uv = false;       // false when the mesh has no UV set at the object's uv channel
+  std::string name;            // the object's name
+  TriMesh mesh;                // world space; vertex texcoords are the lightmap UVs
+  bool has_uv = false;         // false when the mesh has no UV set at the object's uv channel
   int skipped_degenerate = 0;  // zero-area triangles dropped on import
 };
 

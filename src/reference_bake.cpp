@@ -36,8 +36,8 @@ Image bake_reference(const TexelSpace& space, const ReferenceInputs& in,
           const Vec3 position = texel.position.cast<double>();
           const Vec3 normal = texel.normal.cast<double>();
           Vec3 h_sum = Vec3::Zero(), h0_sum = Vec3::Zero();
-          const Vec3 origin = (texel.shadow_origin.cast<double>() +
-                               offset * texel.geometric_normal.cast<double>());
+          const Vec3 origin =
+              (texel.shadow_origin.cast<double>() + offset * texel.geometric_normal.cast<double>());
           for (std::size_t l = 0; l < lights.size(); ++l) {
             const Vec3 h0 = lights[l].unoccluded_irradiance(position, normal);
             if (h0.maxCoeff() <= 0) continue;

@@ -15,10 +15,10 @@ namespace sb {
 // Single precision: a 2048² lightmap has 4 M texels, and their memory traffic, not arithmetic,
 // bounds the fast methods; the methods compute in double from these.
 struct Texel {
-  int x = 0, y = 0;       // pixel; row 0 is v = 1
-  Vec3f position;         // world space, on the triangle
-  Vec3f normal;           // interpolated shading normal, unit
-  Vec3f geometric_normal; // the triangle's face normal, unit, on the side of `normal`
+  int x = 0, y = 0;        // pixel; row 0 is v = 1
+  Vec3f position;          // world space, on the triangle
+  Vec3f normal;            // interpolated shading normal, unit
+  Vec3f geometric_normal;  // the triangle's face normal, unit, on the side of `normal`
   // Where shadow rays leave from: `position` lifted onto the smooth surface the vertex normals
   // describe (uv_rasterizer.cpp), so a coarsely tessellated curved object does not shadow
   // itself along its terminator. Equal to `position` on flat faces.

@@ -256,7 +256,8 @@ TEST(UvRasterizer, NormalsAreUnitAndInterpolated) {
     EXPECT_NEAR(t.normal.norm(), 1.0, 1e-6);
     const Vec3 b = barycentrics(uv, Vec2(t.position.x(), t.position.y()));
     const Vec3 expected = (b[0] * normals[0] + b[1] * normals[1] + b[2] * normals[2]).normalized();
-    EXPECT_NEAR((t.normal.cast<double>() - expected).norm(), 0.0, 1e-6) << "texel (" << t.x << ", " << t.y << ")";
+    EXPECT_NEAR((t.normal.cast<double>() - expected).norm(), 0.0, 1e-6)
+        << "texel (" << t.x << ", " << t.y << ")";
   }
   // The normals really vary: the texels nearest vertices 1 and 2 lean towards +x and +y.
   const auto [lo, hi] = std::minmax_element(
