@@ -40,8 +40,8 @@ double seconds_since(Clock::time_point start) {
 float bilinear(const std::vector<float>& image, int w, int h, const Vec2& p) {
   const double fx = std::clamp(p.x(), 0.0, double(w - 1));
   const double fy = std::clamp(p.y(), 0.0, double(h - 1));
-  const int x0 = std::min(int(fx), w - 2 < 0 ? 0 : w - 2);
-  const int y0 = std::min(int(fy), h - 2 < 0 ? 0 : h - 2);
+  const int x0 = std::max(0, std::min(int(fx), w - 2));
+  const int y0 = std::max(0, std::min(int(fy), h - 2));
   const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
   const double tx = fx - x0, ty = fy - y0;
   const auto at = [&](int x, int y) { return double(image[std::size_t(y) * w + x]); };
@@ -76,8 +76,12 @@ void convolve_part(const TexelSpace& space, const std::vector<std::size_t>& texe
   report.lit_texels = std::int64_t(texels.size());
   for (int k = 0; k < 3; ++k) report.axis[k] = frame.axis[k];
   DepthRange receiver_depths;
-  for (std::size_t t : texels)
-    receiver_depths.extend(frame.depth(space.texels[t].position.cast<double>()));
+  ShadowCaster caster;
+  for (std::size_t t : texels) {
+    const Vec3 p = space.texels[t].position.cast<double>();
+    receiver_depths.extend(frame.depth(p));
+    caster.receiver.extend(p);
+  }
   // Texels this close to the light's plane across D (or behind it) cannot be projected; they
   // keep V = 1 and are counted. The caller's choice of frusta keeps them rare.
   const double near = std::max(1e-4, 1e-3 * receiver_depths.hi);
@@ -96,11 +100,9 @@ void convolve_part(const TexelSpace& space, const std::vector<std::size_t>& texe
     t_hi = t_hi.cwiseMax(tc);
   }
   if (projected_depths.empty()) return;
-  ShadowCaster caster;
   caster.light_radius = light.shape() == LightShape::rectangle
                             ? 0.5 * std::hypot(light.desc().width, light.desc().height)
                             : light.desc().radius;
-  for (std::size_t t : texels) caster.receiver.extend(space.texels[t].position.cast<double>());
   const ProjectedBlockers blockers =
       project_blockers(in.blockers, frame, near, projected_depths.hi, caster);
   const DepthRange blocker_depths = blocker_depths_over(blockers, t_lo, t_hi);
