@@ -5,7 +5,8 @@
 namespace sb {
 
 const std::vector<std::string>& known_methods() {
-  static const std::vector<std::string> names = {"convolution", "reference"};
+  static const std::vector<std::string> names = {"convolution", "accumulation", "pcf",     "pcss",
+                                                 "adaptive-pcf", "erosion",      "chun-oh", "reference"};
   return names;
 }
 

@@ -134,6 +134,11 @@ Status write_outputs(const fs::path& dir, const Scene& scene, const BakeSettings
         {"covered_texels", r.covered_texels},
         {"seconds", r.seconds},
     });
+    if (!r.stats.empty()) {
+      auto& stats = manifest["receivers"].back()["method_stats"];
+      stats = nlohmann::ordered_json::object();
+      for (const auto& [key, value] : r.stats) stats[key] = value;
+    }
     if (!r.pairs.empty()) {
       auto& entry = manifest["receivers"].back();
       double worst = 0, worst_texels = 0;

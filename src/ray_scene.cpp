@@ -1,6 +1,7 @@
 // Shadow rays with Embree 3 (Wald et al., "Embree: a kernel framework for efficient CPU ray
-// tracing", SIGGRAPH 2014). Only occlusion is asked, so rtcOccluded with no hit data; the
-// scene is built once, at high quality, and queried by all threads.
+// tracing", SIGGRAPH 2014). Shadow rays ask only occlusion (rtcOccluded, no hit data, the
+// cheapest query); first_hit asks for the closest hit (rtcIntersect) where a method needs the
+// blocker's distance. The scene is built once, at high quality, and queried by all threads.
 //
 // Robust offsets: a shadow ray starts on a triangle it must not hit, so its origin is pushed
 // along the geometric normal by surface_offset(). Embree stores vertices in single precision,
@@ -12,6 +13,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -87,6 +89,66 @@ bool RayScene::occluded(const Vec3& origin, const Vec3& direction, double length
   return hit != 0;
 }
 
+namespace {
+
+// Fills lanes of an 8-wide ray packet from segments start.. (at most 8), repeating the last
+// segment in the unused lanes, which `valid` switches off. Used by both queries so they agree
+// on where a segment begins and ends.
+void fill_packet(RTCRay8& rays, int* valid, int start, int n, const Vec3* origins,
+                 const Vec3* directions, const double* lengths, double offset) {
+  for (int i = 0; i < 8; ++i) {
+    valid[i] = i < n ? -1 : 0;
+    const int k = start + std::min(i, n - 1);
+    rays.org_x[i] = float(origins[k].x());
+    rays.org_y[i] = float(origins[k].y());
+    rays.org_z[i] = float(origins[k].z());
+    rays.dir_x[i] = float(directions[k].x());
+    rays.dir_y[i] = float(directions[k].y());
+    rays.dir_z[i] = float(directions[k].z());
+    // Skip the first surface_offset of the segment as well: a point exactly on another
+    // blocker's face (the bottom edge of a box standing on a floor) must not be shadowed by
+    // that face at t = 0.
+    rays.tnear[i] = float(offset / std::max(directions[k].norm(), 1e-30));
+    rays.tfar[i] = float(lengths[k]);
+    rays.time[i] = 0.0f;
+    rays.mask[i] = 0xFFFFFFFFu;
+    rays.id[i] = unsigned(i);
+    rays.flags[i] = 0;
+  }
+}
+
+}  // namespace
+
+double RayScene::first_hit(const Vec3& origin, const Vec3& direction, double length) const {
+  double t = -1;
+  first_hit(1, &origin, &direction, &length, &t);
+  return t;
+}
+
+void RayScene::first_hit(int count, const Vec3* origins, const Vec3* directions,
+                         const double* lengths, double* t_hit) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  constexpr int kPacket = 8;
+  alignas(32) int valid[kPacket];
+  RTCRayHit8 query;
+  for (int start = 0; start < count; start += kPacket) {
+    const int n = std::min(kPacket, count - start);
+    fill_packet(query.ray, valid, start, n, origins, directions, lengths, impl_->offset);
+    for (int i = 0; i < kPacket; ++i) {
+      query.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+      query.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect8(valid, impl_->scene, &context, &query);
+    // Embree shortens tfar to the closest hit and sets geomID; a miss keeps RTC_INVALID.
+    for (int i = 0; i < n; ++i) {
+      t_hit[start + i] =
+          query.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID ? double(query.ray.tfar[i]) : -1.0;
+    }
+  }
+}
+
 void RayScene::occluded(int count, const Vec3* origins, const Vec3* directions,
                         const double* lengths, std::uint8_t* hit) const {
   RTCIntersectContext context;
@@ -97,25 +159,7 @@ void RayScene::occluded(int count, const Vec3* origins, const Vec3* directions,
   RTCRay8 rays;
   for (int start = 0; start < count; start += kPacket) {
     const int n = std::min(kPacket, count - start);
-    for (int i = 0; i < kPacket; ++i) {
-      valid[i] = i < n ? -1 : 0;
-      const int k = start + std::min(i, n - 1);
-      rays.org_x[i] = float(origins[k].x());
-      rays.org_y[i] = float(origins[k].y());
-      rays.org_z[i] = float(origins[k].z());
-      rays.dir_x[i] = float(directions[k].x());
-      rays.dir_y[i] = float(directions[k].y());
-      rays.dir_z[i] = float(directions[k].z());
-      // Skip the first surface_offset of the segment as well: a point exactly on another
-      // blocker's face (the bottom edge of a box standing on a floor) must not be shadowed by
-      // that face at t = 0.
-      rays.tnear[i] = float(impl_->offset / std::max(directions[k].norm(), 1e-30));
-      rays.tfar[i] = float(lengths[k]);
-      rays.time[i] = 0.0f;
-      rays.mask[i] = 0xFFFFFFFFu;
-      rays.id[i] = unsigned(i);
-      rays.flags[i] = 0;
-    }
+    fill_packet(rays, valid, start, n, origins, directions, lengths, impl_->offset);
     rtcOccluded8(valid, impl_->scene, &context, &rays);
     // Embree sets tfar to -inf for each occluded ray.
     for (int i = 0; i < n; ++i) hit[start + i] = rays.tfar[i] < 0.0f ? 1 : 0;

@@ -31,6 +31,16 @@ class RayScene {
   void occluded(int count, const Vec3* origins, const Vec3* directions, const double* lengths,
                 std::uint8_t* hit) const;
 
+  // Where the segment origin + t·direction, t ∈ [surface_offset() / |direction|, length], first
+  // meets a blocker triangle (either side): that t, in units of |direction|, or a negative value
+  // when it meets none. The closest-hit counterpart of occluded(), for methods that need the
+  // distance to the blocker (erosion's penumbra width) and not only whether there is one.
+  double first_hit(const Vec3& origin, const Vec3& direction, double length) const;
+
+  // Answers `count` segments at once, writing each first hit's t (or a negative value) into t_hit.
+  void first_hit(int count, const Vec3* origins, const Vec3* directions, const double* lengths,
+                 double* t_hit) const;
+
   // The blockers' bounding box (empty when there are none).
   const Bounds3& bounds() const;
 
