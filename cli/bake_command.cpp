@@ -58,6 +58,7 @@ struct BakeArgs {
   std::optional<std::string> method, quantity;
   std::optional<int> resolution, samples;
   std::optional<std::uint64_t> seed;
+  std::optional<double> error_texels;
   int threads = 0;
   bool quiet = false;
   bool explain = false;
@@ -68,6 +69,8 @@ void print_explanation(const sb::BakeResult& result) {
   for (const auto& r : result.receivers) {
     fmt::print("{}: texel space {:.1f} ms, method {:.1f} ms, dilation {:.1f} ms\n", r.name,
                1e3 * r.seconds_texels, 1e3 * r.seconds_method, 1e3 * r.seconds_dilate);
+    for (const auto& [key, value] : r.stats) fmt::print("    {} = {:.4g}\n", key, value);
+    if (!r.plan.empty()) fmt::print("{}", r.plan);
     for (const auto& p : r.pairs) {
       fmt::print("{} <- {}{}{}: D = ({:.3f}, {:.3f}, {:.3f}), {} lit texels", p.receiver, p.light,
                  p.part.empty() ? "" : " face ", p.part, p.axis[0], p.axis[1], p.axis[2],
@@ -112,6 +115,7 @@ int run_bake(const BakeArgs& args) {
   if (args.resolution) settings.resolution = *args.resolution;
   if (args.samples) settings.samples = *args.samples;
   if (args.seed) settings.seed = *args.seed;
+  if (args.error_texels) settings.error_texels = *args.error_texels;
 
   const bool show_progress = !args.quiet && ::isatty(STDERR_FILENO);
   ProgressBar bar("baking " + settings.method);
@@ -155,6 +159,7 @@ Runner add_bake_command(CLI::App& app) {
     std::string method, quantity;
     int resolution = 0, samples = 0;
     std::uint64_t seed = 0;
+    double error_texels = 1;
   };
   auto o = std::make_shared<Options>();
   auto* bake = app.add_subcommand("bake", "bake every receiver of a scene into OUTDIR");
@@ -171,6 +176,10 @@ Runner add_bake_command(CLI::App& app) {
   auto* samples_opt = bake->add_option("--samples", o->samples, "light samples per texel")
                           ->check(CLI::Range(1, 1 << 20));
   auto* seed_opt = bake->add_option("--seed", o->seed, "sampling seed");
+  auto* error_opt =
+      bake->add_option("--error-texels", o->error_texels,
+                       "convolution: penumbra error allowed, receiver texels (overrides [bake])")
+          ->check(CLI::PositiveNumber);
   bake->add_option("--threads", o->args.threads, "worker threads (0: all cores)")
       ->check(CLI::Range(0, 1024));
   bake->add_flag("-q,--quiet", o->args.quiet, "no progress bar and no summary");
@@ -183,6 +192,7 @@ Runner add_bake_command(CLI::App& app) {
     if (*resolution_opt) o->args.resolution = o->resolution;
     if (*samples_opt) o->args.samples = o->samples;
     if (*seed_opt) o->args.seed = o->seed;
+    if (*error_opt) o->args.error_texels = o->error_texels;
     return run_bake(o->args);
   };
 }

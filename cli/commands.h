@@ -32,5 +32,6 @@ using Runner = std::function<int()>;
 Runner add_bake_command(CLI::App& app);     // bake_command.cpp
 Runner add_compare_command(CLI::App& app);  // compare_command.cpp
 Runner add_report_command(CLI::App& app);   // report_command.cpp
+Runner add_plan_command(CLI::App& app);     // plan_command.cpp
 
 }  // namespace sbcli

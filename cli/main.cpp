@@ -38,6 +38,7 @@ int main(int argc, char** argv) {
       {"bake", sbcli::add_bake_command(app)},
       {"compare", sbcli::add_compare_command(app)},
       {"report", sbcli::add_report_command(app)},
+      {"plan", sbcli::add_plan_command(app)},
   };
   try {
     app.parse(argc, argv);

@@ -11,6 +11,8 @@
 #include <optional>
 #include <thread>
 
+#include "baselines.h"
+#include "clusters.h"
 #include "convolution_bake.h"
 #include "fft_convolution.h"
 #include "lights.h"
@@ -64,13 +66,18 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   std::vector<const Mesh*> blockers;
   for (std::size_t i = 0; i < meshes.size(); ++i)
     if (scene.objects[i].blocker) blockers.push_back(&meshes[i]);
-  const bool ray_traced = scene.bake.method == "reference";
+  // Every method but the convolution casts rays: the reference and accumulation for their
+  // shadows, the shadow-map baselines where they need an exact hard shadow or blocker distance.
+  const bool ray_traced = scene.bake.method != "convolution";
   std::optional<RayScene> rays;
   if (ray_traced) {
     auto built = RayScene::build(blockers);
     if (!built) return built.error();
     rays.emplace(std::move(*built));
   }
+  // The convolution's cluster hierarchy (clusters.h), over the blockers in this order.
+  ClusterTree clusters;
+  if (scene.bake.method == "convolution") clusters = build_clusters(blockers);
   auto lights_or = make_lights(scene.lights, scene.file);
   if (!lights_or) return lights_or.error();
   const std::vector<Light>& lights = *lights_or;
@@ -105,7 +112,25 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     out.seconds_texels = raster_seconds[r];
     out.name = obj.name;
     out.uv_channel = obj.uv_channel;
-    if (ray_traced) {
+    if (scene.bake.method != "convolution" && scene.bake.method != "reference") {
+      BaselineInputs in;
+      in.lights = &lights;
+      in.rays = &*rays;
+      in.blockers = blockers;
+      in.receiver = &meshes[receivers[r]];
+      in.settings = &scene.bake;
+      in.stream = receivers[r];
+      const std::string& m = scene.bake.method;
+      if (m == "accumulation") {
+        out.image = bake_accumulation(spaces[r], in, &out.stats, &result.shadow_rays);
+      } else if (m == "erosion") {
+        out.image = bake_erosion(spaces[r], in, &out.stats, &result.shadow_rays);
+      } else {
+        out.image = bake_shadow_map_filter(spaces[r], in, &out.stats);
+      }
+      texels_done += std::int64_t(spaces[r].texels.size());
+      if (progress) progress(double(texels_done.load()));
+    } else if (ray_traced) {
       ReferenceInputs in;
       in.lights = &lights;
       in.rays = &*rays;
@@ -120,10 +145,18 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
       ConvolutionInputs in;
       in.lights = &lights;
       in.receiver = &meshes[receivers[r]];
-      for (const Mesh* b : blockers)
-        if (b != in.receiver) in.blockers.push_back(b);
+      in.blockers = blockers;
+      in.clusters = &clusters;
       in.quantity = scene.bake.quantity;
-      out.image = bake_convolution(spaces[r], in, &out.pairs);
+      in.error_texels = scene.bake.error_texels;
+      in.max_image = scene.bake.max_image;
+      in.max_triples = scene.bake.max_triples;
+      in.combine = scene.bake.blocker_combine == "sum" ? BlockerCombine::sum
+                                                       : BlockerCombine::product;
+      ConvolutionPlan plan;
+      out.image = bake_convolution(spaces[r], in, &out.pairs, &plan);
+      out.plan = describe_plan(plan);
+      for (const auto& w : plan.warnings) result.warnings.push_back(scene.file.string() + ": " + w);
       texels_done += std::int64_t(spaces[r].texels.size());
       if (progress) progress(double(texels_done.load()));
     }
@@ -139,6 +172,43 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   result.bake_seconds = seconds_since(bake_start);
   if (options.progress) options.progress(1.0);
   return result;
+}
+
+Expected<std::vector<std::string>> plan(const Scene& scene, const BakeOptions& options) {
+  std::unique_ptr<tbb::global_control> thread_limit;
+  if (options.threads > 0) {
+    thread_limit = std::make_unique<tbb::global_control>(
+        tbb::global_control::max_allowed_parallelism, std::size_t(options.threads));
+  }
+  std::vector<Mesh> meshes;
+  meshes.reserve(scene.objects.size());
+  for (const auto& obj : scene.objects) {
+    auto mesh = import_mesh(obj, scene.file);
+    if (!mesh) return mesh.error();
+    meshes.push_back(std::move(*mesh));
+  }
+  std::vector<const Mesh*> blockers;
+  for (std::size_t i = 0; i < meshes.size(); ++i)
+    if (scene.objects[i].blocker) blockers.push_back(&meshes[i]);
+  const ClusterTree clusters = build_clusters(blockers);
+  auto lights = make_lights(scene.lights, scene.file);
+  if (!lights) return lights.error();
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < meshes.size(); ++i) {
+    if (!scene.objects[i].receiver) continue;
+    const TexelSpace space =
+        rasterise_texels(meshes[i], scene.bake.resolution, scene.bake.resolution);
+    PlanInputs in;
+    in.lights = &*lights;
+    in.receiver = &meshes[i];
+    in.blockers = blockers;
+    in.clusters = &clusters;
+    in.error_texels = scene.bake.error_texels;
+    in.max_image = scene.bake.max_image;
+    in.max_triples = scene.bake.max_triples;
+    out.push_back(describe_plan(plan_convolution(space, in)));
+  }
+  return out;
 }
 
 }  // namespace sb

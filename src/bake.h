@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "error.h"
@@ -39,7 +40,8 @@ struct PairReport {
   int image_width = 0, image_height = 0;    // blocker image, pixels
   int kernel_width = 0, kernel_height = 0;  // source kernel, pixels (odd)
   int fft_width = 0, fft_height = 0;        // transform size
-  int convolutions = 0;                     // 1, or 3 for a coloured source image
+  int convolutions = 0;                     // FFT convolutions done (3 per coloured leaf)
+  int triples = 0;                          // leaf triples convolved
   std::int64_t lit_texels = 0;              // texels this light reaches (H0 > 0)
   std::int64_t outside_texels = 0;          // lit texels at or behind the light's plane across D
   double seconds_configure = 0, seconds_source = 0, seconds_blocker = 0, seconds_fft = 0,
@@ -54,7 +56,11 @@ struct ReceiverBake {
   std::int64_t covered_texels = 0;
   double seconds = 0;  // texel space + method + dilation, this receiver only
   double seconds_texels = 0, seconds_method = 0, seconds_dilate = 0;  // its parts
-  std::vector<PairReport> pairs;  // per light, for the convolution method
+  std::vector<PairReport> pairs;  // per (light part, frustum), for the convolution method
+  std::string plan;               // the convolution's triples as text (describe_plan)
+  // Named figures of the method for this receiver (baselines.h), e.g. adaptive PCF's fraction
+  // of texels that took the full filter.
+  std::vector<std::pair<std::string, double>> stats;
 };
 
 struct BakeResult {
@@ -67,5 +73,9 @@ struct BakeResult {
 
 // Bakes scene.bake.method for every receiver. Errors name the scene file and the item.
 Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options = {});
+
+// The convolution method's plan for every receiver (describe_plan's text, in scene order),
+// without convolving: what `shadowbake plan` prints.
+Expected<std::vector<std::string>> plan(const Scene& scene, const BakeOptions& options = {});
 
 }  // namespace sb

@@ -50,66 +50,80 @@ struct Edges {
 
 }  // namespace
 
-ProjectedBlockers project_blockers(const std::vector<const Mesh*>& blockers,
-                                   const ProjectionFrame& frame, double near, double far,
-                                   const ShadowCaster& caster) {
+ProjectedBlockers project_faces(const std::vector<FaceRef>& faces, const ProjectionFrame& frame,
+                                double near, double far, const ShadowCaster& caster) {
   ProjectedBlockers out;
   const Vec3& lo = caster.receiver.lo;
   const Vec3& hi = caster.receiver.hi;
   const double scale = std::max(1.0, (hi - lo).norm());
-  for (const Mesh* m : blockers) {
-    for (auto f : m->mesh.faces()) {
-      std::vector<Vec3> poly;
-      for (auto v : m->mesh.fv_range(f)) {
-        const auto& p = m->mesh.point(v);
-        poly.emplace_back(p[0], p[1], p[2]);
-      }
-      const Vec3 normal = (poly[1] - poly[0]).cross(poly[2] - poly[0]);
-      if (normal.norm() > 0 && !caster.receiver.empty()) {
-        const Vec3 n = normal.normalized();
-        const double light_side = n.dot(frame.origin - poly[0]);
-        if (std::abs(light_side) > caster.light_radius) {
-          // The receiver's extreme distance to the plane on the side away from the light; the
-          // receiver may touch the plane (a box standing on the floor).
-          const double sign = light_side > 0 ? 1.0 : -1.0;
-          double lowest = std::numeric_limits<double>::infinity();
-          for (int corner = 0; corner < 8; ++corner) {
-            const Vec3 c(corner & 1 ? hi.x() : lo.x(), corner & 2 ? hi.y() : lo.y(),
-                         corner & 4 ? hi.z() : lo.z());
-            lowest = std::min(lowest, sign * n.dot(c - poly[0]));
-          }
-          if (lowest >= -1e-6 * scale) continue;  // light and receiver on one side
-        }
-      }
-      poly = clip_depth(poly, frame, near, +1.0);
-      if (poly.size() >= 3) poly = clip_depth(poly, frame, far, -1.0);
-      if (poly.size() < 3) continue;
-      ProjectedBlockers::Polygon pg;
-      pg.depth_lo = std::numeric_limits<double>::infinity();
-      pg.depth_hi = -pg.depth_lo;
-      for (const Vec3& p : poly) {
-        pg.points.push_back(frame.tangent(p));
-        const double d = frame.depth(p);
-        pg.depth_lo = std::min(pg.depth_lo, d);
-        pg.depth_hi = std::max(pg.depth_hi, d);
-      }
-      double area2 = 0;
-      for (std::size_t i = 0; i < pg.points.size(); ++i) {
-        const Vec2& a = pg.points[i];
-        const Vec2& b = pg.points[(i + 1) % pg.points.size()];
-        area2 += a.x() * b.y() - a.y() * b.x();
-      }
-      if (std::abs(area2) < 1e-18) continue;  // seen edge-on: covers nothing
-      if (area2 < 0) std::reverse(pg.points.begin(), pg.points.end());
-      pg.lo = pg.hi = pg.points[0];
-      for (const Vec2& p : pg.points) {
-        pg.lo = pg.lo.cwiseMin(p);
-        pg.hi = pg.hi.cwiseMax(p);
-      }
-      out.polygons.push_back(std::move(pg));
+  std::vector<Vec3> poly;
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    const TriMesh& mesh = faces[i].mesh->mesh;
+    poly.clear();
+    for (auto v : mesh.fv_range(mesh.face_handle(faces[i].face))) {
+      const auto& p = mesh.point(v);
+      poly.emplace_back(p[0], p[1], p[2]);
     }
+    const Vec3 normal = (poly[1] - poly[0]).cross(poly[2] - poly[0]);
+    if (normal.norm() > 0 && !caster.receiver.empty()) {
+      const Vec3 n = normal.normalized();
+      const double light_side = n.dot(frame.origin - poly[0]);
+      if (std::abs(light_side) > caster.light_radius) {
+        // The receiver's extreme distance to the plane on the side away from the light; the
+        // receiver may touch the plane (a box standing on the floor).
+        const double sign = light_side > 0 ? 1.0 : -1.0;
+        double lowest = std::numeric_limits<double>::infinity();
+        for (int corner = 0; corner < 8; ++corner) {
+          const Vec3 c(corner & 1 ? hi.x() : lo.x(), corner & 2 ? hi.y() : lo.y(),
+                       corner & 4 ? hi.z() : lo.z());
+          lowest = std::min(lowest, sign * n.dot(c - poly[0]));
+        }
+        if (lowest >= -1e-6 * scale) continue;  // light and receiver on one side
+      }
+    }
+    std::vector<Vec3> clipped = clip_depth(poly, frame, near, +1.0);
+    if (clipped.size() >= 3) clipped = clip_depth(clipped, frame, far, -1.0);
+    if (clipped.size() < 3) continue;
+    ProjectedBlockers::Polygon pg;
+    pg.source = int(i);
+    pg.depth_lo = std::numeric_limits<double>::infinity();
+    pg.depth_hi = -pg.depth_lo;
+    for (const Vec3& p : clipped) {
+      pg.points.push_back(frame.tangent(p));
+      const double d = frame.depth(p);
+      pg.depth_lo = std::min(pg.depth_lo, d);
+      pg.depth_hi = std::max(pg.depth_hi, d);
+    }
+    double area2 = 0;
+    for (std::size_t k = 0; k < pg.points.size(); ++k) {
+      const Vec2& a = pg.points[k];
+      const Vec2& b = pg.points[(k + 1) % pg.points.size()];
+      area2 += a.x() * b.y() - a.y() * b.x();
+    }
+    if (std::abs(area2) < 1e-18) continue;  // seen edge-on: covers nothing
+    if (area2 < 0) std::reverse(pg.points.begin(), pg.points.end());
+    // 1/depth along the ray o + λ(D + t1·e1 + t2·e2) meeting the plane n·(x − p0) = 0.
+    const double h = normal.dot(poly[0] - frame.origin);
+    if (std::abs(h) > 0) {
+      pg.inverse_depth = Vec3(normal.dot(frame.e1), normal.dot(frame.e2), normal.dot(frame.axis)) / h;
+    }
+    pg.lo = pg.hi = pg.points[0];
+    for (const Vec2& p : pg.points) {
+      pg.lo = pg.lo.cwiseMin(p);
+      pg.hi = pg.hi.cwiseMax(p);
+    }
+    out.polygons.push_back(std::move(pg));
   }
   return out;
+}
+
+ProjectedBlockers project_blockers(const std::vector<const Mesh*>& blockers,
+                                   const ProjectionFrame& frame, double near, double far,
+                                   const ShadowCaster& caster) {
+  std::vector<FaceRef> faces;
+  for (const Mesh* m : blockers)
+    for (auto f : m->mesh.faces()) faces.push_back({m, f.idx()});
+  return project_faces(faces, frame, near, far, caster);
 }
 
 DepthRange blocker_depths_over(const ProjectedBlockers& blockers, const Vec2& lo, const Vec2& hi) {
@@ -120,6 +134,91 @@ DepthRange blocker_depths_over(const ProjectedBlockers& blockers, const Vec2& lo
     range.extend(pg.depth_hi);
   }
   return range;
+}
+
+std::vector<float> nearest_layer_coverage(const ProjectedBlockers& layer,
+                                          const std::vector<std::uint8_t>& mine, double depth_lo,
+                                          double depth_hi, const TangentGrid& grid) {
+  const int w = grid.width, h = grid.height;
+  std::vector<float> coverage(std::size_t(w) * h, 0.0f);
+  struct Raster {
+    Edges edges;
+    Vec3 inverse_depth;  // per pixel unit, see below
+    int x0, x1, y0, y1;
+    bool mine;
+  };
+  std::vector<Raster> rasters;
+  bool any_mine = false;
+  for (std::size_t i = 0; i < layer.polygons.size(); ++i) {
+    const auto& pg = layer.polygons[i];
+    const Vec2 lo = (pg.lo - grid.origin) / grid.pixel, hi = (pg.hi - grid.origin) / grid.pixel;
+    const int x0 = std::max(0, int(std::floor(lo.x()))), x1 = std::min(w - 1, int(hi.x()));
+    const int y0 = std::max(0, int(std::floor(lo.y()))), y1 = std::min(h - 1, int(hi.y()));
+    if (x0 > x1 || y0 > y1) continue;
+    std::vector<Vec2> pts;
+    for (const Vec2& p : pg.points) pts.push_back((p - grid.origin) / grid.pixel);
+    // 1/depth in pixel coordinates: t = origin + pixel·q.
+    const Vec3& a = pg.inverse_depth;
+    const Vec3 inv(a.x() * grid.pixel, a.y() * grid.pixel,
+                   a.x() * grid.origin.x() + a.y() * grid.origin.y() + a.z());
+    rasters.push_back({Edges(pts), inv, x0, x1, y0, y1, mine[i] != 0});
+    any_mine = any_mine || mine[i];
+  }
+  if (!any_mine) return coverage;
+  const double inv_lo = depth_hi > 0 ? 1.0 / depth_hi : 0.0;  // depth < depth_hi
+  const double inv_hi = depth_lo > 0 ? 1.0 / depth_lo : std::numeric_limits<double>::infinity();
+  constexpr int kS = kSamplesPerSide * kSamplesPerSide;
+  constexpr int kBand = 8;
+  tbb::parallel_for(tbb::blocked_range<int>(0, (h + kBand - 1) / kBand), [&](const auto& bands) {
+    std::vector<float> nearest;      // per sample: largest 1/depth so far
+    std::vector<std::uint8_t> owner;  // per sample: whether that polygon is mine
+    for (int band = bands.begin(); band != bands.end(); ++band) {
+      const int row0 = band * kBand, row1 = std::min(h, row0 + kBand);
+      nearest.assign(std::size_t(row1 - row0) * w * kS, 0.0f);
+      owner.assign(nearest.size(), 0);
+      for (const Raster& r : rasters) {
+        const int y0 = std::max(r.y0, row0), y1 = std::min(r.y1, row1 - 1);
+        for (int y = y0; y <= y1; ++y) {
+          for (int x = r.x0; x <= r.x1; ++x) {
+            const std::size_t base = (std::size_t(y - row0) * w + x) * kS;
+            for (int sy = 0; sy < kSamplesPerSide; ++sy) {
+              for (int sx = 0; sx < kSamplesPerSide; ++sx) {
+                const double px = x + (sx + 0.5) / kSamplesPerSide;
+                const double py = y + (sy + 0.5) / kSamplesPerSide;
+                bool inside = true;
+                for (const Vec3& e : r.edges.lines) {
+                  if (e.x() * px + e.y() * py + e.z() < 0) {
+                    inside = false;
+                    break;
+                  }
+                }
+                if (!inside) continue;
+                const float inv = float(r.inverse_depth.x() * px + r.inverse_depth.y() * py +
+                                        r.inverse_depth.z());
+                const std::size_t k = base + std::size_t(sy * kSamplesPerSide + sx);
+                if (inv > nearest[k]) {
+                  nearest[k] = inv;
+                  owner[k] = r.mine ? 1 : 0;
+                }
+              }
+            }
+          }
+        }
+      }
+      for (int y = row0; y < row1; ++y) {
+        for (int x = 0; x < w; ++x) {
+          const std::size_t base = (std::size_t(y - row0) * w + x) * kS;
+          int count = 0;
+          for (int k = 0; k < kS; ++k) {
+            const double inv = nearest[base + k];
+            if (owner[base + k] && inv > inv_lo && inv <= inv_hi) ++count;
+          }
+          coverage[std::size_t(y) * w + x] = float(count) / kS;
+        }
+      }
+    }
+  });
+  return coverage;
 }
 
 std::vector<float> blocker_coverage(const ProjectedBlockers& blockers, const TangentGrid& grid) {

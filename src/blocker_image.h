@@ -28,6 +28,10 @@ struct ProjectedBlockers {
     std::vector<Vec2> points;  // tangent coordinates, counter-clockwise
     Vec2 lo, hi;               // bounding box
     double depth_lo = 0, depth_hi = 0;
+    int source = -1;  // index of the face it came from in the list given to project_faces
+    // The face's plane as inverse depth, affine in tangent coordinates (a plane seen from a
+    // point): 1/depth = x·t1 + y·t2 + z.
+    Vec3 inverse_depth = Vec3::Zero();
   };
   std::vector<Polygon> polygons;
 };
@@ -41,6 +45,17 @@ struct ShadowCaster {
   Bounds3 receiver;
 };
 
+// One triangle of one mesh.
+struct FaceRef {
+  const Mesh* mesh = nullptr;
+  int face = -1;
+};
+
+// Clips every face of `faces` that may shadow the receiver to near <= depth <= far along the
+// frame's axis and projects what remains from the frame's origin (as project_blockers).
+ProjectedBlockers project_faces(const std::vector<FaceRef>& faces, const ProjectionFrame& frame,
+                                double near, double far, const ShadowCaster& caster);
+
 // Clips every triangle of `blockers` that may shadow the receiver to near <= depth <= far along
 // the frame's axis, and projects what remains from the frame's origin. Blocker parts behind the
 // light or beyond the receiver cannot shadow it, and projecting a point at depth ≈ 0 would throw
@@ -51,6 +66,15 @@ ProjectedBlockers project_blockers(const std::vector<const Mesh*>& blockers,
 
 // The depth range of the projected polygons whose bounding boxes overlap [lo, hi].
 DepthRange blocker_depths_over(const ProjectedBlockers& blockers, const Vec2& lo, const Vec2& hi);
+
+// The nearest-layer blocker image of one cluster: the fraction of each pixel's 4 × 4 sample
+// points at which the blocker nearest the light's centre, among all polygons of `layer`, is one
+// of the cluster's (mine[i] for polygon i) and lies at depth in [depth_lo, depth_hi). The
+// clusters of one hierarchy thus have disjoint images that add up to the whole layer's coverage:
+// each part of the hard shadow from the light's centre belongs to the cluster that casts it.
+std::vector<float> nearest_layer_coverage(const ProjectedBlockers& layer,
+                                          const std::vector<std::uint8_t>& mine, double depth_lo,
+                                          double depth_hi, const TangentGrid& grid);
 
 // Fraction of each grid pixel covered by the union of the polygons, from 4 × 4 sample points per
 // pixel (exact where a pixel is wholly inside or outside a polygon). Row-major, width × height.

@@ -2,12 +2,19 @@
 // Using Convolution", SIGGRAPH 1998; ../shared/seeds/001_414ff95054935c53.txt; the mathematics in
 // design-notes §2–4).
 //
-// For each light and receiver: choose the virtual parallel configuration (virtual_configuration),
-// render the source kernel (source_image) and the blocker image (blocker_image) on one grid of the
-// tangent plane, convolve them by FFT (fft_convolution) to get the occluded fraction O, and give
-// each lit texel V = 1 − O read bilinearly at its central projection through the light's centre.
-// That projection makes hard-shadow positions exact for the light's centre whatever the
+// For each receiver, plan_convolution (convolution_plan.cpp) chooses the hierarchy of (light part,
+// blocker cluster, receiver part) triples. Each leaf triple renders its source kernel
+// (source_image) and blocker image (blocker_image) on one grid of its frustum's tangent plane,
+// convolves them by FFT (fft_convolution) to get the occluded fraction O, and gives each texel
+// of its footprint O read bilinearly at the texel's central projection through the light part's
+// centre. That projection makes hard-shadow positions exact for the light's centre whatever the
 // geometry; only penumbra widths are approximate, by at most the penumbra error ε reported.
+//
+// Combining leaves at a texel: a receiver split's two parts are blended by their cut weights (a
+// partition of unity across the seam); a slab's shadow counts in proportion to the part of its
+// geometry in front of the texel; blocker clusters combine by BlockerCombine, which becomes a
+// weighted sum S = Σ w·f(O) with f(O) = O, V = 1 − min(S, 1) (sum) or f(O) = −ln(1 − O),
+// V = exp(−S) (product). Light parts add by power.
 //
 // V here is the emission-weighted unoccluded fraction V_u of design-notes §1 (the paper's split
 // H ≈ H0 · V_u), not the irradiance-weighted V of the reference; §1 says by how much they differ.
@@ -17,6 +24,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
+#include <limits>
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -24,6 +33,7 @@
 #include "blocker_image.h"
 #include "fft_convolution.h"
 #include "source_image.h"
+#include "convolution_plan.h"
 
 namespace sb {
 
@@ -49,240 +59,200 @@ float bilinear(const std::vector<float>& image, int w, int h, const Vec2& p) {
                ty * ((1 - tx) * at(x0, y1) + tx * at(x1, y1)));
 }
 
-}  // namespace
-
-double texel_size(const Mesh& mesh, int width, int height) {
-  double world = 0, uv = 0;
-  for (auto f : mesh.mesh.faces()) {
-    const Triangle t = triangle(mesh.mesh, f);
-    world += 0.5 * (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]).norm();
-    const Vec2 a = t.uv[1] - t.uv[0], b = t.uv[2] - t.uv[0];
-    uv += 0.5 * std::abs(a.x() * b.y() - a.y() * b.x());
-  }
-  if (uv <= 0) return 0;
-  return std::sqrt(world / (uv * double(width) * height));
-}
-
-namespace {
-
-// One light's visibility over one set of texels seen through one frustum: the virtual
-// configuration, source kernel, blocker image, convolution and lookup. Writes V per channel into
-// visibility[t] for each t in `texels`, and fills `report`.
-void convolve_part(const TexelSpace& space, const std::vector<std::size_t>& texels,
-                   const Light& light, const ProjectionFrame& frame, double texel,
-                   const ConvolutionInputs& in, std::vector<Vec3f>& visibility,
-                   PairReport& report) {
+// Convolves one leaf and adds its weighted occlusion into `occlusion` (per frame texel).
+void convolve_leaf(const ConvolutionPlan& plan, Triple& leaf, BlockerCombine combine,
+                   std::vector<Vec3f>& occlusion, PairReport& report) {
+  const PlanFrame& fr = plan.frames[leaf.frame];
+  const Light& light = plan.light_parts[fr.light_part].part;
   auto start = Clock::now();
-  report.lit_texels = std::int64_t(texels.size());
-  for (int k = 0; k < 3; ++k) report.axis[k] = frame.axis[k];
-  DepthRange receiver_depths;
-  ShadowCaster caster;
-  for (std::size_t t : texels) {
-    const Vec3 p = space.texels[t].position.cast<double>();
-    receiver_depths.extend(frame.depth(p));
-    caster.receiver.extend(p);
-  }
-  // Texels this close to the light's plane across D (or behind it) cannot be projected; they
-  // keep V = 1 and are counted. The caller's choice of frusta keeps them rare.
-  const double near = std::max(1e-4, 1e-3 * receiver_depths.hi);
-  Vec2 t_lo = Vec2::Constant(std::numeric_limits<double>::infinity()), t_hi = -t_lo;
-  DepthRange projected_depths;
-  for (std::size_t t : texels) {
-    const Vec3 p = space.texels[t].position.cast<double>();
-    visibility[t] = Vec3f::Ones();
-    if (frame.depth(p) <= near) {
-      ++report.outside_texels;
-      continue;
+  const double k = std::max(0.0, 1.0 / leaf.config.blocker_plane - 1.0 / leaf.config.receiver_plane);
+  const SourceKernel kernel = source_kernel(light, fr.frame, k, leaf.grid.pixel);
+  report.seconds_source += seconds_since(start);
+  start = Clock::now();
+  // This cluster's share of the root layer's hard shadow (nearest_layer_coverage).
+  std::vector<std::uint8_t> mine(leaf.layer->polygons.size(), 0);
+  {
+    std::vector<std::pair<const Mesh*, int>> own;
+    for (const FaceRef& f : leaf.faces) own.emplace_back(f.mesh, f.face);
+    std::sort(own.begin(), own.end());
+    const Triple* root = &leaf;
+    while (root->parent >= 0) root = &plan.triples[std::size_t(root->parent)];
+    for (std::size_t i = 0; i < mine.size(); ++i) {
+      const FaceRef& f = root->faces[std::size_t(leaf.layer->polygons[i].source)];
+      mine[i] = std::binary_search(own.begin(), own.end(), std::make_pair(f.mesh, f.face));
     }
-    projected_depths.extend(frame.depth(p));
-    const Vec2 tc = frame.tangent(p);
-    t_lo = t_lo.cwiseMin(tc);
-    t_hi = t_hi.cwiseMax(tc);
   }
-  if (projected_depths.empty()) return;
-  caster.light_radius = light.shape() == LightShape::rectangle
-                            ? 0.5 * std::hypot(light.desc().width, light.desc().height)
-                            : light.desc().radius;
-  const ProjectedBlockers blockers =
-      project_blockers(in.blockers, frame, near, projected_depths.hi, caster);
-  const DepthRange blocker_depths = blocker_depths_over(blockers, t_lo, t_hi);
-  const VirtualConfiguration config = choose_configuration(frame, blocker_depths, projected_depths,
-                                                           light.extent_across(frame.axis));
-  report.seconds_configure = seconds_since(start);
-
-  report.receiver_depth_lo = projected_depths.lo;
-  report.receiver_depth_hi = projected_depths.hi;
-  report.blocker_plane = config.blocker_plane;
-  report.receiver_plane = config.receiver_plane;
-  report.rho_lo = config.rho_lo;
-  report.rho_hi = config.rho_hi;
-  report.rho = config.rho;
-  report.light_extent = config.light_extent;
-  report.penumbra_error = config.penumbra_error;
-  report.penumbra_error_texels = texel > 0 ? config.penumbra_error / texel : 0;
-  if (blocker_depths.empty()) return;  // nothing can shadow these texels
-  report.blocker_depth_lo = blocker_depths.lo;
-  report.blocker_depth_hi = blocker_depths.hi;
-
-  start = Clock::now();
-  const double k = 1.0 / config.blocker_plane - 1.0 / config.receiver_plane;
-  // One blocker pixel per receiver texel at the receiver plane, unless the image would exceed
-  // max_image (then coarser, uniformly).
-  const Vec2 span = t_hi - t_lo;
-  double pixel = texel > 0 ? texel / config.receiver_plane : span.maxCoeff() / 512;
-  const Vec2 kernel_extent = 2 * k * light.half_extents(frame.e1, frame.e2);
-  const double needed = (span + kernel_extent).maxCoeff();
-  if (needed / pixel + 4 > in.max_image) pixel = needed / (in.max_image - 4);
-  const SourceKernel kernel = source_kernel(light, frame, k, pixel);
-  report.seconds_source = seconds_since(start);
-
-  start = Clock::now();
-  // The convolution is exact where the kernel stays inside the image: pad the texels' footprint
-  // by the kernel's radius (plus one pixel for the bilinear lookup).
-  const int margin_x = kernel.width / 2 + 1, margin_y = kernel.height / 2 + 1;
-  TangentGrid grid;
-  grid.pixel = pixel;
-  grid.origin = t_lo - Vec2(margin_x, margin_y) * pixel;
-  grid.width = int(std::ceil(span.x() / pixel)) + 2 * margin_x + 1;
-  grid.height = int(std::ceil(span.y() / pixel)) + 2 * margin_y + 1;
-  const std::vector<float> coverage = blocker_coverage(blockers, grid);
-  report.seconds_blocker = seconds_since(start);
-
+  const std::vector<float> coverage =
+      nearest_layer_coverage(*leaf.layer, mine, leaf.slab_lo, leaf.slab_hi, leaf.grid);
+  report.seconds_blocker += seconds_since(start);
   start = Clock::now();
   auto& fft = FftConvolver::shared();
-  const int tw = FftConvolver::fast_size(grid.width), th = FftConvolver::fast_size(grid.height);
-  const bool grey = kernel.grey;
+  const int tw = FftConvolver::fast_size(leaf.grid.width);
+  const int th = FftConvolver::fast_size(leaf.grid.height);
   std::array<std::vector<float>, 3> occluded;
-  for (int c = 0; c < (grey ? 1 : 3); ++c) {
+  const int channels = kernel.grey ? 1 : 3;
+  for (int c = 0; c < channels; ++c) {
     const auto spectrum =
         fft.kernel_spectrum(kernel.channels[c], kernel.width, kernel.height, tw, th);
-    fft.convolve(coverage, grid.width, grid.height, *spectrum, occluded[c]);
+    fft.convolve(coverage, leaf.grid.width, leaf.grid.height, *spectrum, occluded[c]);
   }
-  report.seconds_fft = seconds_since(start);
-  report.pixel = pixel;
-  report.image_width = grid.width;
-  report.image_height = grid.height;
-  report.kernel_width = kernel.width;
-  report.kernel_height = kernel.height;
-  report.fft_width = tw;
-  report.fft_height = th;
-  report.convolutions = grey ? 1 : 3;
+  report.seconds_fft += seconds_since(start);
+  report.convolutions += channels;
+  report.image_width = std::max(report.image_width, leaf.grid.width);
+  report.image_height = std::max(report.image_height, leaf.grid.height);
+  report.kernel_width = std::max(report.kernel_width, kernel.width);
+  report.kernel_height = std::max(report.kernel_height, kernel.height);
+  report.fft_width = std::max(report.fft_width, tw);
+  report.fft_height = std::max(report.fft_height, th);
 
   start = Clock::now();
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, texels.size(), 1024), [&](const auto& r) {
-    for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      const std::size_t t = texels[i];
-      const Vec3 p = space.texels[t].position.cast<double>();
-      if (frame.depth(p) <= near) continue;
-      const Vec2 at = grid.to_pixel(frame.tangent(p));
+  // How much of the slab's geometry lies in front of a texel, with half a texel of tolerance so
+  // that a blocker standing on the receiver shadows the texels beside its foot.
+  double lo = -std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const ReceiverCut& c : leaf.cuts) {
+    if (c.below) hi = std::min(hi, c.depth + c.band);
+    else lo = std::max(lo, c.depth - c.band);
+  }
+  const double g_lo = leaf.blocker_depths.lo, g_hi = leaf.blocker_depths.hi;
+  const double bias = 0.5 * plan.texel;
+  std::vector<int> texels;
+  fr.index[std::size_t(leaf.group)].for_each(leaf.footprint_lo, leaf.footprint_hi, [&](int i) {
+    const double d = fr.depth[std::size_t(i)];
+    const Vec2& tc = fr.tangent[std::size_t(i)];
+    if (d <= g_lo || d < lo || d > hi) return;
+    if ((tc.array() < leaf.footprint_lo.array()).any() ||
+        (tc.array() > leaf.footprint_hi.array()).any())
+      return;
+    texels.push_back(i);
+  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, texels.size(), 2048), [&](const auto& r) {
+    for (std::size_t j = r.begin(); j != r.end(); ++j) {
+      const std::size_t i = std::size_t(texels[j]);
+      const double depth = fr.depth[i];
+      double w = g_hi > g_lo ? std::clamp((depth + bias - g_lo) / (g_hi - g_lo), 0.0, 1.0) : 1.0;
+      for (const ReceiverCut& c : leaf.cuts) w *= c.weight(depth);
+      if (w <= 0) continue;
+      const Vec2 at = leaf.grid.to_pixel(fr.tangent[i]);
       for (int c = 0; c < 3; ++c) {
-        const float o = bilinear(occluded[grey ? 0 : c], grid.width, grid.height, at);
-        visibility[t][c] = std::clamp(1.0f - o, 0.0f, 1.0f);
+        const double o = std::clamp(
+            double(bilinear(occluded[kernel.grey ? 0 : c], leaf.grid.width, leaf.grid.height, at)),
+            0.0, 1.0);
+        const double f = combine == BlockerCombine::sum ? o : -std::log(std::max(1e-6, 1.0 - o));
+        occlusion[i][c] += float(w * f);
       }
     }
   });
-  report.seconds_lookup = seconds_since(start);
+  report.seconds_lookup += seconds_since(start);
 }
-
-// The widest angle, from the light's centre, between a receiver's texels and its frustum's axis
-// that one projection serves; beyond it the tangent plane stretches without bound (tan 60° = 1.7).
-constexpr double kMaxFrustumHalfAngleDeg = 60.0;
 
 }  // namespace
 
 Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
-                       std::vector<PairReport>* reports) {
+                       std::vector<PairReport>* reports, ConvolutionPlan* plan_out) {
   const auto& lights = *in.lights;
   const std::size_t n = space.texels.size();
-  const double texel = texel_size(*in.receiver, space.width, space.height);
-  // Per texel, Σ_l w_l·V_l (accumulated in the output) and Σ_l w_l, where the weight w_l is H0_l.
-  // One light's visibility needs no closed form: its weight is its exitance where it reaches
-  // the texel (so that a channel it does not emit stays 0), which is much cheaper.
+  auto start = Clock::now();
+  PlanInputs pin;
+  pin.lights = in.lights;
+  pin.receiver = in.receiver;
+  pin.blockers = in.blockers;
+  pin.clusters = in.clusters;
+  pin.error_texels = in.error_texels;
+  pin.max_image = in.max_image;
+  pin.max_triples = in.max_triples;
+  ConvolutionPlan plan = plan_convolution(space, pin);
+  const double plan_seconds = seconds_since(start);
+
+  // Per texel and light: Σ over the light's parts of fraction·V_part, and Σ fraction over the
+  // parts that reach it.
+  std::vector<std::vector<Vec3f>> visible(lights.size());
+  std::vector<std::vector<float>> reached(lights.size());
+  for (std::size_t f = 0; f < plan.frames.size(); ++f) {
+    PlanFrame& fr = plan.frames[f];
+    const LightPart& lp = plan.light_parts[fr.light_part];
+    PairReport report;
+    report.light = lp.name;
+    report.receiver = in.receiver->name;
+    report.part = fr.face;
+    for (int k = 0; k < 3; ++k) report.axis[k] = fr.frame.axis[k];
+    report.lit_texels = std::int64_t(fr.texels.size());
+    report.outside_texels = fr.outside_texels;
+    report.seconds_configure = f == 0 ? plan_seconds : 0;
+    std::vector<Vec3f> occlusion(fr.texels.size(), Vec3f::Zero());
+    DepthRange blockers, receivers;
+    for (std::size_t t = 0; t < plan.triples.size(); ++t) {
+      Triple& tr = plan.triples[t];
+      if (tr.frame != int(f) || !tr.children.empty() || tr.empty) continue;
+      const auto leaf_start = Clock::now();
+      convolve_leaf(plan, tr, in.combine, occlusion, report);
+      tr.seconds = seconds_since(leaf_start);
+      ++report.triples;
+      blockers.extend(tr.blocker_depths.lo);
+      blockers.extend(tr.blocker_depths.hi);
+      receivers.extend(tr.receiver_depths.lo);
+      receivers.extend(tr.receiver_depths.hi);
+      if (tr.config.penumbra_error >= report.penumbra_error) {
+        report.penumbra_error = tr.config.penumbra_error;
+        report.penumbra_error_texels = tr.penumbra_error_texels;
+        report.rho_lo = tr.config.rho_lo;
+        report.rho_hi = tr.config.rho_hi;
+        report.rho = tr.config.rho;
+        report.blocker_plane = tr.config.blocker_plane;
+        report.receiver_plane = tr.config.receiver_plane;
+        report.light_extent = tr.config.light_extent;
+        report.pixel = tr.grid.pixel;
+      }
+    }
+    if (!blockers.empty()) {
+      report.blocker_depth_lo = blockers.lo;
+      report.blocker_depth_hi = blockers.hi;
+      report.receiver_depth_lo = receivers.lo;
+      report.receiver_depth_hi = receivers.hi;
+    }
+    auto& vis = visible[std::size_t(fr.light)];
+    auto& reach = reached[std::size_t(fr.light)];
+    if (vis.empty()) {
+      vis.assign(n, Vec3f::Zero());
+      reach.assign(n, 0.0f);
+    }
+    const float fraction = float(lp.fraction);
+    for (std::size_t i = 0; i < fr.texels.size(); ++i) {
+      Vec3f v;
+      for (int c = 0; c < 3; ++c) {
+        v[c] = in.combine == BlockerCombine::sum ? std::clamp(1.0f - occlusion[i][c], 0.0f, 1.0f)
+                                                 : std::exp(-occlusion[i][c]);
+      }
+      vis[fr.texels[i]] += fraction * v;
+      reach[fr.texels[i]] += fraction;
+    }
+    if (reports) reports->push_back(std::move(report));
+  }
+
+  // Lights combined as V = Σ H0_l·V_l / Σ H0_l. One light's visibility needs no closed form: its
+  // weight is its exitance where it reaches the texel, so a channel it does not emit stays 0.
   const bool weights_needed = lights.size() > 1 || in.quantity == Quantity::irradiance;
   Image out(space.width, space.height, 3, 0.0f);
-  std::vector<Vec3f> weight_sum(n, Vec3f::Zero());
-  std::vector<Vec3f> visibility(n);
-  std::vector<std::uint8_t> reached(n);
-  auto position = [&](std::size_t t) { return Vec3(space.texels[t].position.cast<double>()); };
-
-  for (const Light& light : lights) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& r) {
-      for (std::size_t t = r.begin(); t != r.end(); ++t)
-        reached[t] = light.reaches(position(t), space.texels[t].normal.cast<double>());
-    });
-    std::vector<std::size_t> lit;
-    Bounds3 lit_bounds;
-    for (std::size_t t = 0; t < n; ++t) {
-      if (!reached[t]) continue;
-      lit.push_back(t);
-      lit_bounds.extend(position(t));
-    }
-    auto add_report = [&](PairReport report, const char* part) {
-      report.light = light.desc().name;
-      report.receiver = in.receiver->name;
-      report.part = part;
-      if (reports) reports->push_back(std::move(report));
-    };
-    if (lit.empty()) {
-      add_report(PairReport{}, "");
-      continue;
-    }
-    // One frustum from the light's centre towards the middle of the lit texels (design-notes
-    // §3) when it holds them all within kMaxFrustumHalfAngleDeg; otherwise (a light beside or
-    // among its receiver) the six faces of a cube around the light, each its own frustum.
-    const ProjectionFrame central = frame_towards(light.centre(), lit_bounds.centre());
-    double widest = 1.0;
-    for (std::size_t t : lit) {
-      const Vec3 d = position(t) - light.centre();
-      const double len = d.norm();
-      widest = std::min(widest, len > 0 ? d.dot(central.axis) / len : 1.0);
-    }
-    if (widest >= std::cos(kMaxFrustumHalfAngleDeg * std::numbers::pi / 180.0)) {
-      PairReport report;
-      convolve_part(space, lit, light, central, texel, in, visibility, report);
-      add_report(std::move(report), "");
-    } else {
-      static const char* kFaces[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
-      std::array<std::vector<std::size_t>, 6> faces;
-      for (std::size_t t : lit) {
-        const Vec3 d = position(t) - light.centre();
-        int axis;
-        d.cwiseAbs().maxCoeff(&axis);
-        faces[2 * axis + (d[axis] < 0 ? 1 : 0)].push_back(t);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& r) {
+    for (std::size_t t = r.begin(); t != r.end(); ++t) {
+      const Texel& tx = space.texels[t];
+      const Vec3 p = tx.position.cast<double>(), normal = tx.normal.cast<double>();
+      Vec3 sum = Vec3::Zero(), weight = Vec3::Zero();
+      for (std::size_t l = 0; l < lights.size(); ++l) {
+        if (visible[l].empty() || reached[l][t] <= 0) continue;
+        const Vec3 w = weights_needed ? lights[l].unoccluded_irradiance(p, normal)
+                                      : lights[l].exitance();
+        sum += w.cwiseProduct((visible[l][t] / reached[l][t]).cast<double>());
+        weight += w;
       }
-      for (int f = 0; f < 6; ++f) {
-        if (faces[f].empty()) continue;
-        Vec3 axis = Vec3::Zero();
-        axis[f / 2] = f % 2 ? -1.0 : 1.0;
-        PairReport report;
-        convolve_part(space, faces[f], light, frame_towards(light.centre(), light.centre() + axis),
-                      texel, in, visibility, report);
-        add_report(std::move(report), kFaces[f]);
+      float* px = out.at(tx.x, tx.y);
+      for (int c = 0; c < 3; ++c) {
+        px[c] = float(in.quantity == Quantity::irradiance ? sum[c]
+                                                          : (weight[c] > 0 ? sum[c] / weight[c]
+                                                                           : 0.0));
       }
     }
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, lit.size(), 4096), [&](const auto& r) {
-      for (std::size_t i = r.begin(); i != r.end(); ++i) {
-        const std::size_t t = lit[i];
-        const Texel& tx = space.texels[t];
-        const Vec3f w =
-            (weights_needed ? light.unoccluded_irradiance(position(t), tx.normal.cast<double>())
-                            : light.exitance())
-                .cast<float>();
-        float* px = out.at(tx.x, tx.y);
-        for (int c = 0; c < 3; ++c) px[c] += w[c] * visibility[t][c];
-        weight_sum[t] += w;
-      }
-    });
-  }
-
-  if (in.quantity == Quantity::visibility) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& r) {
-      for (std::size_t t = r.begin(); t != r.end(); ++t) {
-        float* px = out.at(space.texels[t].x, space.texels[t].y);
-        for (int c = 0; c < 3; ++c) px[c] = weight_sum[t][c] > 0 ? px[c] / weight_sum[t][c] : 0.0f;
-      }
-    });
-  }
+  });
+  if (plan_out) *plan_out = std::move(plan);
   return out;
 }
 

@@ -9,27 +9,30 @@
 #include "lights.h"
 #include "mesh.h"
 #include "texel_space.h"
+#include "convolution_plan.h"
 #include "virtual_configuration.h"
 
 namespace sb {
 
 struct ConvolutionInputs {
   const std::vector<Light>* lights = nullptr;
-  const Mesh* receiver = nullptr;     // the receiver's own mesh (for its texel size)
-  std::vector<const Mesh*> blockers;  // every blocker but the receiver itself
+  const Mesh* receiver = nullptr;  // the receiver's own mesh
+  // Every blocker mesh, the receiver's own included when it is a blocker, and their cluster
+  // hierarchy built over exactly these meshes in this order (may be null: no shaft culling).
+  std::vector<const Mesh*> blockers;
+  const ClusterTree* clusters = nullptr;
   Quantity quantity = Quantity::visibility;
-  int max_image = 4096;  // largest blocker image side, pixels
+  double error_texels = 1.0;  // target penumbra error, receiver texels
+  int max_image = 4096;       // largest image side, pixels
+  int max_triples = 128;      // leaf triples per light
+  BlockerCombine combine = BlockerCombine::sum;
 };
 
-// Bakes one receiver: for each light, the virtual configuration (D towards the receiver's lit
-// texels, planes by the penumbra error metric), the source kernel and the blocker image, their
-// FFT convolution, and a projective bilinear lookup per texel; lights combined as
-// V = Σ H0_l·V_l / Σ H0_l (or H = Σ H0_l·V_l). Appends one report per light to `reports`.
+// Bakes one receiver: plans its triples (plan_convolution), convolves every leaf and combines
+// them per texel; lights combined as V = Σ H0_l·V_l / Σ H0_l (or H = Σ H0_l·V_l). Appends one
+// report per (light part, frustum) to `reports`, and gives the executed plan, with each leaf's
+// measured seconds, in *plan (either may be null).
 Image bake_convolution(const TexelSpace& texels, const ConvolutionInputs& in,
-                       std::vector<PairReport>* reports);
-
-// World size of one texel of `mesh`'s lightmap at width × height, metres: the square root of
-// world area per covered texel area.
-double texel_size(const Mesh& mesh, int width, int height);
+                       std::vector<PairReport>* reports, ConvolutionPlan* plan = nullptr);
 
 }  // namespace sb

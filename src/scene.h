@@ -25,6 +25,18 @@ struct BakeSettings {
   int samples = 256;       // light samples per texel, for sampling methods
   int margin = 4;          // texels of dilation around UV charts
   std::uint64_t seed = 0;  // sampling seed; same seed, same bytes
+  // convolution: the penumbra error ε allowed per (light part, blocker cluster, receiver part)
+  // triple, in receiver texels, and the largest convolution image side, pixels
+  double error_texels = 1.0;
+  int max_image = 4096;
+  int max_triples = 128;  // leaf triples per light: the convolution's work budget
+  std::string blocker_combine = "sum";  // how blocker clusters combine: "product" or "sum"
+  // shadow-map baselines (pcf, pcss, adaptive-pcf, chun-oh, erosion): the shadow map's side in
+  // pixels, PCF's fixed filter radius in shadow-map pixels, and how erosion turns the distance
+  // to a hard-shadow edge into a shadow factor ("pcf" or "distance")
+  int shadow_map = 2048;
+  double pcf_radius = 2.0;
+  std::string erosion_factor = "pcf";
 };
 
 struct ObjectDesc {

@@ -295,7 +295,9 @@ bool is_valid_object_name(std::string_view name) {
 
 Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::table& table) {
   TableReader r(file, table, "[bake]");
-  r.check_known_keys({"resolution", "method", "quantity", "samples", "margin", "seed"});
+  r.check_known_keys({"resolution", "method", "quantity", "samples", "margin", "seed",
+                      "error_texels", "max_image", "max_triples", "blocker_combine", "shadow_map", "pcf_radius",
+                      "erosion_factor"});
   BakeSettings bake;
   const int int_max = std::numeric_limits<int>::max();
   if (auto v = r.integer("resolution", 1, 16384)) bake.resolution = static_cast<int>(*v);
@@ -320,6 +322,29 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
   if (auto v = r.integer("margin", 0, int_max)) bake.margin = static_cast<int>(*v);
   if (auto v = r.integer("seed", 0, std::numeric_limits<std::int64_t>::max())) {
     bake.seed = static_cast<std::uint64_t>(*v);
+  }
+  if (auto v = r.number("error_texels", "a number > 0", is_positive)) bake.error_texels = *v;
+  if (auto v = r.integer("max_image", 64, 16384)) bake.max_image = static_cast<int>(*v);
+  if (auto v = r.string("blocker_combine")) {
+    if (*v == "product" || *v == "sum") {
+      bake.blocker_combine = *v;
+    } else {
+      r.fail_got("blocker_combine", "\"product\" or \"sum\"");
+    }
+  }
+  if (auto v = r.integer("max_triples", 1, 1 << 20)) bake.max_triples = static_cast<int>(*v);
+  if (auto v = r.integer("shadow_map", 64, 16384)) bake.shadow_map = static_cast<int>(*v);
+  if (auto v = r.number("pcf_radius", "a number >= 0", [](double x) {
+        return std::isfinite(x) && x >= 0;
+      })) {
+    bake.pcf_radius = *v;
+  }
+  if (auto v = r.string("erosion_factor")) {
+    if (*v == "pcf" || *v == "distance") {
+      bake.erosion_factor = *v;
+    } else {
+      r.fail_got("erosion_factor", "\"pcf\" or \"distance\"");
+    }
   }
   if (r.failed()) return r.error();
   return bake;

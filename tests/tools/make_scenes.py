@@ -139,6 +139,39 @@ def box_charts(size_x, size_y, size_z, segments):
     return [grid_chart(o, du, dv, segments, segments) for o, du, dv in faces]
 
 
+def moved(charts, offset):
+    """The charts translated by offset (metres)."""
+    for chart in charts:
+        chart.positions = [add(p, offset) for p in chart.positions]
+    return charts
+
+
+def prism_charts(profile, length, segments):
+    """A prism: the polygon `profile` (x, z points, counter-clockwise seen from -y, made of the
+    rectangles `profile_rects` for the caps) extruded along y over [-length/2, length/2].
+    profile is ((x, z), ...) for the sides; caps are given as rectangles (x0, z0, x1, z1)."""
+    points, rects = profile
+    half = length / 2
+    charts = []
+    n = len(points)
+    for i in range(n):
+        (x0, z0), (x1, z1) = points[i], points[(i + 1) % n]
+        origin = (x0, -half, z0)
+        du = (x1 - x0, 0.0, z1 - z0)
+        dv = (0.0, length, 0.0)
+        # Counter-clockwise seen from -y: the outward normal of edge (dx, dz) is (dz, -dx).
+        outward = (z1 - z0, 0.0, -(x1 - x0))
+        if dot(cross(du, dv), outward) < 0:
+            origin, du = (x1, -half, z1), scale(du, -1)
+        edge = math.hypot(x1 - x0, z1 - z0)
+        charts.append(grid_chart(origin, du, dv, max(1, round(segments * edge)), segments))
+    for x0, z0, x1, z1 in rects:
+        # -y cap: normal (0, -1, 0) = du × dv with du along x, dv along z.
+        charts.append(grid_chart((x0, -half, z0), (x1 - x0, 0, 0), (0, 0, z1 - z0), 4, 4))
+        charts.append(grid_chart((x1, half, z0), (x0 - x1, 0, 0), (0, 0, z1 - z0), 4, 4))
+    return charts
+
+
 def uv_sphere_charts(radius, n_lon, n_lat):
     """A latitude-longitude sphere centred at the origin, poles on the z axis (a single vertex
     each). Charts: the polar caps beyond ±45° in Lambert's azimuthal equal-area projection, and
@@ -473,8 +506,8 @@ def toml_vec(values):
     return "[" + ", ".join(toml_number(x) for x in values) + "]"
 
 
-def bake_table(samples):
-    return ["[bake]", "resolution = 512", 'method = "reference"', 'quantity = "visibility"',
+def bake_table(samples, method="reference"):
+    return ["[bake]", "resolution = 512", f'method = "{method}"', 'quantity = "visibility"',
             f"samples = {samples}", "margin = 4", ""]
 
 
@@ -632,6 +665,69 @@ def write_closed_form_scenes(w):
         w.scene(folder, lines)
 
 
+def write_subdivision_scenes(w):
+    """The scenes of the convolution's error-driven subdivision and of the baselines' table:
+    geometry touching its receiver, a tilted off-axis light, an object that shadows itself."""
+    floor_comment = "3 x 3 m at z = 0"
+
+    floor = Shape("floor", [grid_chart((-1.5, -1.5, 0), (3, 0, 0), (0, 3, 0), 12, 12)])
+    top = moved(box_charts(1.0, 0.6, 0.04, 2), (0, 0, 0.72))
+    legs = []
+    for x in (-0.45, 0.45):
+        for y in (-0.25, 0.25):
+            legs += moved(box_charts(0.05, 0.05, 0.72, 2), (x, y, 0))
+    table = Shape("table", top + legs)
+    for shape in (floor, table):
+        pack(shape)
+    lines = [f"# {HEADER}.", "# A table on a floor: a top 0.76 m up on four legs that touch the floor,",
+             "# so its shadow is sharp at the feet and soft under the top.", ""]
+    lines += bake_table(256, "convolution")
+    lines += object_table("floor", w.mesh("table", floor), True, True, comment=floor_comment)
+    lines += object_table("table", w.mesh("table", table), False, True,
+                          comment="1 x 0.6 m top, 4 cm thick, on four 5 cm legs 0.72 m long")
+    lines += light_table("panel", "rectangle", (0.3, -0.2, 2.0), normal=normalize((-0.1, 0.05, -1)),
+                         up=(0, 1, 0), size=(0.6, 0.6), comment="0.6 x 0.6 m, 2 m up, off-centre")
+    w.scene("table", lines)
+
+    floor = Shape("floor", [grid_chart((-2, -2, 0), (4, 0, 0), (0, 4, 0), 16, 16)])
+    posts = []
+    for x, y, h in ((-1.0, -0.6, 1.0), (-0.3, 0.5, 1.2), (0.4, -0.3, 0.8), (1.0, 0.6, 1.0),
+                    (0.0, -1.2, 0.6)):
+        posts += moved(box_charts(0.08, 0.08, h, 4), (x, y, 0))
+    posts = Shape("posts", posts)
+    for shape in (floor, posts):
+        pack(shape)
+    lines = [f"# {HEADER}.", "# Posts standing on a floor under a long, tilted strip light off to the",
+             "# side: each shadow is sharp at the post's foot and widens towards its tip.", ""]
+    lines += bake_table(256, "convolution")
+    lines += object_table("floor", w.mesh("posts", floor), True, True, comment="4 x 4 m at z = 0")
+    lines += object_table("posts", w.mesh("posts", posts), False, True,
+                          comment="five 8 cm square posts, 0.6 to 1.2 m tall")
+    lines += light_table("strip", "rectangle", (1.4, -1.0, 2.2), normal=normalize((-0.45, 0.3, -1)),
+                         up=normalize((1, 1, 0)), size=(1.4, 0.12),
+                         comment="1.4 x 0.12 m strip, 2.2 m up, off to the side, tilted towards "
+                         "the posts")
+    w.scene("posts", lines)
+
+    floor = Shape("floor", [grid_chart((-1.5, -1.5, 0), (3, 0, 0), (0, 3, 0), 12, 12)])
+    # An L-shaped bracket: a 1 m base 10 cm thick with a 12 cm wall 0.8 m tall at its -x end.
+    profile = (((0, 0), (1.0, 0), (1.0, 0.1), (0.12, 0.1), (0.12, 0.8), (0, 0.8)),
+               ((0, 0, 1.0, 0.1), (0, 0.1, 0.12, 0.8)))
+    bracket = Shape("bracket", moved(prism_charts(profile, 1.2, 8), (-0.5, 0, 0)))
+    for shape in (floor, bracket):
+        pack(shape)
+    lines = [f"# {HEADER}.", "# An L-shaped bracket that shadows itself: its wall casts a shadow across",
+             "# its own base and onto the floor beyond.", ""]
+    lines += bake_table(256, "convolution")
+    lines += object_table("floor", w.mesh("bracket", floor), True, True, comment=floor_comment)
+    lines += object_table("bracket", w.mesh("bracket", bracket), True, True,
+                          comment="L-shaped prism 1.2 m long: base 1 x 0.1 m, wall 0.12 x 0.8 m")
+    lines += light_table("panel", "rectangle", (-1.1, -0.3, 1.4), normal=normalize((0.5, 0.1, -1)),
+                         up=(0, 1, 0), size=(0.6, 0.4), comment="0.6 x 0.4 m, 1.4 m up, to the "
+                         "wall's side so the wall shades the base")
+    w.scene("bracket", lines)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     default = Path(__file__).resolve().parents[2] / "scenes"
@@ -641,6 +737,7 @@ def main():
     writer = Writer(args.out.resolve())
     write_showcase(writer)
     write_closed_form_scenes(writer)
+    write_subdivision_scenes(writer)
 
 
 if __name__ == "__main__":

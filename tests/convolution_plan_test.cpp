@@ -1,0 +1,248 @@
+// The convolution's error-driven hierarchy (convolution_plan.cpp): the exact case needs one
+// triple, the worst penumbra error falls as the target falls, clusters' nearest-layer images
+// partition the hard shadow, and on the subdivision scenes (table, posts, bracket) the bake
+// stays close to the reference, shadows itself and hardens at contact.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "bake.h"
+#include "blocker_image.h"
+#include "clusters.h"
+#include "convolution_plan.h"
+#include "mesh.h"
+#include "texel_space.h"
+
+namespace sb {
+namespace {
+
+Scene load(const std::string& name, int resolution, const std::string& method) {
+  auto scene = load_scene(std::string(SB_SOURCE_DIR) + "/scenes/" + name + "/scene.toml");
+  EXPECT_TRUE(scene) << scene.error().message;
+  scene->bake.resolution = resolution;
+  scene->bake.method = method;
+  scene->bake.margin = 0;
+  return *scene;
+}
+
+// The plan of the scene's first receiver, with everything it points into kept alive.
+struct Planned {
+  std::vector<Mesh> meshes;
+  std::vector<const Mesh*> blockers;
+  ClusterTree clusters;
+  std::vector<Light> lights;
+  TexelSpace space;
+  ConvolutionPlan plan;
+};
+
+std::unique_ptr<Planned> plan_scene(const Scene& scene) {
+  auto p = std::make_unique<Planned>();
+  for (const auto& obj : scene.objects) p->meshes.push_back(*import_mesh(obj, scene.file));
+  for (std::size_t i = 0; i < p->meshes.size(); ++i)
+    if (scene.objects[i].blocker) p->blockers.push_back(&p->meshes[i]);
+  p->clusters = build_clusters(p->blockers);
+  p->lights = *make_lights(scene.lights, scene.file);
+  std::size_t receiver = 0;
+  while (!scene.objects[receiver].receiver) ++receiver;
+  p->space = rasterise_texels(p->meshes[receiver], scene.bake.resolution, scene.bake.resolution);
+  PlanInputs in;
+  in.lights = &p->lights;
+  in.receiver = &p->meshes[receiver];
+  in.blockers = p->blockers;
+  in.clusters = &p->clusters;
+  in.error_texels = scene.bake.error_texels;
+  in.max_triples = scene.bake.max_triples;
+  p->plan = plan_convolution(p->space, in);
+  return p;
+}
+
+double rmse(const ReceiverBake& a, const ReceiverBake& b) {
+  double sq = 0;
+  std::int64_t n = 0;
+  for (std::size_t i = 0; i < a.covered.size(); ++i) {
+    if (!a.covered[i]) continue;
+    const double d = a.image.pixels[3 * i] - b.image.pixels[3 * i];
+    sq += d * d;
+    ++n;
+  }
+  return std::sqrt(sq / double(std::max<std::int64_t>(n, 1)));
+}
+
+TEST(ConvolutionPlan, ExactCaseNeedsOneTriple) {
+  const auto p = plan_scene(load("parallel", 256, "convolution"));
+  EXPECT_EQ(p->plan.leaves().size(), 1u) << describe_plan(p->plan);
+  EXPECT_NEAR(p->plan.worst_error_texels(), 0.0, 1e-9);
+  EXPECT_TRUE(p->plan.warnings.empty());
+}
+
+TEST(ConvolutionPlan, WorstErrorFallsAsTheTargetFalls) {
+  Scene scene = load("posts", 128, "convolution");
+  double previous = std::numeric_limits<double>::infinity();
+  std::size_t previous_leaves = 0;
+  for (const double target : {32.0, 8.0, 2.0}) {
+    scene.bake.error_texels = target;
+    const auto p = plan_scene(scene);
+    const double worst = p->plan.worst_error_texels();
+    std::printf("posts 128^2, error_texels %.0f: %zu leaves, worst eps %.2f texels\n", target,
+                p->plan.leaves().size(), worst);
+    EXPECT_LT(worst, previous);
+    EXPECT_GT(p->plan.leaves().size(), previous_leaves);
+    if (p->plan.warnings.empty()) {
+      EXPECT_LE(worst, target);
+    }
+    previous = worst;
+    previous_leaves = p->plan.leaves().size();
+  }
+  // The text a user reads names every split kind it used and the leaves' image sizes.
+  const std::string text = describe_plan(plan_scene(scene)->plan);
+  EXPECT_NE(text.find("blocker depth"), std::string::npos);
+  EXPECT_NE(text.find("image "), std::string::npos);
+}
+
+// Two clusters of one layer (near and far slabs of the same geometry) cover disjoint parts of the
+// tangent plane that add up to the whole layer's hard shadow.
+TEST(ConvolutionPlan, NearestLayersPartitionTheHardShadow) {
+  const auto p = plan_scene(load("table", 128, "convolution"));
+  const Triple* root = nullptr;
+  for (int r : p->plan.frames[0].roots)
+    if (!p->plan.triples[std::size_t(r)].empty) root = &p->plan.triples[std::size_t(r)];
+  ASSERT_NE(root, nullptr);
+  const ProjectedBlockers& layer = *root->layer;
+  const double mid = root->blocker_depths.mid();
+  std::vector<std::uint8_t> all(layer.polygons.size(), 1);
+  TangentGrid grid = root->grid;
+  const auto whole = nearest_layer_coverage(layer, all, 0, 1e9, grid);
+  const auto near = nearest_layer_coverage(layer, all, 0, mid, grid);
+  const auto far = nearest_layer_coverage(layer, all, mid, 1e9, grid);
+  const auto union_cov = blocker_coverage(layer, grid);
+  double worst = 0, covered = 0;
+  for (std::size_t i = 0; i < whole.size(); ++i) {
+    worst = std::max(worst, double(std::abs(near[i] + far[i] - whole[i])));
+    worst = std::max(worst, double(std::abs(whole[i] - union_cov[i])));
+    covered += whole[i];
+  }
+  EXPECT_GT(covered, 100.0);
+  EXPECT_LE(worst, 1e-6);
+}
+
+// The acceptance figures of docs/methods.md, at 128² to stay fast: RMSE against a 256-sample
+// reference on the three subdivision scenes, with the tolerance set from the measured values
+// (table 0.016, posts 0.041, bracket floor 0.057 and bracket 0.035 at 128² when written) plus a
+// margin.
+TEST(ConvolutionPlan, SubdivisionScenesAgainstReference) {
+  struct Case {
+    const char* scene;
+    double tolerance;
+  };
+  for (const Case c : {Case{"table", 0.02}, Case{"posts", 0.045}, Case{"bracket", 0.08}}) {
+    Scene conv = load(c.scene, 128, "convolution");
+    Scene ref = load(c.scene, 128, "reference");
+    ref.bake.samples = 256;
+    auto a = bake(conv), b = bake(ref);
+    ASSERT_TRUE(a && b);
+    for (std::size_t r = 0; r < a->receivers.size(); ++r) {
+      const double e = rmse(a->receivers[r], b->receivers[r]);
+      std::printf("%s/%s 128^2: convolution vs reference RMSE %.4f\n", c.scene,
+                  a->receivers[r].name.c_str(), e);
+      EXPECT_LE(e, c.tolerance) << c.scene << "/" << a->receivers[r].name;
+    }
+  }
+}
+
+// The bracket's wall shades its own base: texels of the base's top face far from the wall are
+// lit, those beside it darker, in the convolution as in the reference.
+TEST(ConvolutionPlan, ObjectShadowsItself) {
+  Scene conv = load("bracket", 128, "convolution");
+  Scene ref = load("bracket", 128, "reference");
+  ref.bake.samples = 128;
+  auto a = bake(conv), b = bake(ref);
+  ASSERT_TRUE(a && b);
+  const ReceiverBake& ca = a->receivers[1];
+  const ReceiverBake& rb = b->receivers[1];
+  ASSERT_EQ(ca.name, "bracket");
+  // Mean visibility over covered texels that the reference puts in shadow (< 0.3).
+  double conv_sum = 0, n = 0;
+  for (std::size_t i = 0; i < ca.covered.size(); ++i) {
+    if (!ca.covered[i] || rb.image.pixels[3 * i] >= 0.3 || rb.image.pixels[3 * i] <= 0) continue;
+    conv_sum += ca.image.pixels[3 * i];
+    ++n;
+  }
+  ASSERT_GT(n, 200);
+  EXPECT_LT(conv_sum / n, 0.35) << "the bracket's self-shadow is missing";
+}
+
+// Contact hardening: a post standing on the floor casts a shadow whose penumbra is sharp at the
+// post's foot and widens towards the tip of its shadow, as in the reference, to within two
+// texels from 0.2 m past the foot (the issue's acceptance test; nearer the foot see below).
+// 10–90 % widths across the shadow, at 512², with a 512-triple budget.
+TEST(ConvolutionPlan, PostShadowHardensAtContact) {
+  const auto dir = std::filesystem::temp_directory_path() / "sb_contact_hardening";
+  std::filesystem::create_directories(dir);
+  {
+    // An 8 cm square post 1 m tall standing at x = 0.2 on the 2 x 2 m floor of scenes/parallel.
+    std::ofstream obj(dir / "post.obj");
+    const double a = 0.04, x0 = 0.2, h = 1.0;
+    for (int i = 0; i < 8; ++i)
+      obj << "v " << x0 + (i & 1 ? a : -a) << " " << (i & 2 ? a : -a) << " " << (i & 4 ? h : 0)
+          << "\n";
+    const int quads[6][4] = {{1, 3, 4, 2}, {5, 6, 8, 7}, {1, 2, 6, 5},
+                             {3, 7, 8, 4}, {1, 5, 7, 3}, {2, 4, 8, 6}};
+    for (const auto& q : quads)
+      obj << "f " << q[0] << " " << q[1] << " " << q[2] << "\nf " << q[0] << " " << q[2] << " "
+          << q[3] << "\n";
+    std::ofstream toml(dir / "scene.toml");
+    toml << "[bake]\nresolution = 512\nmargin = 0\nmax_triples = 512\n"
+         << "[[object]]\nname = \"floor\"\nmesh = \"" << SB_SOURCE_DIR
+         << "/scenes/parallel/floor.obj\"\nblocker = true\n"
+         << "[[object]]\nname = \"post\"\nmesh = \"post.obj\"\nreceiver = false\n"
+         << "[[light]]\nname = \"panel\"\nshape = \"rectangle\"\nposition = [-0.3, 0, 2]\n"
+         << "normal = [0, 0, -1]\nsize = [0.4, 0.4]\npower = 100\n";
+  }
+  auto scene = load_scene(dir / "scene.toml");
+  ASSERT_TRUE(scene) << scene.error().message;
+  Scene ref = *scene;
+  ref.bake.method = "reference";
+  ref.bake.samples = 256;
+  auto a = bake(*scene), b = bake(ref);
+  ASSERT_TRUE(a && b);
+  const Image& ci = a->receivers[0].image;
+  const Image& ri = b->receivers[0].image;
+  const int n = ci.width;
+  const double texel = 2.0 / n;
+  // Width of the penumbra across the shadow (along y) at floor x: the distance between the
+  // 10 % and 90 % crossings on the +y side, linearly interpolated, in texels.
+  auto width_at = [&](const Image& img, double x) {
+    const int i = int((x + 1) / 2 * n);
+    auto v = [&](int j) { return double(img.at(i, j)[0]); };
+    auto crossing = [&](double level) {
+      for (int j = n / 2; j > 0; --j)  // row 0 is v = 1, i.e. y = +1: walk towards +y
+        if (v(j) < level && v(j - 1) >= level) return j - (level - v(j)) / (v(j - 1) - v(j));
+      return double(n / 2);
+    };
+    return std::abs(crossing(0.9) - crossing(0.1));
+  };
+  // The shadow of the post runs in +x from its foot at x = 0.24 to its tip's image at
+  // x = 0.2 + 0.5 · 1/1 ≈ 0.7.
+  double previous = 0;
+  for (const double x : {0.3, 0.45, 0.6}) {
+    const double wc = width_at(ci, x), wr = width_at(ri, x);
+    std::printf("post shadow at x = %.2f m: penumbra %.1f texels (convolution), %.1f (reference)\n",
+                x, wc, wr);
+    // Known gap (docs/methods.md): within ~0.1 m of the foot the convolution's penumbra is
+    // about 8 texels too wide (28 against 20 at x = 0.3); further out it is within 2 texels.
+    if (x >= 0.45) {
+      EXPECT_NEAR(wc, wr, 2.0) << "at x = " << x;
+    } else {
+      EXPECT_NEAR(wc, wr, 10.0) << "at x = " << x;
+    }
+    EXPECT_GT(wc, previous) << "the penumbra must widen away from the post's foot";
+    previous = wc;
+  }
+  (void)texel;
+}
+
+}  // namespace
+}  // namespace sb
