@@ -29,6 +29,36 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+// Every object's mesh, in scene order; skipped degenerate triangles become warnings.
+Expected<std::vector<Mesh>> load_meshes(const Scene& scene, std::vector<std::string>* warnings) {
+  std::vector<Mesh> meshes;
+  meshes.reserve(scene.objects.size());
+  for (const auto& obj : scene.objects) {
+    auto mesh = import_mesh(obj, scene.file);
+    if (!mesh) return mesh.error();
+    if (mesh->skipped_degenerate > 0 && warnings) {
+      warnings->push_back(scene.file.string() + ":" + std::to_string(obj.line) + ": object '" +
+                          obj.name + "': skipped " + std::to_string(mesh->skipped_degenerate) +
+                          " degenerate (zero-area) triangles");
+    }
+    meshes.push_back(std::move(*mesh));
+  }
+  return meshes;
+}
+
+std::vector<const Mesh*> blocker_meshes(const Scene& scene, const std::vector<Mesh>& meshes) {
+  std::vector<const Mesh*> blockers;
+  for (std::size_t i = 0; i < meshes.size(); ++i)
+    if (scene.objects[i].blocker) blockers.push_back(&meshes[i]);
+  return blockers;
+}
+
+std::unique_ptr<tbb::global_control> limit_threads(const BakeOptions& options) {
+  if (options.threads <= 0) return nullptr;
+  return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                               std::size_t(options.threads));
+}
+
 }  // namespace
 
 Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
@@ -39,36 +69,22 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     return scene_error(scene.file.string() + ": [bake]: unknown method '" + scene.bake.method +
                        "' (known: " + known + ")");
   }
-  std::unique_ptr<tbb::global_control> thread_limit;
-  if (options.threads > 0) {
-    thread_limit = std::make_unique<tbb::global_control>(
-        tbb::global_control::max_allowed_parallelism, std::size_t(options.threads));
-  }
+  const auto thread_limit = limit_threads(options);
   FftConvolver::shared().set_threads(options.threads > 0
                                          ? options.threads
                                          : int(std::max(1u, std::thread::hardware_concurrency())));
 
   BakeResult result;
   const auto load_start = std::chrono::steady_clock::now();
-  std::vector<Mesh> meshes;
-  meshes.reserve(scene.objects.size());
-  for (const auto& obj : scene.objects) {
-    auto mesh = import_mesh(obj, scene.file);
-    if (!mesh) return mesh.error();
-    if (mesh->skipped_degenerate > 0) {
-      result.warnings.push_back(scene.file.string() + ":" + std::to_string(obj.line) +
-                                ": object '" + obj.name + "': skipped " +
-                                std::to_string(mesh->skipped_degenerate) +
-                                " degenerate (zero-area) triangles");
-    }
-    meshes.push_back(std::move(*mesh));
-  }
-  std::vector<const Mesh*> blockers;
-  for (std::size_t i = 0; i < meshes.size(); ++i)
-    if (scene.objects[i].blocker) blockers.push_back(&meshes[i]);
-  // Every method but the convolution casts rays: the reference and accumulation for their
-  // shadows, the shadow-map baselines where they need an exact hard shadow or blocker distance.
-  const bool ray_traced = scene.bake.method != "convolution";
+  auto loaded = load_meshes(scene, &result.warnings);
+  if (!loaded) return loaded.error();
+  const std::vector<Mesh>& meshes = *loaded;
+  const std::vector<const Mesh*> blockers = blocker_meshes(scene, meshes);
+  // The methods that cast rays: the reference and accumulation for their shadows, erosion for
+  // its hard shadow and blocker distances. The convolution and the shadow-map filters do not.
+  const std::string& method = scene.bake.method;
+  const bool ray_traced =
+      method == "reference" || method == "accumulation" || method == "erosion";
   std::optional<RayScene> rays;
   if (ray_traced) {
     auto built = RayScene::build(blockers);
@@ -77,7 +93,7 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   }
   // The convolution's cluster hierarchy (clusters.h), over the blockers in this order.
   ClusterTree clusters;
-  if (scene.bake.method == "convolution") clusters = build_clusters(blockers);
+  if (method == "convolution") clusters = build_clusters(blockers);
   auto lights_or = make_lights(scene.lights, scene.file);
   if (!lights_or) return lights_or.error();
   const std::vector<Light>& lights = *lights_or;
@@ -112,25 +128,24 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     out.seconds_texels = raster_seconds[r];
     out.name = obj.name;
     out.uv_channel = obj.uv_channel;
-    if (scene.bake.method != "convolution" && scene.bake.method != "reference") {
+    if (method != "convolution" && method != "reference") {
       BaselineInputs in;
       in.lights = &lights;
-      in.rays = &*rays;
+      in.rays = rays ? &*rays : nullptr;
       in.blockers = blockers;
       in.receiver = &meshes[receivers[r]];
       in.settings = &scene.bake;
       in.stream = receivers[r];
-      const std::string& m = scene.bake.method;
-      if (m == "accumulation") {
+      if (method == "accumulation") {
         out.image = bake_accumulation(spaces[r], in, &out.stats, &result.shadow_rays);
-      } else if (m == "erosion") {
+      } else if (method == "erosion") {
         out.image = bake_erosion(spaces[r], in, &out.stats, &result.shadow_rays);
       } else {
         out.image = bake_shadow_map_filter(spaces[r], in, &out.stats);
       }
       texels_done += std::int64_t(spaces[r].texels.size());
       if (progress) progress(double(texels_done.load()));
-    } else if (ray_traced) {
+    } else if (method == "reference") {
       ReferenceInputs in;
       in.lights = &lights;
       in.rays = &*rays;
@@ -175,21 +190,11 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
 }
 
 Expected<std::vector<std::string>> plan(const Scene& scene, const BakeOptions& options) {
-  std::unique_ptr<tbb::global_control> thread_limit;
-  if (options.threads > 0) {
-    thread_limit = std::make_unique<tbb::global_control>(
-        tbb::global_control::max_allowed_parallelism, std::size_t(options.threads));
-  }
-  std::vector<Mesh> meshes;
-  meshes.reserve(scene.objects.size());
-  for (const auto& obj : scene.objects) {
-    auto mesh = import_mesh(obj, scene.file);
-    if (!mesh) return mesh.error();
-    meshes.push_back(std::move(*mesh));
-  }
-  std::vector<const Mesh*> blockers;
-  for (std::size_t i = 0; i < meshes.size(); ++i)
-    if (scene.objects[i].blocker) blockers.push_back(&meshes[i]);
+  const auto thread_limit = limit_threads(options);
+  auto loaded = load_meshes(scene, nullptr);
+  if (!loaded) return loaded.error();
+  const std::vector<Mesh>& meshes = *loaded;
+  const std::vector<const Mesh*> blockers = blocker_meshes(scene, meshes);
   const ClusterTree clusters = build_clusters(blockers);
   auto lights = make_lights(scene.lights, scene.file);
   if (!lights) return lights.error();

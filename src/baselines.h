@@ -21,7 +21,9 @@ namespace sb {
 
 struct BaselineInputs {
   const std::vector<Light>* lights = nullptr;
-  const RayScene* rays = nullptr;     // every blocker, for ray-cast hard shadows
+  // Every blocker, for ray-cast hard shadows: accumulation and erosion only (null for the
+  // shadow-map filters, which need none).
+  const RayScene* rays = nullptr;
   std::vector<const Mesh*> blockers;  // every blocker mesh, the receiver's own if it blocks
   const Mesh* receiver = nullptr;
   const BakeSettings* settings = nullptr;  // method, quantity, samples, seed, shadow_map, ...

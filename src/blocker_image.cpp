@@ -46,7 +46,43 @@ struct Edges {
       lines.emplace_back(n.x(), n.y(), -n.dot(p));
     }
   }
+  bool contains(double px, double py) const {
+    for (const Vec3& e : lines)
+      if (e.x() * px + e.y() * py + e.z() < 0) return false;
+    return true;
+  }
+  // Pixel [x, x+1] × [y, y+1] from its corners: −1 wholly outside one edge, +1 wholly inside
+  // every edge, 0 straddling (needs samples).
+  int classify(int x, int y) const {
+    bool all_inside = true;
+    for (const Vec3& e : lines) {
+      const double c00 = e.x() * x + e.y() * y + e.z();
+      const double c10 = c00 + e.x(), c01 = c00 + e.y(), c11 = c10 + e.y();
+      if (std::max(std::max(c00, c10), std::max(c01, c11)) < 0) return -1;
+      if (std::min(std::min(c00, c10), std::min(c01, c11)) < 0) all_inside = false;
+    }
+    return all_inside ? 1 : 0;
+  }
 };
+
+// A projected polygon in pixel units of a grid (pixel (i, j) spans [i, i+1] × [j, j+1]) with the
+// pixels its bounding box covers; false when it misses the grid.
+struct PixelPolygon {
+  Edges edges;
+  int x0, x1, y0, y1;
+};
+
+bool to_pixels(const ProjectedBlockers::Polygon& pg, const TangentGrid& grid, PixelPolygon* out) {
+  const Vec2 lo = (pg.lo - grid.origin) / grid.pixel, hi = (pg.hi - grid.origin) / grid.pixel;
+  const int x0 = std::max(0, int(std::floor(lo.x()))), x1 = std::min(grid.width - 1, int(hi.x()));
+  const int y0 = std::max(0, int(std::floor(lo.y()))), y1 = std::min(grid.height - 1, int(hi.y()));
+  if (x0 > x1 || y0 > y1) return false;
+  std::vector<Vec2> pts;
+  pts.reserve(pg.points.size());
+  for (const Vec2& p : pg.points) pts.push_back((p - grid.origin) / grid.pixel);
+  *out = PixelPolygon{Edges(pts), x0, x1, y0, y1};
+  return true;
+}
 
 }  // namespace
 
@@ -117,51 +153,27 @@ ProjectedBlockers project_faces(const std::vector<FaceRef>& faces, const Project
   return out;
 }
 
-ProjectedBlockers project_blockers(const std::vector<const Mesh*>& blockers,
-                                   const ProjectionFrame& frame, double near, double far,
-                                   const ShadowCaster& caster) {
-  std::vector<FaceRef> faces;
-  for (const Mesh* m : blockers)
-    for (auto f : m->mesh.faces()) faces.push_back({m, f.idx()});
-  return project_faces(faces, frame, near, far, caster);
-}
-
-DepthRange blocker_depths_over(const ProjectedBlockers& blockers, const Vec2& lo, const Vec2& hi) {
-  DepthRange range;
-  for (const auto& pg : blockers.polygons) {
-    if ((pg.hi.array() < lo.array()).any() || (pg.lo.array() > hi.array()).any()) continue;
-    range.extend(pg.depth_lo);
-    range.extend(pg.depth_hi);
-  }
-  return range;
-}
-
 std::vector<float> nearest_layer_coverage(const ProjectedBlockers& layer,
                                           const std::vector<std::uint8_t>& mine, double depth_lo,
                                           double depth_hi, const TangentGrid& grid) {
   const int w = grid.width, h = grid.height;
   std::vector<float> coverage(std::size_t(w) * h, 0.0f);
   struct Raster {
-    Edges edges;
-    Vec3 inverse_depth;  // per pixel unit, see below
-    int x0, x1, y0, y1;
+    PixelPolygon pixels;
+    Vec3 inverse_depth;  // 1/depth in pixel coordinates
     bool mine;
   };
   std::vector<Raster> rasters;
   bool any_mine = false;
   for (std::size_t i = 0; i < layer.polygons.size(); ++i) {
     const auto& pg = layer.polygons[i];
-    const Vec2 lo = (pg.lo - grid.origin) / grid.pixel, hi = (pg.hi - grid.origin) / grid.pixel;
-    const int x0 = std::max(0, int(std::floor(lo.x()))), x1 = std::min(w - 1, int(hi.x()));
-    const int y0 = std::max(0, int(std::floor(lo.y()))), y1 = std::min(h - 1, int(hi.y()));
-    if (x0 > x1 || y0 > y1) continue;
-    std::vector<Vec2> pts;
-    for (const Vec2& p : pg.points) pts.push_back((p - grid.origin) / grid.pixel);
-    // 1/depth in pixel coordinates: t = origin + pixel·q.
+    Raster r{PixelPolygon{Edges({}), 0, 0, 0, 0}, Vec3::Zero(), mine[i] != 0};
+    if (!to_pixels(pg, grid, &r.pixels)) continue;
+    // t = origin + pixel·q turns 1/depth = a·t + c into a function of pixel coordinates q.
     const Vec3& a = pg.inverse_depth;
-    const Vec3 inv(a.x() * grid.pixel, a.y() * grid.pixel,
-                   a.x() * grid.origin.x() + a.y() * grid.origin.y() + a.z());
-    rasters.push_back({Edges(pts), inv, x0, x1, y0, y1, mine[i] != 0});
+    r.inverse_depth = Vec3(a.x() * grid.pixel, a.y() * grid.pixel,
+                           a.x() * grid.origin.x() + a.y() * grid.origin.y() + a.z());
+    rasters.push_back(std::move(r));
     any_mine = any_mine || mine[i];
   }
   if (!any_mine) return coverage;
@@ -177,22 +189,18 @@ std::vector<float> nearest_layer_coverage(const ProjectedBlockers& layer,
       nearest.assign(std::size_t(row1 - row0) * w * kS, 0.0f);
       owner.assign(nearest.size(), 0);
       for (const Raster& r : rasters) {
-        const int y0 = std::max(r.y0, row0), y1 = std::min(r.y1, row1 - 1);
+        const PixelPolygon& px_poly = r.pixels;
+        const int y0 = std::max(px_poly.y0, row0), y1 = std::min(px_poly.y1, row1 - 1);
         for (int y = y0; y <= y1; ++y) {
-          for (int x = r.x0; x <= r.x1; ++x) {
+          for (int x = px_poly.x0; x <= px_poly.x1; ++x) {
+            const int cls = px_poly.edges.classify(x, y);
+            if (cls < 0) continue;
             const std::size_t base = (std::size_t(y - row0) * w + x) * kS;
             for (int sy = 0; sy < kSamplesPerSide; ++sy) {
               for (int sx = 0; sx < kSamplesPerSide; ++sx) {
                 const double px = x + (sx + 0.5) / kSamplesPerSide;
                 const double py = y + (sy + 0.5) / kSamplesPerSide;
-                bool inside = true;
-                for (const Vec3& e : r.edges.lines) {
-                  if (e.x() * px + e.y() * py + e.z() < 0) {
-                    inside = false;
-                    break;
-                  }
-                }
-                if (!inside) continue;
+                if (cls == 0 && !px_poly.edges.contains(px, py)) continue;
                 const float inv = float(r.inverse_depth.x() * px + r.inverse_depth.y() * py +
                                         r.inverse_depth.z());
                 const std::size_t k = base + std::size_t(sy * kSamplesPerSide + sx);
@@ -224,22 +232,11 @@ std::vector<float> nearest_layer_coverage(const ProjectedBlockers& layer,
 std::vector<float> blocker_coverage(const ProjectedBlockers& blockers, const TangentGrid& grid) {
   const int w = grid.width, h = grid.height;
   std::vector<float> coverage(std::size_t(w) * h, 0.0f);
-  // Polygons in pixel units (pixel (i, j) spans [i, i+1] × [j, j+1]).
-  struct Raster {
-    Edges edges;
-    int x0, x1, y0, y1;
-  };
-  std::vector<Raster> rasters;
+  std::vector<PixelPolygon> rasters;
   rasters.reserve(blockers.polygons.size());
   for (const auto& pg : blockers.polygons) {
-    std::vector<Vec2> pts;
-    pts.reserve(pg.points.size());
-    for (const Vec2& p : pg.points) pts.push_back((p - grid.origin) / grid.pixel);
-    const Vec2 lo = (pg.lo - grid.origin) / grid.pixel, hi = (pg.hi - grid.origin) / grid.pixel;
-    const int x0 = std::max(0, int(std::floor(lo.x()))), x1 = std::min(w - 1, int(hi.x()));
-    const int y0 = std::max(0, int(std::floor(lo.y()))), y1 = std::min(h - 1, int(hi.y()));
-    if (x0 > x1 || y0 > y1) continue;
-    rasters.push_back({Edges(pts), x0, x1, y0, y1});
+    PixelPolygon r{Edges({}), 0, 0, 0, 0};
+    if (to_pixels(pg, grid, &r)) rasters.push_back(std::move(r));
   }
 
   constexpr int kBand = 16;
@@ -248,7 +245,7 @@ std::vector<float> blocker_coverage(const ProjectedBlockers& blockers, const Tan
     for (int band = bands.begin(); band != bands.end(); ++band) {
       const int row0 = band * kBand, row1 = std::min(h, row0 + kBand);
       masks.assign(std::size_t(row1 - row0) * w, 0);
-      for (const Raster& r : rasters) {
+      for (const PixelPolygon& r : rasters) {
         const int y0 = std::max(r.y0, row0), y1 = std::min(r.y1, row1 - 1);
         if (y0 > y1) continue;
         for (int y = y0; y <= y1; ++y) {
@@ -256,20 +253,9 @@ std::vector<float> blocker_coverage(const ProjectedBlockers& blockers, const Tan
             std::uint16_t& mask = masks[std::size_t(y - row0) * w + x];
             if (mask == 0xFFFF) continue;
             // Corners first: a pixel wholly inside or wholly outside one edge needs no samples.
-            bool all_inside = true, outside = false;
-            for (const Vec3& e : r.edges.lines) {
-              const double c00 = e.x() * x + e.y() * y + e.z();
-              const double c10 = c00 + e.x(), c01 = c00 + e.y(), c11 = c10 + e.y();
-              const double lo = std::min(std::min(c00, c10), std::min(c01, c11));
-              const double hi = std::max(std::max(c00, c10), std::max(c01, c11));
-              if (hi < 0) {
-                outside = true;
-                break;
-              }
-              if (lo < 0) all_inside = false;
-            }
-            if (outside) continue;
-            if (all_inside) {
+            const int cls = r.edges.classify(x, y);
+            if (cls < 0) continue;
+            if (cls > 0) {
               mask = 0xFFFF;
               continue;
             }
@@ -278,14 +264,7 @@ std::vector<float> blocker_coverage(const ProjectedBlockers& blockers, const Tan
               for (int sx = 0; sx < kSamplesPerSide; ++sx) {
                 const double px = x + (sx + 0.5) / kSamplesPerSide;
                 const double py = y + (sy + 0.5) / kSamplesPerSide;
-                bool inside = true;
-                for (const Vec3& e : r.edges.lines) {
-                  if (e.x() * px + e.y() * py + e.z() < 0) {
-                    inside = false;
-                    break;
-                  }
-                }
-                if (inside) bits |= std::uint16_t(1u << (sy * kSamplesPerSide + sx));
+                if (r.edges.contains(px, py)) bits |= std::uint16_t(1u << (sy * kSamplesPerSide + sx));
               }
             }
             mask |= bits;

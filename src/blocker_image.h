@@ -51,21 +51,12 @@ struct FaceRef {
   int face = -1;
 };
 
-// Clips every face of `faces` that may shadow the receiver to near <= depth <= far along the
-// frame's axis and projects what remains from the frame's origin (as project_blockers).
+// Clips every face of `faces` that may shadow the receiver (ShadowCaster) to
+// near <= depth <= far along the frame's axis, and projects what remains from the frame's
+// origin. Blocker parts behind the light or beyond the receiver cannot shadow it, and projecting
+// a point at depth ≈ 0 would throw it to infinity.
 ProjectedBlockers project_faces(const std::vector<FaceRef>& faces, const ProjectionFrame& frame,
                                 double near, double far, const ShadowCaster& caster);
-
-// Clips every triangle of `blockers` that may shadow the receiver to near <= depth <= far along
-// the frame's axis, and projects what remains from the frame's origin. Blocker parts behind the
-// light or beyond the receiver cannot shadow it, and projecting a point at depth ≈ 0 would throw
-// it to infinity.
-ProjectedBlockers project_blockers(const std::vector<const Mesh*>& blockers,
-                                   const ProjectionFrame& frame, double near, double far,
-                                   const ShadowCaster& caster);
-
-// The depth range of the projected polygons whose bounding boxes overlap [lo, hi].
-DepthRange blocker_depths_over(const ProjectedBlockers& blockers, const Vec2& lo, const Vec2& hi);
 
 // The nearest-layer blocker image of one cluster: the fraction of each pixel's 4 × 4 sample
 // points at which the blocker nearest the light's centre, among all polygons of `layer`, is one

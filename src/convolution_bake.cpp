@@ -108,11 +108,7 @@ void convolve_leaf(const ConvolutionPlan& plan, Triple& leaf, BlockerCombine com
   start = Clock::now();
   // How much of the slab's geometry lies in front of a texel, with half a texel of tolerance so
   // that a blocker standing on the receiver shadows the texels beside its foot.
-  double lo = -std::numeric_limits<double>::infinity(), hi = -lo;
-  for (const ReceiverCut& c : leaf.cuts) {
-    if (c.below) hi = std::min(hi, c.depth + c.band);
-    else lo = std::max(lo, c.depth - c.band);
-  }
+  const auto [lo, hi] = part_interval(leaf.cuts);
   const double g_lo = leaf.blocker_depths.lo, g_hi = leaf.blocker_depths.hi;
   const double bias = 0.5 * plan.texel;
   std::vector<int> texels;

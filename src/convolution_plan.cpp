@@ -130,7 +130,8 @@ std::vector<Vec3> light_outline(const Light& light) {
   return pts;
 }
 
-// The depth interval of a receiver part: where every cut's weight is positive.
+}  // namespace
+
 std::pair<double, double> part_interval(const std::vector<ReceiverCut>& cuts) {
   double lo = -std::numeric_limits<double>::infinity(), hi = -lo;
   for (const ReceiverCut& c : cuts) {
@@ -142,8 +143,6 @@ std::pair<double, double> part_interval(const std::vector<ReceiverCut>& cuts) {
   }
   return {lo, hi};
 }
-
-}  // namespace
 
 void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& t) {
   const PlanFrame& fr = plan.frames[t.frame];

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "blocker_image.h"
@@ -51,6 +52,9 @@ struct ReceiverCut {
     return below ? w : 1.0 - w;
   }
 };
+
+// The depth interval of a receiver part: where every cut's weight is positive.
+std::pair<double, double> part_interval(const std::vector<ReceiverCut>& cuts);
 
 // A node of the hierarchy: the root of a (light part, frame), a split, or a leaf to convolve.
 struct Triple {

@@ -10,18 +10,15 @@
 #include <vector>
 
 #include "bake.h"
+#include "test_scenes.h"
 
 namespace sb {
 namespace {
 
 Scene load(const std::string& name, int resolution, const std::string& method, int samples) {
-  auto scene = load_scene(std::string(SB_SOURCE_DIR) + "/scenes/" + name + "/scene.toml");
-  EXPECT_TRUE(scene) << scene.error().message;
-  scene->bake.resolution = resolution;
-  scene->bake.method = method;
-  scene->bake.samples = samples;
-  scene->bake.margin = 0;
-  return *scene;
+  Scene scene = test_scenes::load(name, resolution, method);
+  scene.bake.samples = samples;
+  return scene;
 }
 
 BakeResult bake_or_fail(const Scene& scene) {

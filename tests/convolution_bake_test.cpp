@@ -8,26 +8,15 @@
 #include <functional>
 
 #include "bake.h"
+#include "test_scenes.h"
 #include "closed_forms.h"
 #include "image_io.h"
 
 namespace sb {
 namespace {
 
-Scene load(const std::string& name, int resolution, const std::string& method) {
-  auto scene = load_scene(std::string(SB_SOURCE_DIR) + "/scenes/" + name + "/scene.toml");
-  EXPECT_TRUE(scene) << scene.error().message;
-  scene->bake.resolution = resolution;
-  scene->bake.method = method;
-  scene->bake.margin = 0;
-  return *scene;
-}
-
-ObjectDesc& object(Scene& scene, const std::string& name) {
-  for (auto& o : scene.objects)
-    if (o.name == name) return o;
-  throw std::runtime_error("no object " + name);
-}
+using test_scenes::load;
+using test_scenes::object;
 
 Image bake_floor(const Scene& scene, std::vector<PairReport>* pairs = nullptr) {
   auto result = bake(scene);

@@ -10,6 +10,7 @@
 #include <fstream>
 
 #include "bake.h"
+#include "test_scenes.h"
 #include "blocker_image.h"
 #include "clusters.h"
 #include "convolution_plan.h"
@@ -19,14 +20,7 @@
 namespace sb {
 namespace {
 
-Scene load(const std::string& name, int resolution, const std::string& method) {
-  auto scene = load_scene(std::string(SB_SOURCE_DIR) + "/scenes/" + name + "/scene.toml");
-  EXPECT_TRUE(scene) << scene.error().message;
-  scene->bake.resolution = resolution;
-  scene->bake.method = method;
-  scene->bake.margin = 0;
-  return *scene;
-}
+using test_scenes::load;
 
 // The plan of the scene's first receiver, with everything it points into kept alive.
 struct Planned {

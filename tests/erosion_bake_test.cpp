@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "bake.h"
+#include "test_scenes.h"
 #include "erosion_bake.h"
 #include "lights.h"
 #include "mesh.h"
@@ -18,20 +19,8 @@
 namespace sb {
 namespace {
 
-Scene load(const std::string& name, int resolution, const std::string& method) {
-  auto scene = load_scene(std::string(SB_SOURCE_DIR) + "/scenes/" + name + "/scene.toml");
-  EXPECT_TRUE(scene) << scene.error().message;
-  scene->bake.resolution = resolution;
-  scene->bake.method = method;
-  scene->bake.margin = 0;
-  return *scene;
-}
-
-ObjectDesc& object(Scene& scene, const std::string& name) {
-  for (auto& o : scene.objects)
-    if (o.name == name) return o;
-  throw std::runtime_error("no object " + name);
-}
+using test_scenes::load;
+using test_scenes::object;
 
 BakeResult bake_or_fail(const Scene& scene) {
   auto result = bake(scene);
