@@ -16,8 +16,19 @@
 // weighted sum S = Σ w·f(O) with f(O) = O, V = 1 − min(S, 1) (sum) or f(O) = −ln(1 − O),
 // V = exp(−S) (product). Light parts add by power.
 //
-// V here is the emission-weighted unoccluded fraction V_u of design-notes §1 (the paper's split
-// H ≈ H0 · V_u), not the irradiance-weighted V of the reference; §1 says by how much they differ.
+// With `sum`, each cluster's image is its share of the nearest layer (nearest_layer_coverage),
+// so the shares partition the hard shadow seen from the light's centre. A cluster hidden behind
+// another there still hides light from other points of the light: a bracket's base lies under
+// the shadow of its own wall, yet the floor beneath the base is dark whatever the wall does. So
+// the occluded fraction is at least each cluster's own, from its whole image:
+// O = max(Σ O_share, max O_whole) (a union is at least as large as any of its sets). The
+// second convolution is skipped for clusters that nothing hides.
+//
+// V is the irradiance-weighted visibility of the reference to first order across the light
+// (design-notes §6): the weight cos·cos/distance² of the light's points seen from a texel is
+// expanded about the centre, and the kernel's two first moments, convolved with the same image,
+// give the correction (two more convolutions per leaf; ConvolutionInputs::weighted). Without it
+// V is the emission-weighted V_u of design-notes §1.
 #include "convolution_bake.h"
 
 #include <tbb/blocked_range.h>
@@ -60,13 +71,50 @@ float bilinear(const std::vector<float>& image, int w, int h, const Vec2& p) {
 }
 
 // Convolves one leaf and adds its weighted occlusion into `occlusion` (per frame texel).
+// The irradiance weight w = cos θ_light · cos θ_receiver / distance² of the light's points seen
+// from each texel, to first order across the light: the gradient of ln w at the light's centre
+// along its right and up axes, per metre (design-notes §6). Zero where the light crosses the
+// texel's horizon or its own, where a first-order weight would mislead.
+std::vector<Vec2> weight_gradients(const PlanFrame& fr, const TexelSpace& space, const Light& light) {
+  std::vector<Vec2> g(fr.texels.size(), Vec2::Zero());
+  if (light.shape() == LightShape::sphere) return g;
+  const Vec3 c = light.centre(), n = light.normal();
+  const double h = 1e-3 * std::max(1e-3, light.extent_across(n.unitOrthogonal()));
+  const Vec3 axes[2] = {light.right(), light.up()};
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, g.size(), 4096), [&](const auto& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const Texel& t = space.texels[fr.texels[i]];
+      const Vec3 x = t.position.cast<double>(), nx = t.normal.cast<double>();
+      auto log_w = [&](const Vec3& y, double* out) {
+        const Vec3 d = x - y;
+        const double len2 = d.squaredNorm(), len = std::sqrt(len2);
+        const double cl = n.dot(d) / len, cr = -nx.dot(d) / len;
+        if (cl <= 1e-3 || cr <= 1e-3) return false;
+        *out = std::log(cl * cr / len2);
+        return true;
+      };
+      for (int a = 0; a < 2; ++a) {
+        double plus, minus;
+        if (!log_w(c + h * axes[a], &plus) || !log_w(c - h * axes[a], &minus)) {
+          g[i] = Vec2::Zero();
+          break;
+        }
+        g[i][a] = (plus - minus) / (2 * h);
+      }
+    }
+  });
+  return g;
+}
+
 void convolve_leaf(const ConvolutionPlan& plan, Triple& leaf, BlockerCombine combine,
-                   std::vector<Vec3f>& occlusion, PairReport& report) {
+                   const std::vector<Vec2>& gradient, std::vector<Vec3f>& occlusion,
+                   std::vector<Vec3f>& largest, PairReport& report) {
   const PlanFrame& fr = plan.frames[leaf.frame];
   const Light& light = plan.light_parts[fr.light_part].part;
   auto start = Clock::now();
   const double k = std::max(0.0, 1.0 / leaf.config.blocker_plane - 1.0 / leaf.config.receiver_plane);
-  const SourceKernel kernel = source_kernel(light, fr.frame, k, leaf.grid.pixel);
+  const SourceKernel kernel = source_kernel(light, fr.frame, k, leaf.grid.pixel, leaf.view,
+                                            leaf.config.receiver_plane);
   report.seconds_source += seconds_since(start);
   start = Clock::now();
   // This cluster's share of the root layer's hard shadow (nearest_layer_coverage).
@@ -84,17 +132,36 @@ void convolve_leaf(const ConvolutionPlan& plan, Triple& leaf, BlockerCombine com
   }
   const std::vector<float> coverage =
       nearest_layer_coverage(*leaf.layer, mine, leaf.slab_lo, leaf.slab_hi, leaf.grid);
+  const bool with_full = combine == BlockerCombine::sum;
+  std::vector<float> full;
+  if (with_full) {
+    full = blocker_coverage(leaf.blockers, leaf.grid);
+    // Nothing of the cluster hidden behind others: its full image is its share.
+    bool hidden = false;
+    for (std::size_t i = 0; i < full.size() && !hidden; ++i) hidden = full[i] > coverage[i] + 1e-6f;
+    if (!hidden) full.clear();
+  }
   report.seconds_blocker += seconds_since(start);
   start = Clock::now();
   auto& fft = FftConvolver::shared();
   const int tw = FftConvolver::fast_size(leaf.grid.width);
   const int th = FftConvolver::fast_size(leaf.grid.height);
-  std::array<std::vector<float>, 3> occluded;
+  std::array<std::vector<float>, 3> occluded, occluded_full;
+  std::array<std::vector<float>, 2> occluded_moment;
   const int channels = kernel.grey ? 1 : 3;
   for (int c = 0; c < channels; ++c) {
     const auto spectrum =
         fft.kernel_spectrum(kernel.channels[c], kernel.width, kernel.height, tw, th);
     fft.convolve(coverage, leaf.grid.width, leaf.grid.height, *spectrum, occluded[c]);
+    if (!full.empty()) fft.convolve(full, leaf.grid.width, leaf.grid.height, *spectrum, occluded_full[c]);
+  }
+  const bool weighted = !kernel.moments[0].empty() && !gradient.empty();
+  if (weighted) {
+    for (int m = 0; m < 2; ++m) {
+      const auto spectrum =
+          fft.kernel_spectrum(kernel.moments[m], kernel.width, kernel.height, tw, th);
+      fft.convolve(coverage, leaf.grid.width, leaf.grid.height, *spectrum, occluded_moment[m]);
+    }
   }
   report.seconds_fft += seconds_since(start);
   report.convolutions += channels;
@@ -130,11 +197,26 @@ void convolve_leaf(const ConvolutionPlan& plan, Triple& leaf, BlockerCombine com
       if (w <= 0) continue;
       const Vec2 at = leaf.grid.to_pixel(fr.tangent[i]);
       for (int c = 0; c < 3; ++c) {
-        const double o = std::clamp(
-            double(bilinear(occluded[kernel.grey ? 0 : c], leaf.grid.width, leaf.grid.height, at)),
-            0.0, 1.0);
+        double o = bilinear(occluded[kernel.grey ? 0 : c], leaf.grid.width, leaf.grid.height, at);
+        if (weighted) {
+          // O_w = Σ S·w·P / Σ S·w with w ≈ w0·(1 + g·(a, b)): the occluded irradiance fraction.
+          const Vec2& g = gradient[i];
+          const double first = g.x() * bilinear(occluded_moment[0], leaf.grid.width,
+                                                leaf.grid.height, at) +
+                               g.y() * bilinear(occluded_moment[1], leaf.grid.width,
+                                                leaf.grid.height, at);
+          o = (o + first) / std::max(0.1, 1.0 + g.dot(kernel.centroid));
+        }
+        o = std::clamp(o, 0.0, 1.0);
         const double f = combine == BlockerCombine::sum ? o : -std::log(std::max(1e-6, 1.0 - o));
         occlusion[i][c] += float(w * f);
+        if (with_full) {
+          const auto& source = full.empty() ? occluded : occluded_full;
+          const double of = std::clamp(double(bilinear(source[kernel.grey ? 0 : c],
+                                                       leaf.grid.width, leaf.grid.height, at)),
+                                       0.0, 1.0);
+          largest[i][c] = std::max(largest[i][c], float(w * of));
+        }
       }
     }
   });
@@ -175,20 +257,23 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
     report.outside_texels = fr.outside_texels;
     report.seconds_configure = f == 0 ? plan_seconds : 0;
     std::vector<Vec3f> occlusion(fr.texels.size(), Vec3f::Zero());
+    std::vector<Vec3f> largest(fr.texels.size(), Vec3f::Zero());
+    const std::vector<Vec2> gradient =
+        in.weighted ? weight_gradients(fr, space, lp.part) : std::vector<Vec2>{};
     DepthRange blockers, receivers;
     for (std::size_t t = 0; t < plan.triples.size(); ++t) {
       Triple& tr = plan.triples[t];
       if (tr.frame != int(f) || !tr.children.empty() || tr.empty) continue;
       const auto leaf_start = Clock::now();
-      convolve_leaf(plan, tr, in.combine, occlusion, report);
+      convolve_leaf(plan, tr, in.combine, gradient, occlusion, largest, report);
       tr.seconds = seconds_since(leaf_start);
       ++report.triples;
       blockers.extend(tr.blocker_depths.lo);
       blockers.extend(tr.blocker_depths.hi);
       receivers.extend(tr.receiver_depths.lo);
       receivers.extend(tr.receiver_depths.hi);
-      if (tr.config.penumbra_error >= report.penumbra_error) {
-        report.penumbra_error = tr.config.penumbra_error;
+      if (tr.config.penumbra_error + tr.view_error >= report.penumbra_error) {
+        report.penumbra_error = tr.config.penumbra_error + tr.view_error;
         report.penumbra_error_texels = tr.penumbra_error_texels;
         report.rho_lo = tr.config.rho_lo;
         report.rho_hi = tr.config.rho_hi;
@@ -215,7 +300,8 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
     for (std::size_t i = 0; i < fr.texels.size(); ++i) {
       Vec3f v;
       for (int c = 0; c < 3; ++c) {
-        v[c] = in.combine == BlockerCombine::sum ? std::clamp(1.0f - occlusion[i][c], 0.0f, 1.0f)
+        v[c] = in.combine == BlockerCombine::sum
+                   ? std::clamp(1.0f - std::max(occlusion[i][c], largest[i][c]), 0.0f, 1.0f)
                                                  : std::exp(-occlusion[i][c]);
       }
       vis[fr.texels[i]] += fraction * v;

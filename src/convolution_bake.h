@@ -26,6 +26,10 @@ struct ConvolutionInputs {
   int max_image = 4096;       // largest image side, pixels
   int max_triples = 128;      // leaf triples per light
   BlockerCombine combine = BlockerCombine::sum;
+  // Weight the occluded fraction by irradiance to first order across the light (design-notes
+  // §6: two more convolutions per leaf), so that V is the irradiance-weighted visibility the
+  // reference computes rather than the emission-weighted V_u.
+  bool weighted = true;
 };
 
 // Bakes one receiver: plans its triples (plan_convolution), convolves every leaf and combines

@@ -8,10 +8,21 @@
 // texels or the budget is spent.
 //
 // What the paper leaves open and is chosen here:
+// - A planar group of texels (a floor; one face plane of a bracket) is seen along its plane's
+//   normal (add_frames): every texel then lies at one depth, so the receiver's own depth range is
+//   exact and only the blockers' depths and the light's tilt need subdividing; blockers clipped
+//   to depths before the plane are exactly those on the light's side of it. Other receivers are
+//   seen through one frustum from the light's centre (or cube faces) and split by depth.
 // - ρ is taken over the receiver texels of the blocker cluster's footprint only (its projection
 //   from the light's centre, grown by the widest penumbra), not the whole receiver: a post's
 //   shadow needs the depths of the floor around the post, not of the whole floor. This is what
 //   makes clusters pay: separate clusters have separate, small footprints.
+// - A light tilted against the axis has points off its centre's plane; its kernel is exact for
+//   receiver points seen along the triple's view (source_image.cpp) and sheared elsewhere, an
+//   error counted with ε (Triple::view_error) that blocker-space and light splits reduce.
+// - ε counts in receiver texels up to penumbrae kRelativeSpan texels wide and relative to the
+//   penumbra beyond (design-notes §4 allows either): contact shadows get thin slabs, wide soft
+//   penumbrae do not spend the budget on invisible width errors.
 // - The blockers of a triple are clipped to a slab of depth; a texel takes a slab's shadow in
 //   proportion to how much of the slab's geometry lies in front of it (bake_convolution), so
 //   geometry behind a texel never shadows it and contact shadows converge as slabs thin.
@@ -30,6 +41,7 @@
 
 #include "clusters.h"
 #include "fft_convolution.h"
+#include "source_image.h"
 
 namespace sb {
 
@@ -64,7 +76,8 @@ double ConvolutionPlan::estimated_cost() const {
   return cost;
 }
 
-void TexelIndex::build(const std::vector<int>& texels, const std::vector<Vec2>& tangent) {
+void TexelIndex::build(const std::vector<int>& texels, const std::vector<Vec2>& tangent,
+                       const std::vector<double>& depth, const std::vector<Vec3>& position) {
   if (texels.empty()) return;
   Vec2 hi = tangent[std::size_t(texels[0])];
   lo = hi;
@@ -90,44 +103,35 @@ void TexelIndex::build(const std::vector<int>& texels, const std::vector<Vec2>& 
   items.resize(texels.size());
   std::vector<int> fill(start.begin(), start.end() - 1);
   for (int i : texels) items[std::size_t(fill[cell_of(i)]++)] = i;
+  cells.assign(std::size_t(nx) * ny, Cell{});
+  for (auto& c : cells) {
+    c.lo = Vec2::Constant(std::numeric_limits<double>::infinity());
+    c.hi = -c.lo;
+  }
+  for (int i : texels) {
+    Cell& c = cells[cell_of(i)];
+    c.lo = c.lo.cwiseMin(tangent[std::size_t(i)]);
+    c.hi = c.hi.cwiseMax(tangent[std::size_t(i)]);
+    c.depth.extend(depth[std::size_t(i)]);
+    c.box.extend(position[std::size_t(i)]);
+    ++c.count;
+  }
 }
 
 namespace {
 
-// The widest angle, from the light's centre, between a receiver's texels and its frustum's axis
-// that one projection serves; beyond it the tangent plane stretches without bound (tan 60° = 1.7;
-// each leaf sizes its own pixels, so the stretch costs image size, not accuracy).
-constexpr double kMaxFrustumHalfAngleDeg = 60.0;
-// Light splits: at most this many halvings (2^3 = 8 parts).
-constexpr int kMaxLightSplits = 3;
+// Penumbra errors count in texels up to penumbrae this many texels wide, and relative to the
+// penumbra beyond: a width error of one texel is visible at a contact shadow, while a penumbra
+// 100 texels wide may be off by a few texels unseen. (design-notes §4: "compare it with the texel
+// size, or with the penumbra width, for a relative error".)
+constexpr double kRelativeSpan = 16.0;
+// Light splits: at most this many halvings (2^2 = 4 parts).
+constexpr int kMaxLightSplits = 2;
 
 double light_radius(const Light& light) {
   return light.shape() == LightShape::rectangle
              ? 0.5 * std::hypot(light.desc().width, light.desc().height)
              : light.desc().radius;
-}
-
-// Points whose convex hull holds the light: the shaft's light end.
-std::vector<Vec3> light_outline(const Light& light) {
-  std::vector<Vec3> pts;
-  const Vec3 c = light.centre();
-  if (light.shape() == LightShape::rectangle) {
-    const Vec3 a = 0.5 * light.desc().width * light.right(), b = 0.5 * light.desc().height * light.up();
-    for (const Vec3& p : {Vec3(c + a + b), Vec3(c + a - b), Vec3(c - a + b), Vec3(c - a - b)})
-      pts.push_back(p);
-  } else if (light.shape() == LightShape::disk) {
-    const int n = 16;  // circumscribed 16-gon
-    const double r = light.desc().radius / std::cos(std::numbers::pi / n);
-    for (int i = 0; i < n; ++i) {
-      const double phi = 2 * std::numbers::pi * i / n;
-      pts.push_back(c + r * (std::cos(phi) * light.right() + std::sin(phi) * light.up()));
-    }
-  } else {
-    const double r = light.desc().radius;
-    for (int i = 0; i < 8; ++i)
-      pts.push_back(c + r * Vec3(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1));
-  }
-  return pts;
 }
 
 }  // namespace
@@ -159,8 +163,12 @@ void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& 
   ShadowCaster caster;
   caster.light_radius = light_radius(light);
   caster.receiver = t.receiver_box;
-  t.blockers = project_faces(t.faces, fr.frame, std::max(t.slab_lo, fr.near),
-                             std::min(t.slab_hi, part_depth_hi), caster);
+  // The slab grown by a hair, so that a face lying exactly on a slab boundary (a flat top seen
+  // along its normal) keeps its polygon in both slabs: nearest_layer_coverage gives its samples
+  // to one of them, and that one's footprint must hold them.
+  const double hair = 1e-7 * std::max(1.0, part_depth_hi);
+  t.blockers = project_faces(t.faces, fr.frame, std::max(t.slab_lo - hair, fr.near),
+                             std::min(t.slab_hi + hair, part_depth_hi), caster);
   t.polygons = int(t.blockers.polygons.size());
   if (t.blockers.polygons.empty()) return;
   if (!t.layer) t.layer = std::make_shared<const ProjectedBlockers>(t.blockers);
@@ -174,24 +182,40 @@ void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& 
   }
   // The footprint: the blockers' projection grown by the widest penumbra they can cast on the
   // part, k_max times the light's half extents (tangent units).
-  const Vec2 half = light.half_extents(fr.frame.e1, fr.frame.e2);
+  t.view = 0.5 * (lo + hi);
+  const Vec2 half = projected_half_extents(light, fr.frame, t.view, part_depth_hi);
   const double k_max = std::max(0.0, 1.0 / blocker_depths.lo - 1.0 / part_depth_hi);
   lo -= half * k_max;
   hi += half * k_max;
   DepthRange receiver_depths;
   Vec2 tlo = Vec2::Constant(std::numeric_limits<double>::infinity()), thi = -tlo;
   Bounds3 box;
-  fr.index[std::size_t(t.group)].for_each(lo, hi, [&](int i) {
-    const double d = fr.depth[i];
-    if (d <= blocker_depths.lo || d < part_lo || d > part_hi) return;
-    const Vec2& tc = fr.tangent[i];
-    if ((tc.array() < lo.array()).any() || (tc.array() > hi.array()).any()) return;
-    receiver_depths.extend(d);
-    tlo = tlo.cwiseMin(tc);
-    thi = thi.cwiseMax(tc);
-    box.extend(Vec3(plan.space->texels[fr.texels[i]].position.cast<double>()));
-    ++t.footprint_texels;
-  });
+  const double d_floor = blocker_depths.lo;
+  fr.index[std::size_t(t.group)].for_each_cell(
+      lo, hi,
+      [&](const TexelIndex::Cell& c) {
+        return c.depth.lo > d_floor && c.depth.lo >= part_lo && c.depth.hi <= part_hi;
+      },
+      [&](const TexelIndex::Cell& c) {
+        receiver_depths.extend(c.depth.lo);
+        receiver_depths.extend(c.depth.hi);
+        tlo = tlo.cwiseMin(c.lo);
+        thi = thi.cwiseMax(c.hi);
+        box.extend(c.box.lo);
+        box.extend(c.box.hi);
+        t.footprint_texels += c.count;
+      },
+      [&](int i) {
+        const double d = fr.depth[i];
+        if (d <= d_floor || d < part_lo || d > part_hi) return;
+        const Vec2& tc = fr.tangent[i];
+        if ((tc.array() < lo.array()).any() || (tc.array() > hi.array()).any()) return;
+        receiver_depths.extend(d);
+        tlo = tlo.cwiseMin(tc);
+        thi = thi.cwiseMax(tc);
+        box.extend(fr.position[std::size_t(i)]);
+        ++t.footprint_texels;
+      });
   if (receiver_depths.empty()) return;
   t.empty = false;
   t.receiver_box = box;
@@ -201,8 +225,11 @@ void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& 
   t.footprint_hi = thi;
   const double extent = light.extent_across(fr.frame.axis);
   t.config = choose_configuration(fr.frame, blocker_depths, receiver_depths, extent);
-  t.penumbra_error_texels = plan.texel > 0 ? t.config.penumbra_error / plan.texel : 0;
   t.smallest_penumbra = extent * (t.config.rho_lo - 1.0);
+  const Vec2 reach = (tlo - t.view).cwiseAbs().cwiseMax((thi - t.view).cwiseAbs());
+  t.view_error = depth_half_spread(light, fr.frame) * reach.norm() * (t.config.rho_hi - 1.0);
+  const double scale = std::max(plan.texel, t.smallest_penumbra / kRelativeSpan);
+  t.penumbra_error_texels = scale > 0 ? (t.config.penumbra_error + t.view_error) / scale : 0;
 
   // Image resolution: one pixel per receiver texel at the receiver plane, coarser only where the
   // narrowest penumbra spans 64 pixels anyway (design-notes §5, "texture
@@ -211,7 +238,7 @@ void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& 
   const double detail = std::max(plan.texel, t.smallest_penumbra / 64.0);
   double pixel = (plan.texel > 0 ? detail : (thi - tlo).maxCoeff() / 512) / r_star;
   const double k = std::max(0.0, 1.0 / t.config.blocker_plane - 1.0 / r_star);
-  const Vec2 kernel_extent = 2 * k * half;
+  const Vec2 kernel_extent = 2 * k * projected_half_extents(light, fr.frame, t.view, r_star);
   const Vec2 span = thi - tlo;
   const double needed = (span + kernel_extent).maxCoeff();
   if (needed / pixel + 8 > in.max_image) {
@@ -398,178 +425,6 @@ class Planner {
 
 namespace {
 
-// The receiver's index among the blockers, or -1.
-int own_index(const PlanInputs& in) {
-  for (std::size_t i = 0; i < in.blockers.size(); ++i)
-    if (in.blockers[i] == in.receiver) return int(i);
-  return -1;
-}
-
-// Splits a frame's texels into groups that share their blockers (PlanFrame::groups), and gives
-// each group's key: (component, convex) of the receiver's own geometry, or (-1, ·) for all.
-void group_texels(const TexelSpace& space, const PlanInputs& in, PlanFrame& fr,
-                  std::vector<int>* group_component) {
-  const int own = own_index(in);
-  std::map<std::pair<int, long long>, std::vector<int>> groups;
-  std::map<std::pair<int, long long>, int> component_of;
-  for (std::size_t i = 0; i < fr.texels.size(); ++i) {
-    if (fr.depth[i] <= fr.near) continue;
-    std::pair<int, long long> key{-1, 0};
-    if (own >= 0 && in.clusters) {
-      const TriMesh& mesh = in.receiver->mesh;
-      const int face = space.texels[fr.texels[i]].face;
-      const int comp = in.clusters->face_component[own][face];
-      key.first = comp;
-      if (!in.clusters->component_convex[own][comp]) {
-        // The plane of the texel's face, quantised: normal to ~0.3°, offset to 1 mm.
-        const auto fh = mesh.face_handle(face);
-        const auto n = mesh.normal(fh);
-        const auto p = mesh.point(*mesh.cfv_begin(fh));
-        long long h = 0;
-        for (int k = 0; k < 3; ++k) h = h * 1001 + std::llround(n[k] * 200) + 500;
-        h = h * 1000003 + std::llround((n | p) * 1000);
-        key.second = h;
-      }
-    }
-    groups[key].push_back(int(i));
-    component_of[key] = key.first;
-  }
-  // A curved non-convex component has a plane per face: then fall back to one group per
-  // component (its nearby faces may then shadow it a little: docs/methods.md).
-  std::map<int, int> planes_per_component;
-  for (const auto& [key, members] : groups)
-    if (key.first >= 0 && key.second != 0) ++planes_per_component[key.first];
-  std::map<std::pair<int, long long>, std::vector<int>> merged;
-  for (auto& [key, members] : groups) {
-    auto k = key;
-    if (k.first >= 0 && planes_per_component[k.first] > 64) k.second = 1;
-    auto& dst = merged[k];
-    dst.insert(dst.end(), members.begin(), members.end());
-  }
-  for (auto& [key, members] : merged) {
-    std::sort(members.begin(), members.end(),
-              [&](int a, int b) { return fr.depth[a] < fr.depth[b]; });
-    fr.groups.push_back(std::move(members));
-    group_component->push_back(key.first >= 0 && key.second == 0 ? key.first : -1);
-  }
-}
-
-// The candidate blocker faces of a group: those of the clusters in the shaft between the light
-// and the group's texels, less the group's own convex component.
-std::vector<FaceRef> group_faces(const ConvolutionPlan& plan, const PlanInputs& in,
-                                 const PlanFrame& fr, const std::vector<int>& group,
-                                 const Light& light, int convex_component) {
-  const int own = own_index(in);
-  std::vector<FaceRef> faces;
-  auto keep = [&](int mesh, int face) {
-    return !(mesh == own && convex_component >= 0 &&
-             in.clusters->face_component[mesh][face] == convex_component);
-  };
-  if (!in.clusters) {
-    for (std::size_t m = 0; m < in.blockers.size(); ++m)
-      for (auto f : in.blockers[m]->mesh.faces())
-        if (keep(int(m), f.idx())) faces.push_back({in.blockers[m], f.idx()});
-    return faces;
-  }
-  Bounds3 bounds;
-  for (int i : group) bounds.extend(Vec3(plan.space->texels[fr.texels[i]].position.cast<double>()));
-  const Shaft shaft(light_outline(light), bounds);
-  for (int node : clusters_in_shaft(*in.clusters, shaft)) {
-    const Cluster& c = in.clusters->nodes[node];
-    for (int f : c.faces)
-      if (keep(c.mesh, f)) faces.push_back({in.blockers[c.mesh], f});
-  }
-  return faces;
-}
-
-// Frames, groups and root triples for one light part, appended to `plan`.
-void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part) {
-  const TexelSpace& space = *plan.space;
-  const LightPart& lp = plan.light_parts[light_part];
-  const Light& light = lp.part;
-  std::vector<std::size_t> lit;
-  Bounds3 lit_bounds;
-  for (std::size_t t = 0; t < space.texels.size(); ++t) {
-    const Vec3 p = space.texels[t].position.cast<double>();
-    if (!light.reaches(p, space.texels[t].normal.cast<double>())) continue;
-    lit.push_back(t);
-    lit_bounds.extend(p);
-  }
-  if (lit.empty()) return;
-  auto position = [&](std::size_t t) { return Vec3(space.texels[t].position.cast<double>()); };
-  // One frustum from the light's centre towards the middle of the lit texels (design-notes §3)
-  // when it holds them all within kMaxFrustumHalfAngleDeg; otherwise (a light beside or among
-  // its receiver) the six faces of a cube around the light, each its own frustum.
-  const ProjectionFrame central = frame_towards(light.centre(), lit_bounds.centre());
-  double widest = 1.0;
-  for (std::size_t t : lit) {
-    const Vec3 d = position(t) - light.centre();
-    const double len = d.norm();
-    widest = std::min(widest, len > 0 ? d.dot(central.axis) / len : 1.0);
-  }
-  std::vector<PlanFrame> frames;
-  if (widest >= std::cos(kMaxFrustumHalfAngleDeg * std::numbers::pi / 180.0)) {
-    PlanFrame f;
-    f.frame = central;
-    f.texels = lit;
-    frames.push_back(std::move(f));
-  } else {
-    static const char* kFaces[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
-    frames.resize(6);
-    for (int f = 0; f < 6; ++f) {
-      Vec3 axis = Vec3::Zero();
-      axis[f / 2] = f % 2 ? -1.0 : 1.0;
-      frames[f].frame = frame_towards(light.centre(), light.centre() + axis);
-      frames[f].face = kFaces[f];
-    }
-    for (std::size_t t : lit) {
-      const Vec3 d = position(t) - light.centre();
-      int axis;
-      d.cwiseAbs().maxCoeff(&axis);
-      frames[2 * axis + (d[axis] < 0 ? 1 : 0)].texels.push_back(t);
-    }
-  }
-  for (PlanFrame& f : frames) {
-    if (f.texels.empty()) continue;
-    f.light = lp.light;
-    f.light_part = light_part;
-    double deepest = 0;
-    for (std::size_t t : f.texels) {
-      f.depth.push_back(f.frame.depth(position(t)));
-      deepest = std::max(deepest, f.depth.back());
-    }
-    // Texels this close to the light's plane across D (or behind it) cannot be projected; they
-    // keep V = 1 and are counted. The choice of frusta keeps them rare.
-    f.near = std::max(1e-4, 1e-3 * deepest);
-    for (std::size_t i = 0; i < f.texels.size(); ++i) {
-      f.tangent.push_back(f.depth[i] > f.near ? f.frame.tangent(position(f.texels[i]))
-                                              : Vec2::Zero());
-      if (f.depth[i] <= f.near) ++f.outside_texels;
-    }
-    std::vector<int> convex_component;
-    group_texels(space, in, f, &convex_component);
-    for (const auto& g : f.groups) {
-      f.index.emplace_back();
-      f.index.back().build(g, f.tangent);
-    }
-    const int index = int(plan.frames.size());
-    plan.frames.push_back(std::move(f));
-    PlanFrame& added = plan.frames.back();
-    for (std::size_t g = 0; g < added.groups.size(); ++g) {
-      Triple root;
-      root.frame = index;
-      root.group = int(g);
-      root.slab_lo = 0;
-      root.slab_hi = std::numeric_limits<double>::infinity();
-      root.faces = group_faces(plan, in, added, added.groups[g], light, convex_component[g]);
-      for (int i : added.groups[g])
-        root.receiver_box.extend(Vec3(space.texels[added.texels[i]].position.cast<double>()));
-      evaluate_triple(plan, in, root);
-      added.roots.push_back(int(plan.triples.size()));
-      plan.triples.push_back(std::move(root));
-    }
-  }
-}
 
 // Appends `from` (planned for the same receiver) to `to`, renumbering its indices.
 void merge_plan(ConvolutionPlan& to, ConvolutionPlan&& from) {

@@ -79,10 +79,19 @@ struct Triple {
   Bounds3 receiver_box;  // world bounds of the texels it may shadow (footprint, or the group)
   DepthRange blocker_depths, receiver_depths;
   VirtualConfiguration config;
+  // The kernel is exact for receiver points seen along `view`; a tilted light (its points spread
+  // over depths ±z across D) seen from elsewhere in the footprint is sheared by up to
+  // z·|t − view|·(ρ_hi − 1) on the receiver (source_image.cpp), metres.
+  double view_error = 0;
+  // (ε + view_error) in receiver texels while the narrowest penumbra is below kRelativeSpan
+  // texels, in kRelativeSpan-ths of that penumbra beyond (convolution_plan.cpp).
   double penumbra_error_texels = 0;
   double smallest_penumbra = 0;  // L·(ρ_lo − 1), metres on the receiver
   TangentGrid grid;
   Vec2 footprint_lo = Vec2::Zero(), footprint_hi = Vec2::Zero();  // tangent box
+  // The tangent direction the light is projected along for the kernel (source_kernel): the
+  // middle of the blockers' projection.
+  Vec2 view = Vec2::Zero();
   int fft_width = 0, fft_height = 0;
   bool blurred = false;  // the image budget forced pixels coarser than the shadow's detail
   double cost = 0;       // estimated work, FFT pixel-log units
@@ -100,7 +109,41 @@ struct TexelIndex {
   std::vector<int> start;  // nx·ny + 1 offsets into items
   std::vector<int> items;  // frame texel indices, by cell
 
-  void build(const std::vector<int>& texels, const std::vector<Vec2>& tangent);
+  // Per cell: the bounds of its texels' tangents, depths and positions, and their count, so a
+  // footprint that holds a whole cell takes it at once (for_each_cell).
+  struct Cell {
+    Vec2 lo, hi;
+    DepthRange depth;
+    Bounds3 box;
+    int count = 0;
+  };
+  std::vector<Cell> cells;
+
+  void build(const std::vector<int>& texels, const std::vector<Vec2>& tangent,
+             const std::vector<double>& depth, const std::vector<Vec3>& position);
+  // Like for_each, but a cell whose texels all lie in the box and pass `whole(cell)` goes to
+  // cell(cell) instead of texel by texel.
+  template <class W, class C, class F>
+  void for_each_cell(const Vec2& box_lo, const Vec2& box_hi, W&& whole, C&& cell, F&& f) const {
+    if (nx == 0) return;
+    const int x0 = std::max(0, int((box_lo.x() - lo.x()) / this->cell));
+    const int y0 = std::max(0, int((box_lo.y() - lo.y()) / this->cell));
+    const int x1 = std::min(nx - 1, int((box_hi.x() - lo.x()) / this->cell));
+    const int y1 = std::min(ny - 1, int((box_hi.y() - lo.y()) / this->cell));
+    for (int y = y0; y <= y1; ++y) {
+      for (int x = x0; x <= x1; ++x) {
+        const std::size_t c = std::size_t(y) * nx + x;
+        const Cell& k = cells[c];
+        if (k.count == 0) continue;
+        if ((k.lo.array() >= box_lo.array()).all() && (k.hi.array() <= box_hi.array()).all() &&
+            whole(k)) {
+          cell(k);
+          continue;
+        }
+        for (int i = start[c]; i < start[c + 1]; ++i) f(items[std::size_t(i)]);
+      }
+    }
+  }
   // Calls f(i) for every texel i whose cell meets the box [lo, hi] (callers test the box).
   template <class F>
   void for_each(const Vec2& box_lo, const Vec2& box_hi, F&& f) const {
@@ -125,6 +168,7 @@ struct PlanFrame {
   std::vector<std::size_t> texels;  // indices into TexelSpace::texels
   std::vector<double> depth;        // per texel of `texels`: depth along D
   std::vector<Vec2> tangent;        // per texel: tangent coordinates
+  std::vector<Vec3> position;       // per texel: world position
   double near = 0;                  // texels at or before this depth cannot be projected
   std::int64_t outside_texels = 0;  // at or behind the light's plane: left unshadowed
   // Texels that share their blockers: all of them, or, for a receiver that is its own blocker,
@@ -164,6 +208,10 @@ struct ConvolutionPlan {
 // with ε still above it, a rectangular light is split in two and planned again, keeping
 // whichever plan has the smaller worst ε.
 ConvolutionPlan plan_convolution(const TexelSpace& space, const PlanInputs& in);
+
+// Appends to `plan` the frames, texel groups and evaluated root triples of its light part
+// `light_part` (plan_frames.cpp; used by plan_convolution).
+void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part);
 
 // Evaluates one triple in place (used by the planner; exposed for tests).
 void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& triple);

@@ -23,7 +23,7 @@ void describe_triple(const ConvolutionPlan& plan, int index, int indent, std::st
                 "eps %.2f texels (%.4f m)",
                 t.faces.size(), t.polygons, t.blocker_depths.lo, t.blocker_depths.hi,
                 static_cast<long long>(t.footprint_texels), t.receiver_depths.lo,
-                t.receiver_depths.hi, t.penumbra_error_texels, t.config.penumbra_error);
+                t.receiver_depths.hi, t.penumbra_error_texels, t.config.penumbra_error + t.view_error);
   line += buf;
   if (t.children.empty()) {
     std::snprintf(buf, sizeof buf, "; image %dx%d (FFT %dx%d), cost %.3g%s", t.grid.width,
@@ -55,8 +55,10 @@ std::string describe_plan(const ConvolutionPlan& plan) {
     std::snprintf(buf, sizeof buf,
                   "  light %s (%.1f%% of its power)%s%s: D = (%.3f, %.3f, %.3f), %zu texels, "
                   "%zu group(s)\n",
-                  lp.name.c_str(), 100 * lp.fraction, f.face.empty() ? "" : ", cube face ",
-                  f.face.c_str(), f.frame.axis.x(), f.frame.axis.y(), f.frame.axis.z(),
+                  lp.name.c_str(), 100 * lp.fraction, f.face.empty()        ? ""
+                  : f.face == "plane" ? ", along the receiver plane's normal"
+                                      : ", cube face ",
+                  f.face == "plane" ? "" : f.face.c_str(), f.frame.axis.x(), f.frame.axis.y(), f.frame.axis.z(),
                   f.texels.size(), f.groups.size());
     out += buf;
     for (int r : f.roots) describe_triple(plan, r, 2, out);

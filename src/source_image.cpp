@@ -1,29 +1,100 @@
 // The convolution kernel: the source image scaled and mirrored (design-notes §2;
 // ../shared/seeds/001_414ff95054935c53.txt, "Proof that Convolution is Appropriate").
 //
-// Seen from a receiver point, a point s of the source (an offset across D from the light's centre)
-// is hidden when the blocker image is opaque at t + k·s, t being the receiver point's tangent
-// coordinates and k = 1/d* − 1/r*. So the occluded, emission-weighted fraction is
-// O(t) = Σ_s S(s) P(t + k·s) / Σ S = Σ_u K(u) P(t − u) with K(u) = S(−u/k) / Σ S: the source image
-// scaled by k (per metre to tangent units), mirrored through its centre, normalised. The kernel is
-// centred on a pixel (odd size): with an even size the whole shadow would shift by half a pixel.
+// Seen from a receiver point X at depth r and tangent t (from the light's centre), a light point
+// at lateral offset s and depth z (both from the light's centre, in the frame) is hidden by the
+// blocker plane at depth d where the segment between them crosses it:
+//
+//     t + (r − d) / (d (r − z)) · (s − z·t).
+//
+// For a light in the plane z = 0 this is the paper's t + k·s with k = 1/d − 1/r: the source image
+// scaled by k. A light tilted against the axis has z ≠ 0: its points shift by −z·t (the light seen
+// along the ray to the receiver, not along the axis) and scale by r/(r − z) (perspective). The
+// kernel below is exact for receiver points seen along `view` at depth r; other points of a
+// receiver part see it sheared by their distance from `view`, which the planner counts in the
+// penumbra error (convolution_plan.cpp). So the occluded, emission-weighted fraction is
+// O(t) = Σ_u K(u) P(t − u) with K the light's emission mapped by u = −k·r/(r − z)·(s − z·view),
+// normalised. It is made by splatting samples of the light's surface (forward mapping handles the
+// perspective without inverting it). The kernel is centred on a pixel (odd size): with an even
+// size the whole shadow would shift by half a pixel.
 #include "source_image.h"
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
+#include <vector>
 
 namespace sb {
 
+namespace {
+
+// A sample of the light's emitting surface: its offset from the centre and relative emission.
+struct LightSample {
+  Vec3 offset;
+  Vec3 emission;
+};
+
+// Offsets of the light's outline (or, for a sphere, of its silhouette seen along `along`).
+std::vector<Vec3> outline(const Light& light, const Vec3& along) {
+  std::vector<Vec3> pts;
+  if (light.shape() == LightShape::rectangle) {
+    const Vec3 a = 0.5 * light.desc().width * light.right(), b = 0.5 * light.desc().height * light.up();
+    pts = {a + b, a - b, -a + b, -a - b};
+    return pts;
+  }
+  Vec3 u = light.right(), v = light.up();
+  if (light.shape() == LightShape::sphere) {
+    u = along.unitOrthogonal();
+    v = along.cross(u);
+  }
+  const int n = 64;
+  const double r = light.desc().radius / std::cos(std::numbers::pi / n);  // circumscribed
+  for (int i = 0; i < n; ++i) {
+    const double phi = 2 * std::numbers::pi * i / n;
+    pts.push_back(r * (std::cos(phi) * u + std::sin(phi) * v));
+  }
+  return pts;
+}
+
+// Where a light offset lands in the kernel, in metres at k = 1 (tangent units over k), before
+// mirroring; nullopt-like false when the point is at or beyond the receiver's depth.
+bool kernel_point(const ProjectionFrame& frame, const Vec2& view, double r, const Vec3& offset,
+                  Vec2* out) {
+  const double z = offset.dot(frame.axis);
+  if (r - z <= 1e-9 * r) return false;
+  const Vec2 s(offset.dot(frame.e1), offset.dot(frame.e2));
+  *out = (s - z * view) * (r / (r - z));
+  return true;
+}
+
+}  // namespace
+
+Vec2 projected_half_extents(const Light& light, const ProjectionFrame& frame, const Vec2& view,
+                            double receiver_depth) {
+  const Vec3 along = (frame.axis + view.x() * frame.e1 + view.y() * frame.e2).normalized();
+  Vec2 half = Vec2::Zero();
+  for (const Vec3& c : outline(light, along)) {
+    Vec2 p;
+    if (kernel_point(frame, view, receiver_depth, c, &p)) half = half.cwiseMax(p.cwiseAbs());
+  }
+  return half;
+}
+
+double depth_half_spread(const Light& light, const ProjectionFrame& frame) {
+  double spread = 0;
+  for (const Vec3& c : outline(light, frame.axis)) spread = std::max(spread, std::abs(c.dot(frame.axis)));
+  return light.shape() == LightShape::sphere ? 0.0 : spread;
+}
+
 SourceKernel source_kernel(const Light& light, const ProjectionFrame& frame,
-                           double tangent_per_metre, double pixel) {
+                           double tangent_per_metre, double pixel, const Vec2& view,
+                           double receiver_depth) {
   SourceKernel kernel;
-  const Vec2 radius_px = light.half_extents(frame.e1, frame.e2) * (tangent_per_metre / pixel);
-  const int half_w = std::max(0, int(std::ceil(radius_px.x())));
-  const int half_h = std::max(0, int(std::ceil(radius_px.y())));
-  kernel.width = 2 * half_w + 1;
-  kernel.height = 2 * half_h + 1;
-  const int nw = kernel.width, nh = kernel.height;
-  for (auto& c : kernel.channels) c.assign(std::size_t(nw) * nh, 0.0f);
+  const double r = receiver_depth;
+  const double scale = tangent_per_metre / pixel;  // kernel pixels per metre at k = 1
+  const Vec2 radius_px = projected_half_extents(light, frame, view, r) * scale;
+  const int half_w = std::max(0, int(std::ceil(radius_px.x() - 0.5)));
+  const int half_h = std::max(0, int(std::ceil(radius_px.y() - 0.5)));
   if ((half_w == 0 && half_h == 0) || tangent_per_metre <= 0) {
     // The source is smaller than a pixel: a point light, whose kernel is a delta.
     const Vec3 e = light.exitance();
@@ -32,35 +103,72 @@ SourceKernel source_kernel(const Light& light, const ProjectionFrame& frame,
     kernel.grey = e.x() == e.y() && e.y() == e.z();
     return kernel;
   }
-  // Fewer samples per pixel for large kernels, whose edges are smooth at pixel scale anyway.
+  kernel.width = 2 * half_w + 1;
+  kernel.height = 2 * half_h + 1;
+  const int nw = kernel.width, nh = kernel.height;
+  std::array<std::vector<double>, 3> acc;
+  for (auto& c : acc) c.assign(std::size_t(nw) * nh, 0.0);
+  std::array<std::vector<double>, 2> moment;
+  for (auto& c : moment) c.assign(std::size_t(nw) * nh, 0.0);
+  Vec2 centroid = Vec2::Zero();
+
+  // Samples on the light's surface, several per kernel pixel along each of its axes (fewer for
+  // large kernels, whose edges are smooth at pixel scale anyway; a sphere is its silhouette disk
+  // seen along the view), equal area each.
+  const Vec3 along = (frame.axis + view.x() * frame.e1 + view.y() * frame.e2).normalized();
+  Vec3 axis_u = light.right(), axis_v = light.up();
+  double extent_u = light.desc().width, extent_v = light.desc().height;
+  const bool round = light.shape() != LightShape::rectangle;
+  if (round) {
+    extent_u = extent_v = 2 * light.desc().radius;
+    if (light.shape() == LightShape::sphere) {
+      axis_u = along.unitOrthogonal();
+      axis_v = along.cross(axis_u);
+    }
+  }
+  const double px_per_metre = scale * 1.5;  // perspective can stretch by r/(r − z)
   const int larger = std::max(nw, nh);
-  const int samples = larger <= 64 ? 8 : larger <= 256 ? 4 : 2;
-  const double metres_per_px = pixel / tangent_per_metre;
-  std::array<double, 3> sum = {0, 0, 0};
-  for (int j = 0; j < nh; ++j) {
-    for (int i = 0; i < nw; ++i) {
-      Vec3 acc = Vec3::Zero();
-      for (int sy = 0; sy < samples; ++sy) {
-        for (int sx = 0; sx < samples; ++sx) {
-          const double ux = i - half_w + (sx + 0.5) / samples - 0.5;
-          const double uy = j - half_h + (sy + 0.5) / samples - 0.5;
-          // Mirrored: kernel offset u reads the source at −u.
-          const Vec3 offset = -(ux * frame.e1 + uy * frame.e2) * metres_per_px;
-          acc += light.source_image(offset, frame.axis);
-        }
-      }
-      for (int c = 0; c < 3; ++c) {
-        kernel.channels[c][std::size_t(j) * nw + i] = float(acc[c]);
-        sum[c] += acc[c];
-      }
+  const int per_pixel = larger <= 64 ? 8 : larger <= 256 ? 4 : 2;
+  const int nu = std::clamp(int(std::ceil(per_pixel * extent_u * px_per_metre)), 8, 4096);
+  const int nv = std::clamp(int(std::ceil(per_pixel * extent_v * px_per_metre)), 8, 4096);
+  for (int j = 0; j < nv; ++j) {
+    for (int i = 0; i < nu; ++i) {
+      const double a = ((i + 0.5) / nu - 0.5) * extent_u, b = ((j + 0.5) / nv - 0.5) * extent_v;
+      if (round && a * a + b * b > 0.25 * extent_u * extent_u) continue;
+      const Vec3 offset = a * axis_u + b * axis_v;
+      const Vec3 e = light.shape() == LightShape::sphere ? Vec3(Vec3::Ones())
+                                                          : light.tint(Vec2(a, b));
+      Vec2 p;
+      if (!kernel_point(frame, view, r, offset, &p)) continue;
+      // Mirrored: the kernel holds the light at −u. Each sample lands in the pixel that holds
+      // it, so a pixel gets the emission of the part of the light that maps into it.
+      const int x = std::clamp(int(std::lround(-p.x() * scale)) + half_w, 0, nw - 1);
+      const int y = std::clamp(int(std::lround(-p.y() * scale)) + half_h, 0, nh - 1);
+      for (int c = 0; c < 3; ++c) acc[c][std::size_t(y) * nw + x] += e[c];
+      moment[0][std::size_t(y) * nw + x] += e[0] * a;
+      moment[1][std::size_t(y) * nw + x] += e[0] * b;
+      centroid += e[0] * Vec2(a, b);
     }
   }
   for (int c = 0; c < 3; ++c) {
-    if (sum[c] <= 0) continue;
-    for (float& v : kernel.channels[c]) v = float(v / sum[c]);
+    double sum = 0;
+    for (double v : acc[c]) sum += v;
+    kernel.channels[c].assign(acc[c].size(), 0.0f);
+    if (sum <= 0) continue;
+    for (std::size_t k = 0; k < acc[c].size(); ++k) kernel.channels[c][k] = float(acc[c][k] / sum);
   }
   kernel.grey =
       kernel.channels[0] == kernel.channels[1] && kernel.channels[1] == kernel.channels[2];
+  double sum0 = 0;
+  for (double v : acc[0]) sum0 += v;
+  if (kernel.grey && light.shape() != LightShape::sphere && sum0 > 0) {
+    for (int m = 0; m < 2; ++m) {
+      kernel.moments[m].resize(moment[m].size());
+      for (std::size_t k = 0; k < moment[m].size(); ++k)
+        kernel.moments[m][k] = float(moment[m][k] / sum0);
+    }
+    kernel.centroid = centroid / sum0;
+  }
   return kernel;
 }
 
