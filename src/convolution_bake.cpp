@@ -70,7 +70,6 @@ float bilinear(const std::vector<float>& image, int w, int h, const Vec2& p) {
                ty * ((1 - tx) * at(x0, y1) + tx * at(x1, y1)));
 }
 
-// Convolves one leaf and adds its weighted occlusion into `occlusion` (per frame texel).
 // The irradiance weight w = cos θ_light · cos θ_receiver / distance² of the light's points seen
 // from each texel, to first order across the light: the gradient of ln w at the light's centre
 // along its right and up axes, per metre (design-notes §6). Zero where the light crosses the
@@ -106,6 +105,8 @@ std::vector<Vec2> weight_gradients(const PlanFrame& fr, const TexelSpace& space,
   return g;
 }
 
+// Convolves one leaf and adds its weighted occlusion into `occlusion` (per frame texel), and
+// its whole image's occlusion into `largest` (the max rule of `sum`; see the file's header).
 void convolve_leaf(const ConvolutionPlan& plan, Triple& leaf, BlockerCombine combine,
                    const std::vector<Vec2>& gradient, std::vector<Vec3f>& occlusion,
                    std::vector<Vec3f>& largest, PairReport& report) {
@@ -164,7 +165,7 @@ void convolve_leaf(const ConvolutionPlan& plan, Triple& leaf, BlockerCombine com
     }
   }
   report.seconds_fft += seconds_since(start);
-  report.convolutions += channels;
+  report.convolutions += channels * (full.empty() ? 1 : 2) + (weighted ? 2 : 0);
   report.image_width = std::max(report.image_width, leaf.grid.width);
   report.image_height = std::max(report.image_height, leaf.grid.height);
   report.kernel_width = std::max(report.kernel_width, kernel.width);
@@ -197,7 +198,9 @@ void convolve_leaf(const ConvolutionPlan& plan, Triple& leaf, BlockerCombine com
       if (w <= 0) continue;
       const Vec2 at = leaf.grid.to_pixel(fr.tangent[i]);
       for (int c = 0; c < 3; ++c) {
-        double o = bilinear(occluded[kernel.grey ? 0 : c], leaf.grid.width, leaf.grid.height, at);
+        const double share =
+            bilinear(occluded[kernel.grey ? 0 : c], leaf.grid.width, leaf.grid.height, at);
+        double o = share;
         if (weighted) {
           // O_w = Σ S·w·P / Σ S·w with w ≈ w0·(1 + g·(a, b)): the occluded irradiance fraction.
           const Vec2& g = gradient[i];
@@ -211,11 +214,11 @@ void convolve_leaf(const ConvolutionPlan& plan, Triple& leaf, BlockerCombine com
         const double f = combine == BlockerCombine::sum ? o : -std::log(std::max(1e-6, 1.0 - o));
         occlusion[i][c] += float(w * f);
         if (with_full) {
-          const auto& source = full.empty() ? occluded : occluded_full;
-          const double of = std::clamp(double(bilinear(source[kernel.grey ? 0 : c],
-                                                       leaf.grid.width, leaf.grid.height, at)),
-                                       0.0, 1.0);
-          largest[i][c] = std::max(largest[i][c], float(w * of));
+          const double whole =
+              full.empty() ? share
+                           : bilinear(occluded_full[kernel.grey ? 0 : c], leaf.grid.width,
+                                      leaf.grid.height, at);
+          largest[i][c] = std::max(largest[i][c], float(w * std::clamp(whole, 0.0, 1.0)));
         }
       }
     }

@@ -34,8 +34,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
-#include <numbers>
 #include <queue>
 #include <tuple>
 

@@ -28,12 +28,6 @@ namespace sb {
 
 namespace {
 
-// A sample of the light's emitting surface: its offset from the centre and relative emission.
-struct LightSample {
-  Vec3 offset;
-  Vec3 emission;
-};
-
 // Offsets of the light's outline (or, for a sphere, of its silhouette seen along `along`).
 std::vector<Vec3> outline(const Light& light, const Vec3& along) {
   std::vector<Vec3> pts;
@@ -56,8 +50,13 @@ std::vector<Vec3> outline(const Light& light, const Vec3& along) {
   return pts;
 }
 
+// The unit direction from the frame's origin through tangent point `view`.
+Vec3 view_ray(const ProjectionFrame& frame, const Vec2& view) {
+  return (frame.axis + view.x() * frame.e1 + view.y() * frame.e2).normalized();
+}
+
 // Where a light offset lands in the kernel, in metres at k = 1 (tangent units over k), before
-// mirroring; nullopt-like false when the point is at or beyond the receiver's depth.
+// mirroring; false when the point is at or beyond the receiver's depth.
 bool kernel_point(const ProjectionFrame& frame, const Vec2& view, double r, const Vec3& offset,
                   Vec2* out) {
   const double z = offset.dot(frame.axis);
@@ -71,7 +70,7 @@ bool kernel_point(const ProjectionFrame& frame, const Vec2& view, double r, cons
 
 Vec2 projected_half_extents(const Light& light, const ProjectionFrame& frame, const Vec2& view,
                             double receiver_depth) {
-  const Vec3 along = (frame.axis + view.x() * frame.e1 + view.y() * frame.e2).normalized();
+  const Vec3 along = view_ray(frame, view);
   Vec2 half = Vec2::Zero();
   for (const Vec3& c : outline(light, along)) {
     Vec2 p;
@@ -115,7 +114,7 @@ SourceKernel source_kernel(const Light& light, const ProjectionFrame& frame,
   // Samples on the light's surface, several per kernel pixel along each of its axes (fewer for
   // large kernels, whose edges are smooth at pixel scale anyway; a sphere is its silhouette disk
   // seen along the view), equal area each.
-  const Vec3 along = (frame.axis + view.x() * frame.e1 + view.y() * frame.e2).normalized();
+  const Vec3 along = view_ray(frame, view);
   Vec3 axis_u = light.right(), axis_v = light.up();
   double extent_u = light.desc().width, extent_v = light.desc().height;
   const bool round = light.shape() != LightShape::rectangle;
