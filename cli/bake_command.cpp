@@ -95,8 +95,8 @@ void print_explanation(const sb::BakeResult& result) {
                  p.image_width, p.image_height, p.kernel_width, p.kernel_height, p.fft_width,
                  p.fft_height, p.convolutions);
       fmt::print(
-          "    time: configure {:.1f} ms, source {:.1f} ms, blocker {:.1f} ms, FFT {:.1f} ms, "
-          "lookup {:.1f} ms\n",
+          "    time: configure {:.1f} ms; summed over threads: source {:.1f} ms, blocker {:.1f} ms, "
+          "FFT {:.1f} ms, lookup {:.1f} ms\n",
           1e3 * p.seconds_configure, 1e3 * p.seconds_source, 1e3 * p.seconds_blocker,
           1e3 * p.seconds_fft, 1e3 * p.seconds_lookup);
     }

@@ -10,6 +10,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -167,6 +168,9 @@ std::vector<float> nearest_layer_coverage(const ProjectedBlockers& layer,
   bool any_mine = false;
   for (std::size_t i = 0; i < layer.polygons.size(); ++i) {
     const auto& pg = layer.polygons[i];
+    // A polygon wholly beyond the slab only ever wins samples that then count for nobody, and
+    // any nearer polygon wins over it anyway: leaving it out changes nothing.
+    if (pg.depth_lo > depth_hi) continue;
     Raster r{PixelPolygon{Edges({}), 0, 0, 0, 0}, Vec3::Zero(), mine[i] != 0};
     if (!to_pixels(pg, grid, &r.pixels)) continue;
     // t = origin + pixel·q turns 1/depth = a·t + c into a function of pixel coordinates q.
@@ -191,23 +195,29 @@ std::vector<float> nearest_layer_coverage(const ProjectedBlockers& layer,
       for (const Raster& r : rasters) {
         const PixelPolygon& px_poly = r.pixels;
         const int y0 = std::max(px_poly.y0, row0), y1 = std::min(px_poly.y1, row1 - 1);
+        // 1/depth at each sample of a pixel is its value at the pixel's corner plus a fixed
+        // offset per sample.
+        std::array<float, kS> sample_inv;
+        for (int k = 0; k < kS; ++k) {
+          sample_inv[std::size_t(k)] =
+              float(r.inverse_depth.x() * (k % kSamplesPerSide + 0.5) / kSamplesPerSide +
+                    r.inverse_depth.y() * (k / kSamplesPerSide + 0.5) / kSamplesPerSide);
+        }
         for (int y = y0; y <= y1; ++y) {
           for (int x = px_poly.x0; x <= px_poly.x1; ++x) {
             const int cls = px_poly.edges.classify(x, y);
             if (cls < 0) continue;
             const std::size_t base = (std::size_t(y - row0) * w + x) * kS;
-            for (int sy = 0; sy < kSamplesPerSide; ++sy) {
-              for (int sx = 0; sx < kSamplesPerSide; ++sx) {
-                const double px = x + (sx + 0.5) / kSamplesPerSide;
-                const double py = y + (sy + 0.5) / kSamplesPerSide;
-                if (cls == 0 && !px_poly.edges.contains(px, py)) continue;
-                const float inv = float(r.inverse_depth.x() * px + r.inverse_depth.y() * py +
-                                        r.inverse_depth.z());
-                const std::size_t k = base + std::size_t(sy * kSamplesPerSide + sx);
-                if (inv > nearest[k]) {
-                  nearest[k] = inv;
-                  owner[k] = r.mine ? 1 : 0;
-                }
+            const float corner =
+                float(r.inverse_depth.x() * x + r.inverse_depth.y() * y + r.inverse_depth.z());
+            for (int k = 0; k < kS; ++k) {
+              if (cls == 0 && !px_poly.edges.contains(x + (k % kSamplesPerSide + 0.5) / kSamplesPerSide,
+                                                      y + (k / kSamplesPerSide + 0.5) / kSamplesPerSide))
+                continue;
+              const float inv = corner + sample_inv[std::size_t(k)];
+              if (inv > nearest[base + std::size_t(k)]) {
+                nearest[base + std::size_t(k)] = inv;
+                owner[base + std::size_t(k)] = r.mine ? 1 : 0;
               }
             }
           }

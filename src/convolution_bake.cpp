@@ -52,6 +52,10 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// Transform pixels of the leaves convolved together before their images are added in (about
+// 5 images of 4 bytes each per pixel: 64 MiB).
+constexpr std::size_t kBatchPixels = std::size_t(1) << 22;
+
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -105,18 +109,30 @@ std::vector<Vec2> weight_gradients(const PlanFrame& fr, const TexelSpace& space,
   return g;
 }
 
-// Convolves one leaf and adds its weighted occlusion into `occlusion` (per frame texel), and
-// its whole image's occlusion into `largest` (the max rule of `sum`; see the file's header).
-void convolve_leaf(const ConvolutionPlan& plan, Triple& leaf, BlockerCombine combine,
-                   const std::vector<Vec2>& gradient, std::vector<Vec3f>& occlusion,
-                   std::vector<Vec3f>& largest, PairReport& report) {
+// One leaf's convolved images, made independently of every other leaf (so leaves run in
+// parallel) and then added into the frame's texels by accumulate_leaf.
+struct LeafImages {
+  SourceKernel kernel;
+  std::array<std::vector<float>, 3> occluded;       // share of the nearest layer ⊛ kernel
+  std::array<std::vector<float>, 3> occluded_full;  // whole image ⊛ kernel; empty if equal
+  std::array<std::vector<float>, 2> moment;         // share ⊛ moment kernels (weighting)
+  int tw = 0, th = 0;
+  int convolutions = 0;
+  double seconds_source = 0, seconds_blocker = 0, seconds_fft = 0;
+};
+
+// Renders one leaf's kernel and blocker images and convolves them.
+LeafImages convolve_leaf(const ConvolutionPlan& plan, const Triple& leaf, BlockerCombine combine,
+                         bool weighted) {
+  LeafImages out;
   const PlanFrame& fr = plan.frames[leaf.frame];
   const Light& light = plan.light_parts[fr.light_part].part;
   auto start = Clock::now();
   const double k = std::max(0.0, 1.0 / leaf.config.blocker_plane - 1.0 / leaf.config.receiver_plane);
-  const SourceKernel kernel = source_kernel(light, fr.frame, k, leaf.grid.pixel, leaf.view,
-                                            leaf.config.receiver_plane);
-  report.seconds_source += seconds_since(start);
+  out.kernel = source_kernel(light, fr.frame, k, leaf.grid.pixel, leaf.view,
+                             leaf.config.receiver_plane);
+  const SourceKernel& kernel = out.kernel;
+  out.seconds_source = seconds_since(start);
   start = Clock::now();
   // This cluster's share of the root layer's hard shadow (nearest_layer_coverage).
   std::vector<std::uint8_t> mine(leaf.layer->polygons.size(), 0);
@@ -133,47 +149,60 @@ void convolve_leaf(const ConvolutionPlan& plan, Triple& leaf, BlockerCombine com
   }
   const std::vector<float> coverage =
       nearest_layer_coverage(*leaf.layer, mine, leaf.slab_lo, leaf.slab_hi, leaf.grid);
-  const bool with_full = combine == BlockerCombine::sum;
   std::vector<float> full;
-  if (with_full) {
+  if (combine == BlockerCombine::sum) {
     full = blocker_coverage(leaf.blockers, leaf.grid);
     // Nothing of the cluster hidden behind others: its full image is its share.
     bool hidden = false;
     for (std::size_t i = 0; i < full.size() && !hidden; ++i) hidden = full[i] > coverage[i] + 1e-6f;
     if (!hidden) full.clear();
   }
-  report.seconds_blocker += seconds_since(start);
+  out.seconds_blocker = seconds_since(start);
   start = Clock::now();
   auto& fft = FftConvolver::shared();
-  const int tw = FftConvolver::fast_size(leaf.grid.width);
-  const int th = FftConvolver::fast_size(leaf.grid.height);
-  std::array<std::vector<float>, 3> occluded, occluded_full;
-  std::array<std::vector<float>, 2> occluded_moment;
+  out.tw = leaf.fft_width;
+  out.th = leaf.fft_height;
+  const int w = leaf.grid.width, h = leaf.grid.height;
   const int channels = kernel.grey ? 1 : 3;
   for (int c = 0; c < channels; ++c) {
-    const auto spectrum =
-        fft.kernel_spectrum(kernel.channels[c], kernel.width, kernel.height, tw, th);
-    fft.convolve(coverage, leaf.grid.width, leaf.grid.height, *spectrum, occluded[c]);
-    if (!full.empty()) fft.convolve(full, leaf.grid.width, leaf.grid.height, *spectrum, occluded_full[c]);
+    const auto spectrum = fft.kernel_spectrum(kernel.channels[c], kernel.width, kernel.height,
+                                              out.tw, out.th);
+    fft.convolve(coverage, w, h, *spectrum, out.occluded[c]);
+    if (!full.empty()) fft.convolve(full, w, h, *spectrum, out.occluded_full[c]);
   }
-  const bool weighted = !kernel.moments[0].empty() && !gradient.empty();
+  weighted = weighted && !kernel.moments[0].empty();
   if (weighted) {
     for (int m = 0; m < 2; ++m) {
-      const auto spectrum =
-          fft.kernel_spectrum(kernel.moments[m], kernel.width, kernel.height, tw, th);
-      fft.convolve(coverage, leaf.grid.width, leaf.grid.height, *spectrum, occluded_moment[m]);
+      const auto spectrum = fft.kernel_spectrum(kernel.moments[m], kernel.width, kernel.height,
+                                                out.tw, out.th);
+      fft.convolve(coverage, w, h, *spectrum, out.moment[m]);
     }
   }
-  report.seconds_fft += seconds_since(start);
-  report.convolutions += channels * (full.empty() ? 1 : 2) + (weighted ? 2 : 0);
+  out.seconds_fft = seconds_since(start);
+  out.convolutions = channels * (full.empty() ? 1 : 2) + (weighted ? 2 : 0);
+  return out;
+}
+
+// Adds a convolved leaf's weighted occlusion into `occlusion` (per frame texel), and its whole
+// image's occlusion into `largest` (the max rule of `sum`; see the file's header).
+void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const LeafImages& images,
+                     BlockerCombine combine, const std::vector<Vec2>& gradient,
+                     std::vector<Vec3f>& occlusion, std::vector<Vec3f>& largest,
+                     PairReport& report) {
+  const PlanFrame& fr = plan.frames[leaf.frame];
+  const SourceKernel& kernel = images.kernel;
+  report.seconds_source += images.seconds_source;
+  report.seconds_blocker += images.seconds_blocker;
+  report.seconds_fft += images.seconds_fft;
+  report.convolutions += images.convolutions;
   report.image_width = std::max(report.image_width, leaf.grid.width);
   report.image_height = std::max(report.image_height, leaf.grid.height);
   report.kernel_width = std::max(report.kernel_width, kernel.width);
   report.kernel_height = std::max(report.kernel_height, kernel.height);
-  report.fft_width = std::max(report.fft_width, tw);
-  report.fft_height = std::max(report.fft_height, th);
+  report.fft_width = std::max(report.fft_width, images.tw);
+  report.fft_height = std::max(report.fft_height, images.th);
 
-  start = Clock::now();
+  const auto start = Clock::now();
   // How much of the slab's geometry lies in front of a texel, with half a texel of tolerance so
   // that a blocker standing on the receiver shadows the texels beside its foot.
   const auto [lo, hi] = part_interval(leaf.cuts);
@@ -189,36 +218,42 @@ void convolve_leaf(const ConvolutionPlan& plan, Triple& leaf, BlockerCombine com
       return;
     texels.push_back(i);
   });
+  const bool weighted = !images.moment[0].empty() && !gradient.empty();
+  const bool with_full = combine == BlockerCombine::sum;
+  const int w = leaf.grid.width, h = leaf.grid.height;
+  const int channels = kernel.grey ? 1 : 3;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, texels.size(), 2048), [&](const auto& r) {
     for (std::size_t j = r.begin(); j != r.end(); ++j) {
       const std::size_t i = std::size_t(texels[j]);
       const double depth = fr.depth[i];
-      double w = g_hi > g_lo ? std::clamp((depth + bias - g_lo) / (g_hi - g_lo), 0.0, 1.0) : 1.0;
-      for (const ReceiverCut& c : leaf.cuts) w *= c.weight(depth);
-      if (w <= 0) continue;
+      double wt = g_hi > g_lo ? std::clamp((depth + bias - g_lo) / (g_hi - g_lo), 0.0, 1.0) : 1.0;
+      for (const ReceiverCut& c : leaf.cuts) wt *= c.weight(depth);
+      if (wt <= 0) continue;
       const Vec2 at = leaf.grid.to_pixel(fr.tangent[i]);
-      for (int c = 0; c < 3; ++c) {
-        const double share =
-            bilinear(occluded[kernel.grey ? 0 : c], leaf.grid.width, leaf.grid.height, at);
-        double o = share;
-        if (weighted) {
-          // O_w = Σ S·w·P / Σ S·w with w ≈ w0·(1 + g·(a, b)): the occluded irradiance fraction.
-          const Vec2& g = gradient[i];
-          const double first = g.x() * bilinear(occluded_moment[0], leaf.grid.width,
-                                                leaf.grid.height, at) +
-                               g.y() * bilinear(occluded_moment[1], leaf.grid.width,
-                                                leaf.grid.height, at);
-          o = (o + first) / std::max(0.1, 1.0 + g.dot(kernel.centroid));
-        }
-        o = std::clamp(o, 0.0, 1.0);
+      // The moments' correction is the same for every channel (grey kernels only).
+      double first = 0, norm = 1;
+      if (weighted) {
+        // O_w = Σ S·w·P / Σ S·w with w ≈ w0·(1 + g·(a, b)): the occluded irradiance fraction.
+        const Vec2& g = gradient[i];
+        first = g.x() * bilinear(images.moment[0], w, h, at) +
+                g.y() * bilinear(images.moment[1], w, h, at);
+        norm = std::max(0.1, 1.0 + g.dot(kernel.centroid));
+      }
+      for (int c = 0; c < channels; ++c) {
+        const double share = bilinear(images.occluded[c], w, h, at);
+        const double o = std::clamp((share + first) / norm, 0.0, 1.0);
         const double f = combine == BlockerCombine::sum ? o : -std::log(std::max(1e-6, 1.0 - o));
-        occlusion[i][c] += float(w * f);
+        float whole = 0;
         if (with_full) {
-          const double whole =
-              full.empty() ? share
-                           : bilinear(occluded_full[kernel.grey ? 0 : c], leaf.grid.width,
-                                      leaf.grid.height, at);
-          largest[i][c] = std::max(largest[i][c], float(w * std::clamp(whole, 0.0, 1.0)));
+          const double v = images.occluded_full[c].empty()
+                               ? share
+                               : bilinear(images.occluded_full[c], w, h, at);
+          whole = float(wt * std::clamp(v, 0.0, 1.0));
+        }
+        // A grey kernel's one channel stands for all three.
+        for (int out = kernel.grey ? 0 : c; out < (kernel.grey ? 3 : c + 1); ++out) {
+          occlusion[i][out] += float(wt * f);
+          if (with_full) largest[i][out] = std::max(largest[i][out], whole);
         }
       }
     }
@@ -263,29 +298,61 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
     std::vector<Vec3f> largest(fr.texels.size(), Vec3f::Zero());
     const std::vector<Vec2> gradient =
         in.weighted ? weight_gradients(fr, space, lp.part) : std::vector<Vec2>{};
-    DepthRange blockers, receivers;
+    std::vector<std::size_t> leaves;
     for (std::size_t t = 0; t < plan.triples.size(); ++t) {
-      Triple& tr = plan.triples[t];
-      if (tr.frame != int(f) || !tr.children.empty() || tr.empty) continue;
-      const auto leaf_start = Clock::now();
-      convolve_leaf(plan, tr, in.combine, gradient, occlusion, largest, report);
-      tr.seconds = seconds_since(leaf_start);
-      ++report.triples;
-      blockers.extend(tr.blocker_depths.lo);
-      blockers.extend(tr.blocker_depths.hi);
-      receivers.extend(tr.receiver_depths.lo);
-      receivers.extend(tr.receiver_depths.hi);
-      if (tr.config.penumbra_error + tr.view_error >= report.penumbra_error) {
-        report.penumbra_error = tr.config.penumbra_error + tr.view_error;
-        report.penumbra_error_texels = tr.penumbra_error_texels;
-        report.rho_lo = tr.config.rho_lo;
-        report.rho_hi = tr.config.rho_hi;
-        report.rho = tr.config.rho;
-        report.blocker_plane = tr.config.blocker_plane;
-        report.receiver_plane = tr.config.receiver_plane;
-        report.light_extent = tr.config.light_extent;
-        report.pixel = tr.grid.pixel;
+      const Triple& tr = plan.triples[t];
+      if (tr.frame == int(f) && tr.children.empty() && !tr.empty) leaves.push_back(t);
+    }
+    // Leaves are convolved in parallel, a batch at a time (their images held until added), with
+    // one FFTW thread each: on 2 cores two threads slow a transform below ~400² down
+    // (tests/bench/fft_bench.cpp). A larger leaf is convolved alone, with FFTW's threads.
+    // Adding into the texels stays in leaf order, so the result does not depend on scheduling.
+    DepthRange blockers, receivers;
+    for (std::size_t first = 0; first < leaves.size();) {
+      std::size_t last = first;
+      std::size_t pixels = 0;
+      while (last < leaves.size()) {
+        const Triple& tr = plan.triples[leaves[last]];
+        const std::size_t area = std::size_t(tr.fft_width) * std::size_t(tr.fft_height);
+        if (last > first && (FftConvolver::threaded(tr.fft_width, tr.fft_height) ||
+                             pixels + area > kBatchPixels))
+          break;
+        pixels += area;
+        ++last;
+        if (FftConvolver::threaded(tr.fft_width, tr.fft_height)) break;
       }
+      std::vector<LeafImages> images(last - first);
+      std::vector<double> seconds(last - first, 0.0);
+      tbb::parallel_for(std::size_t(first), last, [&](std::size_t b) {
+        const auto leaf_start = Clock::now();
+        images[b - first] = convolve_leaf(plan, plan.triples[leaves[b]], in.combine, in.weighted);
+        seconds[b - first] = seconds_since(leaf_start);
+      });
+      for (std::size_t b = first; b < last; ++b) {
+        Triple& tr = plan.triples[leaves[b]];
+        const auto leaf_start = Clock::now();
+        accumulate_leaf(plan, tr, images[b - first], in.combine, gradient, occlusion, largest,
+                        report);
+        images[b - first] = LeafImages{};
+        tr.seconds = seconds[b - first] + seconds_since(leaf_start);
+        ++report.triples;
+        blockers.extend(tr.blocker_depths.lo);
+        blockers.extend(tr.blocker_depths.hi);
+        receivers.extend(tr.receiver_depths.lo);
+        receivers.extend(tr.receiver_depths.hi);
+        if (tr.config.penumbra_error + tr.view_error >= report.penumbra_error) {
+          report.penumbra_error = tr.config.penumbra_error + tr.view_error;
+          report.penumbra_error_texels = tr.penumbra_error_texels;
+          report.rho_lo = tr.config.rho_lo;
+          report.rho_hi = tr.config.rho_hi;
+          report.rho = tr.config.rho;
+          report.blocker_plane = tr.config.blocker_plane;
+          report.receiver_plane = tr.config.receiver_plane;
+          report.light_extent = tr.config.light_extent;
+          report.pixel = tr.grid.pixel;
+        }
+      }
+      first = last;
     }
     if (!blockers.empty()) {
       report.blocker_depth_lo = blockers.lo;

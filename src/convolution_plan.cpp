@@ -32,7 +32,10 @@
 //   plane-side test of project_faces drops the faces they lie on.
 #include "convolution_plan.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <queue>
 #include <tuple>
@@ -113,6 +116,27 @@ void TexelIndex::build(const std::vector<int>& texels, const std::vector<Vec2>& 
     c.depth.extend(depth[std::size_t(i)]);
     c.box.extend(position[std::size_t(i)]);
     ++c.count;
+  }
+  bx = (nx + kBlock - 1) / kBlock;
+  by = (ny + kBlock - 1) / kBlock;
+  blocks.assign(std::size_t(bx) * by, Cell{});
+  for (auto& b : blocks) {
+    b.lo = Vec2::Constant(std::numeric_limits<double>::infinity());
+    b.hi = -b.lo;
+  }
+  for (int y = 0; y < ny; ++y) {
+    for (int x = 0; x < nx; ++x) {
+      const Cell& c = cells[std::size_t(y) * nx + x];
+      if (c.count == 0) continue;
+      Cell& b = blocks[std::size_t(y / kBlock) * bx + x / kBlock];
+      b.lo = b.lo.cwiseMin(c.lo);
+      b.hi = b.hi.cwiseMax(c.hi);
+      b.depth.extend(c.depth.lo);
+      b.depth.extend(c.depth.hi);
+      b.box.extend(c.box.lo);
+      b.box.extend(c.box.hi);
+      b.count += c.count;
+    }
   }
 }
 
@@ -252,8 +276,8 @@ void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& 
   t.grid.origin = tlo - Vec2(margin_x, margin_y) * pixel;
   t.grid.width = int(std::ceil(span.x() / pixel)) + 2 * margin_x + 1;
   t.grid.height = int(std::ceil(span.y() / pixel)) + 2 * margin_y + 1;
-  t.fft_width = FftConvolver::fast_size(t.grid.width);
-  t.fft_height = FftConvolver::fast_size(t.grid.height);
+  t.fft_width = FftConvolver::transform_size(t.grid.width);
+  t.fft_height = FftConvolver::transform_size(t.grid.height);
   const double n = double(t.fft_width) * t.fft_height;
   t.cost = n * std::log2(std::max(2.0, n)) * (light.textured() ? 3 : 1) +
            30.0 * double(t.footprint_texels) + 20.0 * double(t.faces.size());
@@ -368,7 +392,7 @@ class Planner {
       }
       a.faces = surviving(t, near_polys);
       b.faces = surviving(t, far_polys);
-      out.push_back(evaluate_pair(std::move(a), std::move(b)));
+      out.push_back(pair(std::move(a), std::move(b)));
     }
     // Blocker space: two clusters either side of the median polygon centroid along the wider
     // axis of their tangent bounding box.
@@ -389,7 +413,7 @@ class Planner {
         Triple a = child_of(t, "blocker space"), b = child_of(t, "blocker space");
         a.faces = surviving(t, std::vector<int>(order.begin(), middle));
         b.faces = surviving(t, std::vector<int>(middle, order.end()));
-        out.push_back(evaluate_pair(std::move(a), std::move(b)));
+        out.push_back(pair(std::move(a), std::move(b)));
       }
     }
     // Receiver depth: two parts either side of the middle of the footprint's depths, blended over
@@ -401,18 +425,20 @@ class Planner {
       a.cuts.push_back({mid, band, true});
       b.cuts.push_back({mid, band, false});
       a.faces = b.faces = surviving(t, all);
-      out.push_back(evaluate_pair(std::move(a), std::move(b)));
+      out.push_back(pair(std::move(a), std::move(b)));
     }
+    // The candidates' children are independent of one another: evaluated on all threads.
+    tbb::parallel_for(std::size_t(0), 2 * out.size(), [&](std::size_t k) {
+      evaluate_triple(plan_, in_, out[k / 2][k % 2]);
+    });
     return out;
   }
 
-  std::vector<Triple> evaluate_pair(Triple a, Triple b) {
-    evaluate_triple(plan_, in_, a);
-    evaluate_triple(plan_, in_, b);
-    std::vector<Triple> pair;
-    pair.push_back(std::move(a));
-    pair.push_back(std::move(b));
-    return pair;
+  static std::vector<Triple> pair(Triple a, Triple b) {
+    std::vector<Triple> both;
+    both.push_back(std::move(a));
+    both.push_back(std::move(b));
+    return both;
   }
 
   ConvolutionPlan& plan_;
@@ -466,8 +492,9 @@ ConvolutionPlan plan_light_part(const ConvolutionPlan& base, const PlanInputs& i
   const bool splittable =
       d.shape == LightShape::rectangle && !part.part.textured() && level < kMaxLightSplits;
   if (worst <= in.error_texels || !splittable) return whole;
-  ConvolutionPlan halves = empty_like(base);
-  for (int side = 0; side < 2; ++side) {
+  // The halves are planned at once, on their own threads.
+  std::array<ConvolutionPlan, 2> half_plans;
+  tbb::parallel_for(0, 2, [&](int side) {
     LightDesc h = d;
     const double sign = side == 0 ? -0.5 : 0.5;
     if (d.width >= d.height) {
@@ -479,8 +506,11 @@ ConvolutionPlan plan_light_part(const ConvolutionPlan& base, const PlanInputs& i
     }
     h.power = 0.5 * d.power;
     LightPart half{part.light, part.name + "." + std::to_string(side), Light(h), 0.5 * part.fraction};
-    merge_plan(halves, plan_light_part(base, in, std::move(half), std::max(1, budget / 2), level + 1));
-  }
+    half_plans[std::size_t(side)] =
+        plan_light_part(base, in, std::move(half), std::max(1, budget / 2), level + 1);
+  });
+  ConvolutionPlan halves = empty_like(base);
+  for (ConvolutionPlan& h : half_plans) merge_plan(halves, std::move(h));
   return halves.worst_error_texels() < worst ? std::move(halves) : std::move(whole);
 }
 

@@ -131,7 +131,7 @@ struct FftConvolver::Impl {
   // The plans for a tw × th transform with the current thread count. The reference stays valid:
   // std::map nodes do not move, and plans are destroyed only with the convolver.
   const Plans& plans_for(int tw, int th) {
-    const PlanKey key{tw, th, threads.load()};
+    const PlanKey key{tw, th, FftConvolver::threaded(tw, th) ? threads.load() : 1};
     std::lock_guard lock(planner_mutex);
     auto found = plans.find(key);
     if (found != plans.end()) return found->second;
@@ -199,6 +199,20 @@ int FftConvolver::fast_size(int n) {
       while (rest % factor == 0) rest /= factor;
     if (rest == 1) return candidate;
   }
+}
+
+int FftConvolver::transform_size(int n) {
+  if (n <= 64) return fast_size(n);
+  int octave = 16;  // 2^a with 4·2^a >= 64
+  while (7 * octave < n) octave *= 2;
+  for (const int step : {4, 5, 6, 7})
+    if (step * octave >= n) return step * octave;
+  return 8 * octave;  // unreachable: 7·octave >= n
+}
+
+bool FftConvolver::threaded(int tw, int th) {
+  constexpr std::int64_t kThreadedPoints = 400 * 400;
+  return std::int64_t(tw) * std::int64_t(th) >= kThreadedPoints;
 }
 
 std::shared_ptr<const KernelSpectrum> FftConvolver::kernel_spectrum(

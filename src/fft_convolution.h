@@ -22,6 +22,17 @@ class FftConvolver {
   // The smallest size >= n whose prime factors are all 2, 3, 5 or 7 (sizes FFTW is fast at).
   static int fast_size(int n);
 
+  // The transform size for an image n pixels wide: fast_size up to 64, then the smallest of
+  // 2^a · {4, 5, 6, 7} / 4 >= n (at most 25 % padding). A few sizes per octave let the many
+  // images of a bake share FFTW plans, whose making (2–4 ms a pair) costs more than the
+  // transforms of a ~300² image (0.4 ms a round trip; tests/bench/fft_bench.cpp).
+  static int transform_size(int n);
+
+  // Whether a tw × th transform runs on several FFTW threads (set_threads) or on one: two
+  // threads slow transforms below ~400² down on 2 cores (fft_bench), so those run on one, and
+  // callers may run several such convolutions at once on their own threads.
+  static bool threaded(int tw, int th);
+
   // Spectrum of `kernel` (kw × kh floats, row-major, both odd; its centre pixel (kw/2, kh/2) is
   // the origin) for transforms of size tw × th (tw >= kw, th >= kh). Cached: a second call with
   // the same kernel values and sizes returns the same spectrum without transforming again.
@@ -37,7 +48,8 @@ class FftConvolver {
   void convolve(const std::vector<float>& image, int w, int h, const KernelSpectrum& kernel,
                 std::vector<float>& out);
 
-  // Number of FFTW threads used for one transform (default: all cores). Call before baking.
+  // Number of FFTW threads used for one threaded() transform (default: all cores). Call before
+  // baking.
   void set_threads(int threads);
 
   FftConvolver(const FftConvolver&) = delete;

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <memory>
 #include <random>
+#include <set>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -182,6 +183,29 @@ TEST(FftConvolution, FastSizeHasOnlyFactorsTwoThreeFiveSeven) {
   EXPECT_EQ(FftConvolver::fast_size(1021), 1024);
   EXPECT_EQ(FftConvolver::fast_size(1024), 1024);
   EXPECT_EQ(FftConvolver::fast_size(2113), 2160);  // 2^4 · 3^3 · 5
+}
+
+TEST(FftConvolution, TransformSizesAreFewPerOctaveAndPadAtMostAQuarter) {
+  EXPECT_EQ(FftConvolver::transform_size(11), 12);  // fast_size below 65
+  EXPECT_EQ(FftConvolver::transform_size(64), 64);
+  EXPECT_EQ(FftConvolver::transform_size(65), 80);
+  EXPECT_EQ(FftConvolver::transform_size(113), 128);
+  EXPECT_EQ(FftConvolver::transform_size(300), 320);
+  EXPECT_EQ(FftConvolver::transform_size(449), 512);
+  std::set<int> sizes;
+  for (int n = 65; n <= 4096; ++n) {
+    const int t = FftConvolver::transform_size(n);
+    ASSERT_GE(t, n);
+    ASSERT_LE(t, n + n / 4 + 1) << n;
+    ASSERT_EQ(FftConvolver::fast_size(t), t) << n;  // FFTW-friendly factors
+    sizes.insert(t);
+  }
+  EXPECT_LE(sizes.size(), 4u * 6u + 1u);  // 4 per octave from 64 to 4096
+}
+
+TEST(FftConvolution, SmallTransformsRunOnOneThread) {
+  EXPECT_FALSE(FftConvolver::threaded(320, 320));
+  EXPECT_TRUE(FftConvolver::threaded(512, 512));
 }
 
 TEST(FftConvolution, SingleThreadedPlansGiveSameResult) {
