@@ -168,6 +168,7 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
       in.max_triples = scene.bake.max_triples;
       in.combine = scene.bake.blocker_combine == "sum" ? BlockerCombine::sum
                                                        : BlockerCombine::product;
+      in.weighted = scene.bake.weighting == "irradiance";
       ConvolutionPlan plan;
       out.image = bake_convolution(spaces[r], in, &out.pairs, &plan);
       out.plan = describe_plan(plan);

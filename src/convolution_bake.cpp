@@ -116,6 +116,7 @@ struct LeafImages {
   std::array<std::vector<float>, 3> occluded;       // share of the nearest layer ⊛ kernel
   std::array<std::vector<float>, 3> occluded_full;  // whole image ⊛ kernel; empty if equal
   std::array<std::vector<float>, 2> moment;         // share ⊛ moment kernels (weighting)
+  std::array<std::vector<float>, 2> moment_full;    // whole ⊛ moment kernels, if whole differs
   int tw = 0, th = 0;
   int convolutions = 0;
   double seconds_source = 0, seconds_blocker = 0, seconds_fft = 0;
@@ -176,10 +177,11 @@ LeafImages convolve_leaf(const ConvolutionPlan& plan, const Triple& leaf, Blocke
       const auto spectrum = fft.kernel_spectrum(kernel.moments[m], kernel.width, kernel.height,
                                                 out.tw, out.th);
       fft.convolve(coverage, w, h, *spectrum, out.moment[m]);
+      if (!full.empty()) fft.convolve(full, w, h, *spectrum, out.moment_full[m]);
     }
   }
   out.seconds_fft = seconds_since(start);
-  out.convolutions = channels * (full.empty() ? 1 : 2) + (weighted ? 2 : 0);
+  out.convolutions = (channels + (weighted ? 2 : 0)) * (full.empty() ? 1 : 2);
   return out;
 }
 
@@ -230,13 +232,19 @@ void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const Leaf
       for (const ReceiverCut& c : leaf.cuts) wt *= c.weight(depth);
       if (wt <= 0) continue;
       const Vec2 at = leaf.grid.to_pixel(fr.tangent[i]);
-      // The moments' correction is the same for every channel (grey kernels only).
-      double first = 0, norm = 1;
+      // The moments' correction is the same for every channel (grey kernels only); the whole
+      // image takes it too, or the max rule would compare an irradiance-weighted share with an
+      // emission-weighted whole and keep the darker of two different quantities.
+      double first = 0, first_full = 0, norm = 1;
       if (weighted) {
         // O_w = Σ S·w·P / Σ S·w with w ≈ w0·(1 + g·(a, b)): the occluded irradiance fraction.
         const Vec2& g = gradient[i];
         first = g.x() * bilinear(images.moment[0], w, h, at) +
                 g.y() * bilinear(images.moment[1], w, h, at);
+        first_full = images.moment_full[0].empty()
+                         ? first
+                         : g.x() * bilinear(images.moment_full[0], w, h, at) +
+                               g.y() * bilinear(images.moment_full[1], w, h, at);
         norm = std::max(0.1, 1.0 + g.dot(kernel.centroid));
       }
       for (int c = 0; c < channels; ++c) {
@@ -248,7 +256,7 @@ void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const Leaf
           const double v = images.occluded_full[c].empty()
                                ? share
                                : bilinear(images.occluded_full[c], w, h, at);
-          whole = float(wt * std::clamp(v, 0.0, 1.0));
+          whole = float(wt * std::clamp((v + first_full) / norm, 0.0, 1.0));
         }
         // A grey kernel's one channel stands for all three.
         for (int out = kernel.grey ? 0 : c; out < (kernel.grey ? 3 : c + 1); ++out) {

@@ -31,6 +31,9 @@ struct BakeSettings {
   int max_image = 4096;
   int max_triples = 128;  // leaf triples per light: the convolution's work budget
   std::string blocker_combine = "sum";  // how blocker clusters combine: "product" or "sum"
+  // What the convolution's V averages the light's points by: "irradiance" (cos·cos/r², to first
+  // order across the light, as the reference) or "emission" (V_u, exact for parallel planes)
+  std::string weighting = "irradiance";
   // shadow-map baselines (pcf, pcss, adaptive-pcf, chun-oh, erosion): the shadow map's side in
   // pixels, PCF's fixed filter radius in shadow-map pixels, and how erosion turns the distance
   // to a hard-shadow edge into a shadow factor ("pcf" or "distance")

@@ -296,7 +296,7 @@ bool is_valid_object_name(std::string_view name) {
 Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::table& table) {
   TableReader r(file, table, "[bake]");
   r.check_known_keys({"resolution", "method", "quantity", "samples", "margin", "seed",
-                      "error_texels", "max_image", "max_triples", "blocker_combine", "shadow_map", "pcf_radius",
+                      "error_texels", "max_image", "max_triples", "blocker_combine", "weighting", "shadow_map", "pcf_radius",
                       "erosion_factor"});
   BakeSettings bake;
   const int int_max = std::numeric_limits<int>::max();
@@ -330,6 +330,13 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
       bake.blocker_combine = *v;
     } else {
       r.fail_got("blocker_combine", "\"product\" or \"sum\"");
+    }
+  }
+  if (auto v = r.string("weighting")) {
+    if (*v == "irradiance" || *v == "emission") {
+      bake.weighting = *v;
+    } else {
+      r.fail_got("weighting", "\"irradiance\" or \"emission\"");
     }
   }
   if (auto v = r.integer("max_triples", 1, 1 << 20)) bake.max_triples = static_cast<int>(*v);

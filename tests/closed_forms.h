@@ -95,3 +95,64 @@ inline double disk_light_unweighted_visibility(double x, double y, double bx, do
 }
 
 }  // namespace sb::closed_forms
+
+namespace sb::closed_forms {
+
+// ∫∫ h²/(s² + t² + h²)² over [0, a] × [0, b] (π times the form factor of that rectangle of a
+// light parallel to the receiver, seen from the receiver point under its corner at distance h):
+// the weight cos θ_light · cos θ_receiver / r² integrated in closed form. Odd in a and in b, so
+// any rectangle is four corners' sum (rectangle_weight).
+inline double corner_weight(double a, double b, double h) {
+  const double ra = std::sqrt(a * a + h * h), rb = std::sqrt(b * b + h * h);
+  return 0.5 * (a / ra * std::atan(b / ra) + b / rb * std::atan(a / rb));
+}
+
+// The weight of the light rectangle [x0, x1] × [y0, y1] seen from (x, y) at distance h below.
+inline double rectangle_weight(double x0, double x1, double y0, double y1, double x, double y,
+                               double h) {
+  if (x0 >= x1 || y0 >= y1) return 0.0;
+  x0 -= x, x1 -= x, y0 -= y, y1 -= y;
+  return corner_weight(x1, y1, h) - corner_weight(x0, y1, h) - corner_weight(x1, y0, h) +
+         corner_weight(x0, y0, h);
+}
+
+// V = H/H0 under the 0.5 m square light 1.5 m above the floor, blocker at height h: the light's
+// weight less that of its hidden part, exact.
+inline double square_light_weighted_visibility(double x, double y, double bx, double by,
+                                               double h) {
+  const HiddenSquare s = parallel_hidden_square(x, y, bx, by, h);
+  const double total = rectangle_weight(-0.25, 0.25, -0.25, 0.25, x, y, 1.5);
+  const double hidden = rectangle_weight(std::max(-0.25, s.cx - s.half), std::min(0.25, s.cx + s.half),
+                                         std::max(-0.25, s.cy - s.half), std::min(0.25, s.cy + s.half),
+                                         x, y, 1.5);
+  return 1.0 - hidden / total;
+}
+
+// V = H/H0 under a disk light of radius r in place of the square: exact along the light's y
+// (∫ dt/(A + t²)² in closed form), midpoint rule over its x in `steps` columns.
+inline double disk_light_weighted_visibility(double x, double y, double bx, double by, double h,
+                                             double r, int steps = 2000) {
+  const HiddenSquare s = parallel_hidden_square(x, y, bx, by, h);
+  const double d = 1.5;
+  // ∫ h²/(A + t²)² dt from t0 to t1, A = (sx − x)² + d².
+  auto column = [&](double A, double t0, double t1) {
+    if (t0 >= t1) return 0.0;
+    auto F = [&](double t) {
+      return t / (2 * A * (A + t * t)) + std::atan(t / std::sqrt(A)) / (2 * A * std::sqrt(A));
+    };
+    return d * d * (F(t1) - F(t0));
+  };
+  double total = 0, hidden = 0;
+  const double dx = 2 * r / steps;
+  for (int i = 0; i < steps; ++i) {
+    const double sx = -r + (i + 0.5) * dx;
+    const double half = std::sqrt(std::max(0.0, r * r - sx * sx));
+    const double A = (sx - x) * (sx - x) + d * d;
+    total += column(A, -half - y, half - y) * dx;
+    if (std::abs(sx - s.cx) < s.half)
+      hidden += column(A, std::max(-half, s.cy - s.half) - y, std::min(half, s.cy + s.half) - y) * dx;
+  }
+  return 1.0 - hidden / total;
+}
+
+}  // namespace sb::closed_forms

@@ -252,13 +252,14 @@ TEST_F(SceneFile, RejectsUnknownMethod) {
 TEST_F(SceneFile, ReadsAndChecksMethodSettings) {
   const Scene scene = load_ok(
       "[bake]\nerror_texels = 0.5\nmax_image = 2048\nmax_triples = 32\n"
-      "blocker_combine = \"product\"\nshadow_map = 1024\npcf_radius = 3\n"
+      "blocker_combine = \"product\"\nweighting = \"emission\"\nshadow_map = 1024\npcf_radius = 3\n"
       "erosion_factor = \"distance\"\n" +
       object_floor + light_panel);
   EXPECT_EQ(scene.bake.error_texels, 0.5);
   EXPECT_EQ(scene.bake.max_image, 2048);
   EXPECT_EQ(scene.bake.max_triples, 32);
   EXPECT_EQ(scene.bake.blocker_combine, "product");
+  EXPECT_EQ(scene.bake.weighting, "emission");
   EXPECT_EQ(scene.bake.shadow_map, 1024);
   EXPECT_EQ(scene.bake.pcf_radius, 3.0);
   EXPECT_EQ(scene.bake.erosion_factor, "distance");
@@ -266,6 +267,8 @@ TEST_F(SceneFile, ReadsAndChecksMethodSettings) {
                "[bake]", "'error_texels' must be a number > 0");
   expect_error("[bake]\nblocker_combine = \"max\"\n" + object_floor + light_panel,
                "blocker_combine", "[bake]", "'blocker_combine' must be \"product\" or \"sum\"");
+  expect_error("[bake]\nweighting = \"area\"\n" + object_floor + light_panel, "weighting",
+               "[bake]", "'weighting' must be \"irradiance\" or \"emission\"");
   expect_error("[bake]\nerosion_factor = 2\n" + object_floor + light_panel, "erosion_factor",
                "[bake]", "'erosion_factor' must be a string");
   expect_error("[bake]\nmax_image = 10\n" + object_floor + light_panel, "max_image", "[bake]",
