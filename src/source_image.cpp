@@ -140,7 +140,6 @@ SourceKernel source_kernel(const Light& light, const ProjectionFrame& frame,
   const Vec2 sv(axis_v.dot(frame.e1), axis_v.dot(frame.e2));
   const double da = extent_u / nu, db = extent_v / nv;
   const bool uniform = light.shape() == LightShape::sphere || !light.textured();
-  const Vec3 flat = light.shape() == LightShape::sphere ? Vec3(Vec3::Ones()) : light.tint(Vec2(0, 0));
   for (int j = 0; j < nv; ++j) {
     const double b = ((j + 0.5) / nv - 0.5) * extent_v;
     for (int i = 0; i < nu; ++i) {
@@ -191,8 +190,6 @@ SourceKernel source_kernel(const Light& light, const ProjectionFrame& frame,
   }
   if (uniform) {
     for (int c = 1; c < 3; ++c) acc[c] = acc[0];
-    for (int c = 0; c < 3; ++c)
-      if (flat[c] <= 0) std::fill(acc[c].begin(), acc[c].end(), 0.0);
   }
   for (int c = 0; c < 3; ++c) {
     double sum = 0;
