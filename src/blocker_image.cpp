@@ -52,6 +52,16 @@ struct Edges {
       if (e.x() * px + e.y() * py + e.z() < 0) return false;
     return true;
   }
+  // Like contains, but a point on an edge belongs to one side only (the usual top-left rule,
+  // by the sign of the edge's normal): two polygons sharing an edge with opposite windings
+  // never both hold it, so parities of overlapping polygons count each crossing once.
+  bool contains_once(double px, double py) const {
+    for (const Vec3& e : lines) {
+      const double v = e.x() * px + e.y() * py + e.z();
+      if (v < 0 || (v == 0 && !(e.x() > 0 || (e.x() == 0 && e.y() > 0)))) return false;
+    }
+    return true;
+  }
   // Pixel [x, x+1] × [y, y+1] from its corners: −1 wholly outside one edge, +1 wholly inside
   // every edge, 0 straddling (needs samples).
   int classify(int x, int y) const {
@@ -239,19 +249,26 @@ std::vector<float> nearest_layer_coverage(const ProjectedBlockers& layer,
   return coverage;
 }
 
-std::vector<float> blocker_coverage(const ProjectedBlockers& blockers, const TangentGrid& grid) {
+std::vector<float> blocker_coverage(const ProjectedBlockers& blockers, const TangentGrid& grid,
+                                    const ProjectedBlockers* section) {
   const int w = grid.width, h = grid.height;
   std::vector<float> coverage(std::size_t(w) * h, 0.0f);
-  std::vector<PixelPolygon> rasters;
-  rasters.reserve(blockers.polygons.size());
-  for (const auto& pg : blockers.polygons) {
-    PixelPolygon r{Edges({}), 0, 0, 0, 0};
-    if (to_pixels(pg, grid, &r)) rasters.push_back(std::move(r));
-  }
+  auto rasterise = [&](const ProjectedBlockers& from) {
+    std::vector<PixelPolygon> out;
+    out.reserve(from.polygons.size());
+    for (const auto& pg : from.polygons) {
+      PixelPolygon r{Edges({}), 0, 0, 0, 0};
+      if (to_pixels(pg, grid, &r)) out.push_back(std::move(r));
+    }
+    return out;
+  };
+  const std::vector<PixelPolygon> rasters = rasterise(blockers);
+  const std::vector<PixelPolygon> crossings =
+      section ? rasterise(*section) : std::vector<PixelPolygon>{};
 
   constexpr int kBand = 16;
   tbb::parallel_for(tbb::blocked_range<int>(0, (h + kBand - 1) / kBand), [&](const auto& bands) {
-    std::vector<std::uint16_t> masks;
+    std::vector<std::uint16_t> masks, parity;
     for (int band = bands.begin(); band != bands.end(); ++band) {
       const int row0 = band * kBand, row1 = std::min(h, row0 + kBand);
       masks.assign(std::size_t(row1 - row0) * w, 0);
@@ -280,6 +297,31 @@ std::vector<float> blocker_coverage(const ProjectedBlockers& blockers, const Tan
             mask |= bits;
           }
         }
+      }
+      // The section: a sample is inside the solid at the section's depth when its ray from the
+      // light's centre has crossed the solid's surface an odd number of times before it.
+      if (!crossings.empty()) {
+        parity.assign(masks.size(), 0);
+        for (const PixelPolygon& r : crossings) {
+          const int y0 = std::max(r.y0, row0), y1 = std::min(r.y1, row1 - 1);
+          for (int y = y0; y <= y1; ++y) {
+            for (int x = r.x0; x <= r.x1; ++x) {
+              const int cls = r.edges.classify(x, y);
+              if (cls < 0) continue;
+              std::uint16_t bits = 0xFFFF;
+              if (cls == 0) {
+                bits = 0;
+                for (int k = 0; k < kSamplesPerSide * kSamplesPerSide; ++k) {
+                  if (r.edges.contains_once(x + (k % kSamplesPerSide + 0.5) / kSamplesPerSide,
+                                            y + (k / kSamplesPerSide + 0.5) / kSamplesPerSide))
+                    bits |= std::uint16_t(1u << k);
+                }
+              }
+              parity[std::size_t(y - row0) * w + x] ^= bits;
+            }
+          }
+        }
+        for (std::size_t i = 0; i < masks.size(); ++i) masks[i] |= parity[i];
       }
       for (int y = row0; y < row1; ++y)
         for (int x = 0; x < w; ++x)

@@ -69,6 +69,13 @@ std::vector<float> nearest_layer_coverage(const ProjectedBlockers& layer,
 
 // Fraction of each grid pixel covered by the union of the polygons, from 4 × 4 sample points per
 // pixel (exact where a pixel is wholly inside or outside a polygon). Row-major, width × height.
-std::vector<float> blocker_coverage(const ProjectedBlockers& blockers, const TangentGrid& grid);
+// With `section`, the union also takes the section of a closed solid at one depth: the samples
+// whose ray from the light's centre crosses the section's polygons (the solid's whole surface
+// clipped to depths before it, unculled) an odd number of times, i.e. enters the solid and has
+// not left it. A slab of a solid then projects as the solid, not as the open shell of its faces
+// (its far cap is never needed: from the light, a slab's inside is seen through its near cap or
+// its faces).
+std::vector<float> blocker_coverage(const ProjectedBlockers& blockers, const TangentGrid& grid,
+                                    const ProjectedBlockers* section = nullptr);
 
 }  // namespace sb

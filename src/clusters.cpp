@@ -63,6 +63,29 @@ std::vector<Vec3> convex_hull_vertices(const std::vector<Vec3>& points) {
   return hull;
 }
 
+// An edge by the positions of its ends, lower first, on a grid of `quantum` metres: the same for
+// both halfedges, and for the copies of an edge on either side of a seam of split vertices,
+// whose positions may differ in the last bits (a sphere's seam at longitude 0 and 2π).
+using EdgeKey = std::array<std::int64_t, 6>;
+EdgeKey edge_key(const TriMesh& mesh, OpenMesh::HalfedgeHandle h, double quantum) {
+  const auto& p = mesh.point(mesh.from_vertex_handle(h));
+  const auto& q = mesh.point(mesh.to_vertex_handle(h));
+  std::array<std::int64_t, 3> a, b;
+  for (int k = 0; k < 3; ++k) {
+    a[k] = std::llround(p[k] / quantum);
+    b[k] = std::llround(q[k] / quantum);
+  }
+  if (b < a) std::swap(a, b);
+  return {a[0], a[1], a[2], b[0], b[1], b[2]};
+}
+
+// The grid for edge_key: a millionth of the mesh's bounding-box diagonal.
+double weld_quantum(const TriMesh& mesh) {
+  Bounds3 box;
+  for (auto v : mesh.vertices()) box.extend(to_vec(mesh.point(v)));
+  return std::max(1e-6 * box.diagonal(), 1e-12);
+}
+
 // Per face (by idx()), its connected component: CGAL's components, where faces meet when they
 // share an edge, then joined across seams. Imported meshes split vertices wherever UVs or
 // normals jump (a box's six sides, a sphere's UV seam), which cuts one object into pieces that
@@ -81,16 +104,11 @@ std::vector<int> face_components(const TriMesh& mesh, int* count) {
     while (parent[i] != i) i = parent[i] = parent[parent[i]];
     return i;
   };
-  std::map<std::array<double, 6>, std::size_t> piece_of_edge;  // endpoints, lower first
+  std::map<EdgeKey, std::size_t> piece_of_edge;
+  const double quantum = weld_quantum(mesh);
   for (auto h : mesh.halfedges()) {
     if (mesh.is_boundary(h)) continue;
-    const auto& p = mesh.point(mesh.from_vertex_handle(h));
-    const auto& q = mesh.point(mesh.to_vertex_handle(h));
-    const bool p_first =
-        std::lexicographical_compare(p.data(), p.data() + 3, q.data(), q.data() + 3);
-    const auto& a = p_first ? p : q;
-    const auto& b = p_first ? q : p;
-    const std::array<double, 6> key = {a[0], a[1], a[2], b[0], b[1], b[2]};
+    const EdgeKey key = edge_key(mesh, h, quantum);
     const std::size_t piece = component[mesh.face_handle(h)];
     const auto [it, inserted] = piece_of_edge.emplace(key, piece);
     if (!inserted) parent[find(piece)] = find(it->second);
@@ -214,6 +232,17 @@ bool component_is_convex(const ClusterTree& tree, int root, const TriMesh& mesh)
   return true;
 }
 
+// Closed when every edge, keyed by its end positions (seams of split vertices join), borders
+// exactly two of the component's faces.
+bool component_is_closed(const TriMesh& mesh, const std::vector<int>& faces, double quantum) {
+  std::map<EdgeKey, int> edge_faces;
+  for (int f : faces) {
+    for (auto h : mesh.fh_range(mesh.face_handle(f))) ++edge_faces[edge_key(mesh, h, quantum)];
+  }
+  return !edge_faces.empty() &&
+         std::all_of(edge_faces.begin(), edge_faces.end(), [](const auto& e) { return e.second == 2; });
+}
+
 }  // namespace
 
 void Cluster::depth_range(const Vec3& origin, const Vec3& axis, double* lo, double* hi) const {
@@ -232,6 +261,7 @@ ClusterTree build_clusters(const std::vector<const Mesh*>& meshes, int leaf_face
   ClusterTree tree;
   tree.face_component.resize(meshes.size());
   tree.component_convex.resize(meshes.size());
+  tree.component_closed.resize(meshes.size());
   for (std::size_t m = 0; m < meshes.size(); ++m) {
     assert(meshes[m] != nullptr);
     const TriMesh& mesh = meshes[m]->mesh;
@@ -241,7 +271,10 @@ ClusterTree build_clusters(const std::vector<const Mesh*>& meshes, int leaf_face
     for (auto f : mesh.faces()) component_faces[tree.face_component[m][f.idx()]].push_back(f.idx());
 
     TreeBuilder builder(tree, mesh, static_cast<int>(m), leaf_faces);
+    const double quantum = weld_quantum(mesh);
     for (int c = 0; c < count; ++c) {
+      tree.component_closed[m].push_back(
+          component_is_closed(mesh, component_faces[c], quantum) ? 1 : 0);
       const int root = builder.build(c, std::move(component_faces[c]));
       tree.roots.push_back(root);
       tree.component_convex[m].push_back(component_is_convex(tree, root, mesh) ? 1 : 0);

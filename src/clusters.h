@@ -41,6 +41,10 @@ struct ClusterTree {
   // shadow itself beyond its own horizon, which H0 already accounts for; a single planar patch is
   // convex.
   std::vector<std::vector<std::uint8_t>> component_convex;
+  // Per mesh, per component: whether it is closed (watertight): every edge, by its two end
+  // positions so that seams of split vertices count as joined, has exactly two faces. A closed
+  // component bounds a solid, so a slab of it can be capped (convolution_plan.cpp).
+  std::vector<std::vector<std::uint8_t>> component_closed;
 };
 
 // Builds the hierarchy. Leaves hold at most `leaf_faces` faces; an inner node splits its faces

@@ -37,6 +37,7 @@
 #include <algorithm>
 #include <array>
 #include <limits>
+#include <map>
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -135,28 +136,44 @@ LeafImages convolve_leaf(const ConvolutionPlan& plan, const Triple& leaf, Blocke
   const SourceKernel& kernel = out.kernel;
   out.seconds_source = seconds_since(start);
   start = Clock::now();
-  // This cluster's share of the root layer's hard shadow (nearest_layer_coverage).
-  std::vector<std::uint8_t> mine(leaf.layer->polygons.size(), 0);
-  {
-    std::vector<std::pair<const Mesh*, int>> own;
-    for (const FaceRef& f : leaf.faces) own.emplace_back(f.mesh, f.face);
-    std::sort(own.begin(), own.end());
-    const Triple* root = &leaf;
-    while (root->parent >= 0) root = &plan.triples[std::size_t(root->parent)];
-    for (std::size_t i = 0; i < mine.size(); ++i) {
-      const FaceRef& f = root->faces[std::size_t(leaf.layer->polygons[i].source)];
-      mine[i] = std::binary_search(own.begin(), own.end(), std::make_pair(f.mesh, f.face));
+  // A closed solid's surface clipped to depths before `depth`, unculled: the crossings whose
+  // parity gives its section there (blocker_coverage).
+  auto crossings = [&](double depth) {
+    return project_faces(*leaf.solid_faces, fr.frame, fr.near, depth, ShadowCaster{});
+  };
+  std::vector<float> coverage, full;
+  if (leaf.section) {
+    const ProjectedBlockers before = crossings(leaf.slab_lo);
+    coverage = blocker_coverage(ProjectedBlockers{}, leaf.grid, &before);
+  } else {
+    // This cluster's share of the root layer's hard shadow (nearest_layer_coverage).
+    std::vector<std::uint8_t> mine(leaf.layer->polygons.size(), 0);
+    {
+      std::vector<std::pair<const Mesh*, int>> own;
+      for (const FaceRef& f : leaf.faces) own.emplace_back(f.mesh, f.face);
+      std::sort(own.begin(), own.end());
+      const Triple* root = &leaf;
+      while (root->parent >= 0) root = &plan.triples[std::size_t(root->parent)];
+      for (std::size_t i = 0; i < mine.size(); ++i) {
+        const FaceRef& f = root->faces[std::size_t(leaf.layer->polygons[i].source)];
+        mine[i] = std::binary_search(own.begin(), own.end(), std::make_pair(f.mesh, f.face));
+      }
     }
-  }
-  const std::vector<float> coverage =
-      nearest_layer_coverage(*leaf.layer, mine, leaf.slab_lo, leaf.slab_hi, leaf.grid);
-  std::vector<float> full;
-  if (combine == BlockerCombine::sum) {
-    full = blocker_coverage(leaf.blockers, leaf.grid);
-    // Nothing of the cluster hidden behind others: its full image is its share.
-    bool hidden = false;
-    for (std::size_t i = 0; i < full.size() && !hidden; ++i) hidden = full[i] > coverage[i] + 1e-6f;
-    if (!hidden) full.clear();
+    coverage = nearest_layer_coverage(*leaf.layer, mine, leaf.slab_lo, leaf.slab_hi, leaf.grid);
+    if (combine == BlockerCombine::sum) {
+      // A slab of a closed solid is capped by the solid's section at its near side, so that its
+      // whole image is the solid slab's projection rather than the ring of its faces.
+      if (leaf.solid_faces) {
+        const ProjectedBlockers before = crossings(leaf.slab_lo);
+        full = blocker_coverage(leaf.blockers, leaf.grid, &before);
+      } else {
+        full = blocker_coverage(leaf.blockers, leaf.grid);
+      }
+      // Nothing of the cluster hidden behind others: its full image is its share.
+      bool hidden = false;
+      for (std::size_t i = 0; i < full.size() && !hidden; ++i) hidden = full[i] > coverage[i] + 1e-6f;
+      if (!hidden) full.clear();
+    }
   }
   out.seconds_blocker = seconds_since(start);
   start = Clock::now();
@@ -190,7 +207,7 @@ LeafImages convolve_leaf(const ConvolutionPlan& plan, const Triple& leaf, Blocke
 void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const LeafImages& images,
                      BlockerCombine combine, const std::vector<Vec2>& gradient,
                      std::vector<Vec3f>& occlusion, std::vector<Vec3f>& largest,
-                     PairReport& report) {
+                     std::vector<Vec3f>* euler, PairReport& report) {
   const PlanFrame& fr = plan.frames[leaf.frame];
   const SourceKernel& kernel = images.kernel;
   report.seconds_source += images.seconds_source;
@@ -250,6 +267,11 @@ void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const Leaf
       for (int c = 0; c < channels; ++c) {
         const double share = bilinear(images.occluded[c], w, h, at);
         const double o = std::clamp((share + first) / norm, 0.0, 1.0);
+        if (leaf.section) {
+          for (int out = kernel.grey ? 0 : c; out < (kernel.grey ? 3 : c + 1); ++out)
+            (*euler)[i][out] -= float(wt * o);
+          continue;
+        }
         const double f = combine == BlockerCombine::sum ? o : -std::log(std::max(1e-6, 1.0 - o));
         float whole = 0;
         if (with_full) {
@@ -262,6 +284,7 @@ void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const Leaf
         for (int out = kernel.grey ? 0 : c; out < (kernel.grey ? 3 : c + 1); ++out) {
           occlusion[i][out] += float(wt * f);
           if (with_full) largest[i][out] = std::max(largest[i][out], whole);
+          if (euler) (*euler)[i][out] += whole;
         }
       }
     }
@@ -304,11 +327,15 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
     report.seconds_configure = f == 0 ? plan_seconds : 0;
     std::vector<Vec3f> occlusion(fr.texels.size(), Vec3f::Zero());
     std::vector<Vec3f> largest(fr.texels.size(), Vec3f::Zero());
+    // Per convex solid (by the triple heading its slabs): Euler's count of the lines it blocks.
+    std::map<int, std::vector<Vec3f>> euler;
     const std::vector<Vec2> gradient =
         in.weighted ? weight_gradients(fr, space, lp.part) : std::vector<Vec2>{};
     std::vector<std::size_t> leaves;
     for (std::size_t t = 0; t < plan.triples.size(); ++t) {
       const Triple& tr = plan.triples[t];
+      // Sections count only in the sum's Euler counts.
+      if (tr.section && in.combine != BlockerCombine::sum) continue;
       if (tr.frame == int(f) && tr.children.empty() && !tr.empty) leaves.push_back(t);
     }
     // Leaves are convolved in parallel, a batch at a time (their images held until added), with
@@ -339,8 +366,13 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
       for (std::size_t b = first; b < last; ++b) {
         Triple& tr = plan.triples[leaves[b]];
         const auto leaf_start = Clock::now();
+        std::vector<Vec3f>* count = nullptr;
+        if (tr.euler >= 0 && in.combine == BlockerCombine::sum) {
+          count = &euler[tr.euler];
+          if (count->empty()) count->assign(fr.texels.size(), Vec3f::Zero());
+        }
         accumulate_leaf(plan, tr, images[b - first], in.combine, gradient, occlusion, largest,
-                        report);
+                        count, report);
         images[b - first] = LeafImages{};
         tr.seconds = seconds[b - first] + seconds_since(leaf_start);
         ++report.triples;
@@ -378,8 +410,9 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
     for (std::size_t i = 0; i < fr.texels.size(); ++i) {
       Vec3f v;
       for (int c = 0; c < 3; ++c) {
-        v[c] = in.combine == BlockerCombine::sum
-                   ? std::clamp(1.0f - std::max(occlusion[i][c], largest[i][c]), 0.0f, 1.0f)
+        float o = std::max(occlusion[i][c], largest[i][c]);
+        for (const auto& [top, count] : euler) o = std::max(o, count[i][c]);
+        v[c] = in.combine == BlockerCombine::sum ? std::clamp(1.0f - o, 0.0f, 1.0f)
                                                  : std::exp(-occlusion[i][c]);
       }
       vis[fr.texels[i]] += fraction * v;

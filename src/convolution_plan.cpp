@@ -37,6 +37,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 #include <queue>
 #include <tuple>
 
@@ -285,6 +286,21 @@ void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& 
 
 namespace {
 
+// A new child of `parent`, made by `split`: same frame, group, slab, cuts and layer, to be
+// narrowed by the caller and evaluated.
+Triple child_of(const Triple& parent, const char* split) {
+  Triple c;
+  c.frame = parent.frame;
+  c.group = parent.group;
+  c.split = split;
+  c.slab_lo = parent.slab_lo;
+  c.slab_hi = parent.slab_hi;
+  c.cuts = parent.cuts;
+  c.layer = parent.layer;
+  c.receiver_box = parent.receiver_box;
+  return c;
+}
+
 class Planner {
  public:
   Planner(ConvolutionPlan& plan, const PlanInputs& in) : plan_(plan), in_(in) {}
@@ -346,19 +362,6 @@ class Planner {
            plan_.triples[t].penumbra_error_texels > in_.error_texels * (1 + 1e-9);
   }
 
-  Triple child_of(const Triple& parent, const char* split) const {
-    Triple c;
-    c.frame = parent.frame;
-    c.group = parent.group;
-    c.split = split;
-    c.slab_lo = parent.slab_lo;
-    c.slab_hi = parent.slab_hi;
-    c.cuts = parent.cuts;
-    c.layer = parent.layer;
-    c.receiver_box = parent.receiver_box;
-    return c;
-  }
-
   // The faces of the parent that kept a polygon (the others were culled or clipped away).
   std::vector<FaceRef> surviving(const Triple& t, const std::vector<int>& polygons) const {
     std::vector<FaceRef> faces;
@@ -394,8 +397,10 @@ class Planner {
       b.faces = surviving(t, far_polys);
       out.push_back(pair(std::move(a), std::move(b)));
     }
-    // Blocker space: two clusters either side of the median polygon centroid along the wider
-    // axis of their tangent bounding box.
+    // Blocker space: two clusters either side of the median centroid along the wider axis of
+    // their tangent bounding box. Polygons of several connected components are split by whole
+    // components (at the median of the components' centroids), so that each side keeps whole
+    // solids, which add_sections can cap; polygons of one component by polygon centroids.
     if (polys.size() >= 2) {
       std::vector<Vec2> centroid(polys.size());
       Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
@@ -405,14 +410,52 @@ class Planner {
         hi = hi.cwiseMax(centroid[i]);
       }
       const int axis = (hi - lo).x() >= (hi - lo).y() ? 0 : 1;
-      if (hi[axis] > lo[axis]) {
+      // Per polygon, its component's index among those present.
+      std::vector<int> part(polys.size(), 0);
+      std::vector<Vec2> part_centroid;
+      if (in_.clusters) {
+        std::map<std::pair<const Mesh*, int>, int> index;
+        std::vector<int> count;
+        for (std::size_t i = 0; i < polys.size(); ++i) {
+          const FaceRef& f = t.faces[std::size_t(polys[i].source)];
+          const auto m = std::find(in_.blockers.begin(), in_.blockers.end(), f.mesh);
+          if (m == in_.blockers.end()) continue;
+          const int c = in_.clusters->face_component[std::size_t(m - in_.blockers.begin())]
+                                                    [std::size_t(f.face)];
+          const auto [it, added] = index.emplace(std::pair(f.mesh, c), int(count.size()));
+          if (added) {
+            count.push_back(0);
+            part_centroid.push_back(Vec2::Zero());
+          }
+          part[i] = it->second;
+          ++count[std::size_t(it->second)];
+          part_centroid[std::size_t(it->second)] += centroid[i];
+        }
+        for (std::size_t k = 0; k < count.size(); ++k) part_centroid[k] /= double(count[k]);
+      }
+      std::vector<int> near_side, far_side;
+      if (part_centroid.size() >= 2) {
+        std::vector<int> parts(part_centroid.size());
+        for (std::size_t k = 0; k < parts.size(); ++k) parts[k] = int(k);
+        const auto middle = parts.begin() + std::ptrdiff_t(parts.size() / 2);
+        std::nth_element(parts.begin(), middle, parts.end(), [&](int a, int b) {
+          return part_centroid[std::size_t(a)][axis] < part_centroid[std::size_t(b)][axis];
+        });
+        std::vector<std::uint8_t> first(parts.size(), 0);
+        for (auto it = parts.begin(); it != middle; ++it) first[std::size_t(*it)] = 1;
+        for (int p : all) (first[std::size_t(part[std::size_t(p)])] ? near_side : far_side).push_back(p);
+      } else if (hi[axis] > lo[axis]) {
         std::vector<int> order = all;
         const auto middle = order.begin() + std::ptrdiff_t(order.size() / 2);
         std::nth_element(order.begin(), middle, order.end(),
                          [&](int a, int b) { return centroid[a][axis] < centroid[b][axis]; });
+        near_side.assign(order.begin(), middle);
+        far_side.assign(middle, order.end());
+      }
+      if (!near_side.empty() && !far_side.empty()) {
         Triple a = child_of(t, "blocker space"), b = child_of(t, "blocker space");
-        a.faces = surviving(t, std::vector<int>(order.begin(), middle));
-        b.faces = surviving(t, std::vector<int>(middle, order.end()));
+        a.faces = surviving(t, near_side);
+        b.faces = surviving(t, far_side);
         out.push_back(pair(std::move(a), std::move(b)));
       }
     }
@@ -446,6 +489,98 @@ class Planner {
 };
 
 }  // namespace
+
+void add_sections(ConvolutionPlan& plan, const PlanInputs& in) {
+  if (!in.clusters) return;
+  const ClusterTree& tree = *in.clusters;
+  std::map<const Mesh*, int> mesh_index;
+  for (std::size_t m = 0; m < in.blockers.size(); ++m) mesh_index.emplace(in.blockers[m], int(m));
+  using Component = std::pair<int, int>;  // (mesh, connected component)
+  std::map<Component, int> root_of;       // its cluster tree's root node
+  for (int r : tree.roots) root_of.emplace(Component(tree.nodes[r].mesh, tree.nodes[r].component), r);
+  auto component_of = [&](const FaceRef& f) {
+    const int m = mesh_index.at(f.mesh);
+    return Component(m, tree.face_component[std::size_t(m)][std::size_t(f.face)]);
+  };
+  std::map<int, std::shared_ptr<const std::vector<FaceRef>>> solid_faces;  // by root node
+
+  // A triple is complete when it holds every face of each component it touches that meets its
+  // slab: a root holding whole components, and its descendants, except where a blocker-space
+  // split shares a component between its two sides. Parents come before children in `triples`.
+  const std::size_t n = plan.triples.size();
+  std::vector<std::uint8_t> complete(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    Triple& t = plan.triples[i];
+    std::map<Component, std::size_t> count;
+    for (const FaceRef& f : t.faces) ++count[component_of(f)];
+    if (t.parent < 0) {
+      complete[i] = std::all_of(count.begin(), count.end(), [&](const auto& c) {
+        return c.second == tree.nodes[std::size_t(root_of.at(c.first))].faces.size();
+      });
+    } else {
+      const Triple& parent = plan.triples[std::size_t(t.parent)];
+      complete[i] = complete[std::size_t(t.parent)];
+      if (complete[i] && parent.split == "blocker space") {
+        for (int sibling : parent.children) {
+          if (sibling == int(i)) continue;
+          for (const FaceRef& f : plan.triples[std::size_t(sibling)].faces)
+            if (count.count(component_of(f))) complete[i] = 0;
+        }
+      }
+    }
+    if (!complete[i] || count.size() != 1) continue;
+    const auto [m, c] = count.begin()->first;
+    if (!tree.component_closed[std::size_t(m)][std::size_t(c)]) continue;
+    const int root = root_of.at(Component(m, c));
+    const PlanFrame& fr = plan.frames[std::size_t(t.frame)];
+    double lo = 0, hi = 0;
+    tree.nodes[std::size_t(root)].depth_range(fr.frame.origin, fr.frame.axis, &lo, &hi);
+    // A section counts crossings from the light's side: the solid must lie wholly before it.
+    if (!(lo > fr.near)) continue;
+    auto& faces = solid_faces[root];
+    if (!faces) {
+      auto all = std::make_shared<std::vector<FaceRef>>();
+      for (int f : tree.nodes[std::size_t(root)].faces) all->push_back({in.blockers[std::size_t(m)], f});
+      faces = std::move(all);
+    }
+    t.solid_faces = faces;
+  }
+
+  // Euler's count for a convex solid: a line meets it in one interval, which touches k
+  // consecutive slabs and crosses the k − 1 sections between them inside the solid, so
+  // Σ slabs − Σ sections is 1 for a line that meets the solid and 0 for one that misses it.
+  for (std::size_t top = 0; top < n; ++top) {
+    const Triple& t = plan.triples[top];
+    if (!t.solid_faces || t.children.empty()) continue;
+    if (t.parent >= 0 && plan.triples[std::size_t(t.parent)].solid_faces) continue;
+    const auto [m, c] = component_of(t.solid_faces->front());
+    if (!tree.component_convex[std::size_t(m)][std::size_t(c)]) continue;
+    std::vector<int> subtree = {int(top)};
+    bool whole = true;
+    for (std::size_t k = 0; k < subtree.size() && whole; ++k) {
+      const Triple& s = plan.triples[std::size_t(subtree[k])];
+      if (!s.empty && !s.solid_faces) whole = false;
+      for (int child : s.children) subtree.push_back(child);
+    }
+    if (!whole) continue;
+    for (int s : subtree) plan.triples[std::size_t(s)].euler = int(top);
+    for (int s : subtree) {
+      if (plan.triples[std::size_t(s)].split != "blocker depth") continue;
+      const Triple& split = plan.triples[std::size_t(s)];
+      Triple section = child_of(split, "");
+      section.parent = s;
+      section.slab_lo = section.slab_hi = plan.triples[std::size_t(split.children[0])].slab_hi;
+      section.faces = split.faces;
+      section.solid_faces = split.solid_faces;
+      section.euler = int(top);
+      section.section = true;
+      evaluate_triple(plan, in, section);
+      if (section.empty) continue;
+      plan.triples[std::size_t(s)].children.push_back(int(plan.triples.size()));
+      plan.triples.push_back(std::move(section));
+    }
+  }
+}
 
 namespace {
 
@@ -487,6 +622,7 @@ ConvolutionPlan plan_light_part(const ConvolutionPlan& base, const PlanInputs& i
   whole.light_parts.push_back(part);
   add_frames(whole, in, 0);
   Planner(whole, in).refine(0, whole.frames.size(), budget);
+  add_sections(whole, in);
   const double worst = whole.worst_error_texels();
   const LightDesc& d = part.part.desc();
   const bool splittable =

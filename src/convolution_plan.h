@@ -98,6 +98,16 @@ struct Triple {
   std::int64_t footprint_texels = 0;
   int polygons = 0;
   double seconds = 0;  // measured by the bake (0 in a plan)
+  // A slab of a closed solid (add_sections): the triple's blockers are all of one closed
+  // component's faces within its slab, so its whole image is capped by the component's section
+  // at slab_lo; every face of the component, for that section.
+  std::shared_ptr<const std::vector<FaceRef>> solid_faces;
+  // Slabs of one convex solid count the lines from a texel to the light that meet it by Euler's
+  // count (convolution_bake.cpp): `euler` is the triple heading their depth splits (-1: none);
+  // a `section` leaf is the solid's section at its slab (slab_lo = slab_hi) between two of them,
+  // subtracted.
+  int euler = -1;
+  bool section = false;
 };
 
 // A uniform grid over tangent coordinates holding texel indices, so a footprint's texels are
@@ -234,6 +244,10 @@ ConvolutionPlan plan_convolution(const TexelSpace& space, const PlanInputs& in);
 // Appends to `plan` the frames, texel groups and evaluated root triples of its light part
 // `light_part` (plan_frames.cpp; used by plan_convolution).
 void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part);
+
+// Marks the triples of `plan` that are slabs of closed solids and adds, under every depth split
+// of a convex one, the section leaf at the split's depth (used by plan_convolution).
+void add_sections(ConvolutionPlan& plan, const PlanInputs& in);
 
 // Evaluates one triple in place (used by the planner; exposed for tests).
 void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& triple);

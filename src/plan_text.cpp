@@ -11,7 +11,7 @@ namespace {
 void describe_triple(const ConvolutionPlan& plan, int index, int indent, std::string& out) {
   const Triple& t = plan.triples[index];
   std::string line(std::size_t(indent) * 2, ' ');
-  line += t.parent < 0 ? "root" : plan.triples[t.parent].split;
+  line += t.parent < 0 ? "root" : t.section ? "solid section, subtracted" : plan.triples[t.parent].split;
   char buf[512];
   if (t.empty) {
     std::snprintf(buf, sizeof buf, ": %zu faces, nothing to convolve\n", t.faces.size());
