@@ -24,6 +24,16 @@
 // O = max(Σ O_share, max O_whole) (a union is at least as large as any of its sets). The
 // second convolution is skipped for clusters that nothing hides.
 //
+// Neither holds the light that a thick solid hides from off-centre light points only: rays that
+// enter a post through a side the light's centre does not see. For a convex closed solid
+// (add_sections) the plan keeps its slabs together: each slab's whole image is capped by the
+// solid's section at its near depth (the solid slab's projection, not the ring of its faces), and
+// a section leaf sits at every depth between two slabs. A line from the texel to a light point
+// meets a convex solid in one interval, which touches k consecutive slabs and crosses the k − 1
+// sections between them inside the solid, so Σ whole slabs − Σ sections (Euler's count) is the
+// fraction of the light the solid hides, E; O = max(Σ O_share, max O_whole, max E). Each term
+// is convolved at its own plane: sections exactly, slabs within their penumbra error.
+//
 // V is the irradiance-weighted visibility of the reference to first order across the light
 // (design-notes §6): the weight cos·cos/distance² of the light's points seen from a texel is
 // expanded about the centre, and the kernel's two first moments, convolved with the same image,

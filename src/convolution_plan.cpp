@@ -530,7 +530,11 @@ void add_sections(ConvolutionPlan& plan, const PlanInputs& in) {
     }
     if (!complete[i] || count.size() != 1) continue;
     const auto [m, c] = count.begin()->first;
-    if (!tree.component_closed[std::size_t(m)][std::size_t(c)]) continue;
+    // Convex only: a non-convex solid's capped slabs cost convolutions and measured no gain
+    // (the bracket), and Euler's count needs a line to meet the solid in one interval.
+    if (!tree.component_closed[std::size_t(m)][std::size_t(c)] ||
+        !tree.component_convex[std::size_t(m)][std::size_t(c)])
+      continue;
     const int root = root_of.at(Component(m, c));
     const PlanFrame& fr = plan.frames[std::size_t(t.frame)];
     double lo = 0, hi = 0;
@@ -553,8 +557,6 @@ void add_sections(ConvolutionPlan& plan, const PlanInputs& in) {
     const Triple& t = plan.triples[top];
     if (!t.solid_faces || t.children.empty()) continue;
     if (t.parent >= 0 && plan.triples[std::size_t(t.parent)].solid_faces) continue;
-    const auto [m, c] = component_of(t.solid_faces->front());
-    if (!tree.component_convex[std::size_t(m)][std::size_t(c)]) continue;
     std::vector<int> subtree = {int(top)};
     bool whole = true;
     for (std::size_t k = 0; k < subtree.size() && whole; ++k) {
@@ -598,6 +600,7 @@ void merge_plan(ConvolutionPlan& to, ConvolutionPlan&& from) {
   for (auto& t : from.triples) {
     t.frame += frames;
     if (t.parent >= 0) t.parent += triples;
+    if (t.euler >= 0) t.euler += triples;
     for (int& c : t.children) c += triples;
     to.triples.push_back(std::move(t));
   }

@@ -98,7 +98,7 @@ struct Triple {
   std::int64_t footprint_texels = 0;
   int polygons = 0;
   double seconds = 0;  // measured by the bake (0 in a plan)
-  // A slab of a closed solid (add_sections): the triple's blockers are all of one closed
+  // A slab of a convex closed solid (add_sections): the triple's blockers are all of one such
   // component's faces within its slab, so its whole image is capped by the component's section
   // at slab_lo; every face of the component, for that section.
   std::shared_ptr<const std::vector<FaceRef>> solid_faces;
@@ -245,8 +245,9 @@ ConvolutionPlan plan_convolution(const TexelSpace& space, const PlanInputs& in);
 // `light_part` (plan_frames.cpp; used by plan_convolution).
 void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part);
 
-// Marks the triples of `plan` that are slabs of closed solids and adds, under every depth split
-// of a convex one, the section leaf at the split's depth (used by plan_convolution).
+// Marks the triples of `plan` that are slabs of convex closed solids and adds, under every depth
+// split between two of a solid's slabs, the section leaf at the split's depth (used by
+// plan_convolution).
 void add_sections(ConvolutionPlan& plan, const PlanInputs& in);
 
 // Evaluates one triple in place (used by the planner; exposed for tests).

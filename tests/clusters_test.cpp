@@ -327,6 +327,30 @@ TEST(Clusters, ConvexComponents) {
   EXPECT_FALSE(tree.component_convex[4][0]) << "torus";
 }
 
+TEST(Clusters, ClosedComponents) {
+  const Mesh box = box_mesh(Vec3(0, 0, 0), Vec3(1, 2, 0.5));
+  const Mesh split = split_box_mesh(Vec3(0, 0, 0), Vec3(1, 2, 3));
+  const Mesh plane = plane_mesh(4, 6, 0);
+  const Mesh l_prism = l_prism_mesh();
+  // A box without its first triangle.
+  const Mesh whole = box_mesh(Vec3(0, 0, 0), Vec3(1, 1, 1));
+  Mesh open_box;
+  for (auto v : whole.mesh.vertices()) open_box.mesh.add_vertex(whole.mesh.point(v));
+  for (auto f : whole.mesh.faces()) {
+    if (f.idx() == 0) continue;
+    std::vector<TriMesh::VertexHandle> corners;
+    for (auto v : whole.mesh.fv_range(f)) corners.push_back(open_box.mesh.vertex_handle(v.idx()));
+    open_box.mesh.add_face(corners);
+  }
+  const ClusterTree tree = build_clusters({&box, &split, &plane, &l_prism, &open_box});
+  ASSERT_EQ(tree.roots.size(), 5u);
+  EXPECT_TRUE(tree.component_closed[0][0]) << "box";
+  EXPECT_TRUE(tree.component_closed[1][0]) << "box with a seam at every edge";
+  EXPECT_FALSE(tree.component_closed[2][0]) << "plane";
+  EXPECT_TRUE(tree.component_closed[3][0]) << "L prism";
+  EXPECT_FALSE(tree.component_closed[4][0]) << "box without one triangle";
+}
+
 // A 1 × 1 square light at z = 2 over a flat 1 × 1 receiver at z = 0: the shaft is a prism.
 Shaft square_shaft() {
   const std::vector<Vec3> light = {Vec3(0, 0, 2), Vec3(1, 0, 2), Vec3(1, 1, 2), Vec3(0, 1, 2)};
@@ -479,6 +503,10 @@ TEST(Clusters, ShowcaseObjectsAreOneComponentEach) {
   for (std::size_t m = 0; m < meshes.size(); ++m) {
     ASSERT_EQ(tree.component_convex[m].size(), 1u) << meshes[m].name;
     EXPECT_EQ(tree.component_convex[m][0], meshes[m].name == "torus" ? 0 : 1) << meshes[m].name;
+    // Solids are closed across their seams (the sphere's copies of its seam at longitude 0 and
+    // 2π differ in the last bits); the floor and the wall are open sheets.
+    const bool sheet = meshes[m].name == "floor" || meshes[m].name == "wall";
+    EXPECT_EQ(tree.component_closed[m][0], sheet ? 0 : 1) << meshes[m].name;
   }
 }
 

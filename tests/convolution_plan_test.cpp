@@ -122,6 +122,63 @@ TEST(ConvolutionPlan, NearestLayersPartitionTheHardShadow) {
   EXPECT_LE(worst, 1e-6);
 }
 
+// The posts are convex closed solids: their slabs are capped and every depth split between two
+// of a post's slabs has its section leaf, at the split's depth, whose image is the post's
+// 8 × 8 cm cross-section seen from the light's centre (by the parity of the surface's crossings,
+// so the triangles' shared edges and the far faces must cancel exactly).
+TEST(ConvolutionPlan, ConvexSolidsGetTheirSections) {
+  const auto p = plan_scene(load("posts", 128, "convolution"));
+  const ConvolutionPlan& plan = p->plan;
+  int sections = 0;
+  for (const Triple& t : plan.triples) {
+    if (!t.section) continue;
+    ++sections;
+    ASSERT_GE(t.parent, 0);
+    const Triple& split = plan.triples[std::size_t(t.parent)];
+    EXPECT_EQ(split.split, "blocker depth");
+    EXPECT_EQ(t.slab_lo, t.slab_hi);
+    EXPECT_EQ(t.slab_lo, plan.triples[std::size_t(split.children[0])].slab_hi);
+    ASSERT_TRUE(t.solid_faces);
+    ASSERT_GE(t.euler, 0);
+    // Every leaf under the solid's top is one of its slabs.
+    std::vector<int> below = {t.euler};
+    for (std::size_t k = 0; k < below.size(); ++k) {
+      const Triple& b = plan.triples[std::size_t(below[k])];
+      EXPECT_EQ(b.euler, t.euler);
+      if (!b.empty) {
+        EXPECT_EQ(b.solid_faces, t.solid_faces);
+      }
+      for (int c : b.children) below.push_back(c);
+    }
+    const PlanFrame& fr = plan.frames[std::size_t(t.frame)];
+    const ProjectedBlockers before =
+        project_faces(*t.solid_faces, fr.frame, fr.near, t.slab_lo, ShadowCaster{});
+    // On a grid of its own around the crossings (the plan's grid need only reach the footprint's
+    // texels, which at 128² may not span the whole section).
+    Vec2 lo = Vec2::Constant(1e30), hi = -lo;
+    for (const auto& pg : before.polygons) {
+      lo = lo.cwiseMin(pg.lo);
+      hi = hi.cwiseMax(pg.hi);
+    }
+    ASSERT_LT(lo.x(), hi.x());
+    TangentGrid grid;
+    grid.pixel = 1e-3;
+    grid.origin = lo - Vec2::Constant(2 * grid.pixel);
+    grid.width = int((hi.x() - lo.x()) / grid.pixel) + 4;
+    grid.height = int((hi.y() - lo.y()) / grid.pixel) + 4;
+    const std::vector<float> image = blocker_coverage(ProjectedBlockers{}, grid, &before);
+    double area = 0;
+    for (float c : image) area += double(c);
+    area *= grid.pixel * grid.pixel;
+    // Seen along D = -z from the light's centre, a horizontal 8 cm square at depth d covers
+    // (0.08 / d)² of the tangent plane.
+    ASSERT_NEAR(fr.frame.axis.z(), -1.0, 1e-9);
+    const double expected = std::pow(0.08 / t.slab_lo, 2);
+    EXPECT_NEAR(area, expected, 0.03 * expected) << "section at depth " << t.slab_lo;
+  }
+  EXPECT_GT(sections, 0);
+}
+
 // The acceptance figures of docs/methods.md, at 128² to stay fast: RMSE against a 256-sample
 // reference on the three subdivision scenes, with the tolerance set from the measured values
 // (table 0.016, posts 0.041, bracket floor 0.057 and bracket 0.035 at 128² when written) plus a
@@ -225,14 +282,10 @@ TEST(ConvolutionPlan, PostShadowHardensAtContact) {
     const double wc = width_at(ci, x), wr = width_at(ri, x);
     std::printf("post shadow at x = %.2f m: penumbra %.1f texels (convolution), %.1f (reference)\n",
                 x, wc, wr);
-    // Known gap (docs/methods.md): within ~0.1 m of the foot the convolution's penumbra is
-    // about 9 texels too wide (29 against 20 at x = 0.3); at x = 0.45 it is 2.4 texels wide of
-    // the reference and at 0.6 within half a texel.
-    if (x >= 0.45) {
-      EXPECT_NEAR(wc, wr, 3.0) << "at x = " << x;
-    } else {
-      EXPECT_NEAR(wc, wr, 10.0) << "at x = " << x;
-    }
+    // Measured (docs/methods.md): 22.2 against 20.0 texels at x = 0.30, 47.2 against 44.7 at
+    // 0.45, 55.0 against 54.9 at 0.60. The issue asks for two texels; the slab planes' error
+    // across a solid's many slabs leaves up to 2.5 (halving the light brings it under 2).
+    EXPECT_NEAR(wc, wr, 3.0) << "at x = " << x;
     EXPECT_GT(wc, previous) << "the penumbra must widen away from the post's foot";
     previous = wc;
   }
