@@ -398,9 +398,9 @@ class Planner {
       out.push_back(pair(std::move(a), std::move(b)));
     }
     // Blocker space: two clusters either side of the median centroid along the wider axis of
-    // their tangent bounding box. Polygons of several connected components are split by whole
-    // components (at the median of the components' centroids), so that each side keeps whole
-    // solids, which add_sections can cap; polygons of one component by polygon centroids.
+    // their tangent bounding box: of the polygons, and, when they belong to several connected
+    // components, also of whole components (at the median of the components' centroids), which
+    // keeps each side's solids whole for add_sections.
     if (polys.size() >= 2) {
       std::vector<Vec2> centroid(polys.size());
       Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
@@ -433,7 +433,13 @@ class Planner {
         }
         for (std::size_t k = 0; k < count.size(); ++k) part_centroid[k] /= double(count[k]);
       }
-      std::vector<int> near_side, far_side;
+      auto add = [&](const std::vector<int>& near_side, const std::vector<int>& far_side) {
+        if (near_side.empty() || far_side.empty()) return;
+        Triple a = child_of(t, "blocker space"), b = child_of(t, "blocker space");
+        a.faces = surviving(t, near_side);
+        b.faces = surviving(t, far_side);
+        out.push_back(pair(std::move(a), std::move(b)));
+      };
       if (part_centroid.size() >= 2) {
         std::vector<int> parts(part_centroid.size());
         for (std::size_t k = 0; k < parts.size(); ++k) parts[k] = int(k);
@@ -443,20 +449,16 @@ class Planner {
         });
         std::vector<std::uint8_t> first(parts.size(), 0);
         for (auto it = parts.begin(); it != middle; ++it) first[std::size_t(*it)] = 1;
+        std::vector<int> near_side, far_side;
         for (int p : all) (first[std::size_t(part[std::size_t(p)])] ? near_side : far_side).push_back(p);
-      } else if (hi[axis] > lo[axis]) {
+        add(near_side, far_side);
+      }
+      if (hi[axis] > lo[axis]) {
         std::vector<int> order = all;
         const auto middle = order.begin() + std::ptrdiff_t(order.size() / 2);
         std::nth_element(order.begin(), middle, order.end(),
                          [&](int a, int b) { return centroid[a][axis] < centroid[b][axis]; });
-        near_side.assign(order.begin(), middle);
-        far_side.assign(middle, order.end());
-      }
-      if (!near_side.empty() && !far_side.empty()) {
-        Triple a = child_of(t, "blocker space"), b = child_of(t, "blocker space");
-        a.faces = surviving(t, near_side);
-        b.faces = surviving(t, far_side);
-        out.push_back(pair(std::move(a), std::move(b)));
+        add(std::vector<int>(order.begin(), middle), std::vector<int>(middle, order.end()));
       }
     }
     // Receiver depth: two parts either side of the middle of the footprint's depths, blended over
