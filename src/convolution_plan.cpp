@@ -504,7 +504,8 @@ void add_sections(ConvolutionPlan& plan, const PlanInputs& in) {
     const int m = mesh_index.at(f.mesh);
     return Component(m, tree.face_component[std::size_t(m)][std::size_t(f.face)]);
   };
-  std::map<int, std::shared_ptr<const std::vector<FaceRef>>> solid_faces;  // by root node
+  // Every face of a set of solids, by their cluster roots.
+  std::map<std::vector<int>, std::shared_ptr<const std::vector<FaceRef>>> solid_faces;
 
   // A triple is complete when it holds every face of each component it touches that meets its
   // slab: a root holding whole components, and its descendants, except where a blocker-space
@@ -530,23 +531,61 @@ void add_sections(ConvolutionPlan& plan, const PlanInputs& in) {
         }
       }
     }
-    if (!complete[i] || count.size() != 1) continue;
-    const auto [m, c] = count.begin()->first;
-    // Convex only: a non-convex solid's capped slabs cost convolutions and measured no gain
-    // (the bracket), and Euler's count needs a line to meet the solid in one interval.
-    if (!tree.component_closed[std::size_t(m)][std::size_t(c)] ||
-        !tree.component_convex[std::size_t(m)][std::size_t(c)])
-      continue;
-    const int root = root_of.at(Component(m, c));
+    if (!complete[i] || t.empty) continue;
     const PlanFrame& fr = plan.frames[std::size_t(t.frame)];
-    double lo = 0, hi = 0;
-    tree.nodes[std::size_t(root)].depth_range(fr.frame.origin, fr.frame.axis, &lo, &hi);
-    // A section counts crossings from the light's side: the solid must lie wholly before it.
-    if (!(lo > fr.near)) continue;
-    auto& faces = solid_faces[root];
+    std::vector<int> roots;
+    bool solid = true;
+    for (const auto& [component, faces] : count) {
+      const auto [m, c] = component;
+      // Convex only: a non-convex solid's capped slabs cost convolutions and measured no gain
+      // (the bracket), and Euler's count needs a line to meet the solid in one interval.
+      if (!tree.component_closed[std::size_t(m)][std::size_t(c)] ||
+          !tree.component_convex[std::size_t(m)][std::size_t(c)]) {
+        solid = false;
+        break;
+      }
+      const int root = root_of.at(component);
+      double lo = 0, hi = 0;
+      tree.nodes[std::size_t(root)].depth_range(fr.frame.origin, fr.frame.axis, &lo, &hi);
+      // A section counts crossings from the light's side: the solid must lie wholly before it.
+      if (!(lo > fr.near)) {
+        solid = false;
+        break;
+      }
+      roots.push_back(root);
+    }
+    if (!solid || roots.empty()) continue;
+    // Several solids count together only when no line from a receiver texel to the light can
+    // meet two of them within the slab: such a line's projection from the light's centre moves
+    // by at most the light's projected half extents times (1/d_lo − 1/d_hi) across the slab's
+    // depths, so solids whose projections lie further apart than that are never both met.
+    if (roots.size() > 1) {
+      const Light& light = plan.light_parts[std::size_t(fr.light_part)].part;
+      const Vec2 reach = projected_half_extents(light, fr.frame, t.view, t.receiver_depths.hi) *
+                         (1.0 / t.blocker_depths.lo - 1.0 / t.blocker_depths.hi);
+      std::vector<std::pair<Vec2, Vec2>> boxes;
+      for (int root : roots) {
+        Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+        for (const Vec3& p : tree.nodes[std::size_t(root)].hull) {
+          lo = lo.cwiseMin(fr.frame.tangent(p));
+          hi = hi.cwiseMax(fr.frame.tangent(p));
+        }
+        boxes.emplace_back(lo - reach, hi + reach);
+      }
+      for (std::size_t a = 0; a < boxes.size() && solid; ++a)
+        for (std::size_t b = a + 1; b < boxes.size() && solid; ++b)
+          solid = (boxes[a].second.array() < boxes[b].first.array()).any() ||
+                  (boxes[b].second.array() < boxes[a].first.array()).any();
+      if (!solid) continue;
+    }
+    std::sort(roots.begin(), roots.end());
+    auto& faces = solid_faces[roots];
     if (!faces) {
       auto all = std::make_shared<std::vector<FaceRef>>();
-      for (int f : tree.nodes[std::size_t(root)].faces) all->push_back({in.blockers[std::size_t(m)], f});
+      for (int root : roots) {
+        const Cluster& node = tree.nodes[std::size_t(root)];
+        for (int f : node.faces) all->push_back({in.blockers[std::size_t(node.mesh)], f});
+      }
       faces = std::move(all);
     }
     t.solid_faces = faces;
