@@ -166,6 +166,7 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
       in.error_texels = scene.bake.error_texels;
       in.max_image = scene.bake.max_image;
       in.max_triples = scene.bake.max_triples;
+      in.light_parts = scene.bake.light_parts;
       in.combine = scene.bake.blocker_combine == "sum" ? BlockerCombine::sum
                                                        : BlockerCombine::product;
       in.weighted = scene.bake.weighting == "irradiance";
@@ -212,6 +213,7 @@ Expected<std::vector<std::string>> plan(const Scene& scene, const BakeOptions& o
     in.error_texels = scene.bake.error_texels;
     in.max_image = scene.bake.max_image;
     in.max_triples = scene.bake.max_triples;
+    in.light_parts = scene.bake.light_parts;
     out.push_back(describe_plan(plan_convolution(space, in)));
   }
   return out;

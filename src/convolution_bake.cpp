@@ -14,7 +14,8 @@
 // partition of unity across the seam); a slab's shadow counts in proportion to the part of its
 // geometry in front of the texel; blocker clusters combine by BlockerCombine, which becomes a
 // weighted sum S = Σ w·f(O) with f(O) = O, V = 1 − min(S, 1) (sum) or f(O) = −ln(1 − O),
-// V = exp(−S) (product). Light parts add by power.
+// V = exp(−S) (product). Light parts add weighted by their own unoccluded irradiance at the texel
+// (by their share of the power with `weighting = "emission"`).
 //
 // With `sum`, each cluster's image is its share of the nearest layer (nearest_layer_coverage),
 // so the shares partition the hard shadow seen from the light's centre. A cluster hidden behind
@@ -317,11 +318,14 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
   pin.error_texels = in.error_texels;
   pin.max_image = in.max_image;
   pin.max_triples = in.max_triples;
+  pin.light_parts = in.light_parts;
   ConvolutionPlan plan = plan_convolution(space, pin);
   const double plan_seconds = seconds_since(start);
 
-  // Per texel and light: Σ over the light's parts of fraction·V_part, and Σ fraction over the
-  // parts that reach it.
+  // Per texel and light: Σ over the light's parts of weight·V_part, and Σ weight over the parts
+  // that reach it. The weight is the part's share of the light: with the irradiance weighting,
+  // its own unoccluded irradiance at the texel (V is irradiance-weighted, and the part nearer the
+  // texel brings more of it); without, its share of the power (V_u weights the light by area).
   std::vector<std::vector<Vec3f>> visible(lights.size());
   std::vector<std::vector<float>> reached(lights.size());
   for (std::size_t f = 0; f < plan.frames.size(); ++f) {
@@ -416,8 +420,22 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
       vis.assign(n, Vec3f::Zero());
       reach.assign(n, 0.0f);
     }
-    const float fraction = float(lp.fraction);
+    const bool parts = lp.fraction < 1.0;
+    std::vector<float> share(parts ? fr.texels.size() : 0, float(lp.fraction));
+    if (parts && in.weighted) {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, share.size(), 4096), [&](const auto& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+          const Texel& tx = space.texels[fr.texels[i]];
+          // Plus a trace of the power share, so that a texel no part's closed form reaches
+          // still averages its parts by power rather than dropping the light.
+          share[i] = float(
+              lp.part.unoccluded_irradiance(tx.position.cast<double>(), tx.normal.cast<double>())
+                  .sum() + 1e-9 * lp.fraction);
+        }
+      });
+    }
     for (std::size_t i = 0; i < fr.texels.size(); ++i) {
+      const float fraction = parts ? share[i] : 1.0f;
       Vec3f v;
       for (int c = 0; c < 3; ++c) {
         float o = std::max(occlusion[i][c], largest[i][c]);

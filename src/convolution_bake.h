@@ -25,6 +25,7 @@ struct ConvolutionInputs {
   double error_texels = 1.0;  // target penumbra error, receiver texels
   int max_image = 4096;       // largest image side, pixels
   int max_triples = 128;      // leaf triples per light
+  int light_parts = 2;        // each rectangular light in at least this many parts (1, 2, 4)
   BlockerCombine combine = BlockerCombine::sum;
   // Weight the occluded fraction by irradiance to first order across the light (design-notes
   // §6: two more convolutions per leaf), so that V is the irradiance-weighted visibility the

@@ -671,7 +671,13 @@ ConvolutionPlan plan_light_part(const ConvolutionPlan& base, const PlanInputs& i
   const LightDesc& d = part.part.desc();
   const bool splittable =
       d.shape == LightShape::rectangle && !part.part.textured() && level < kMaxLightSplits;
-  if (worst <= in.error_texels || !splittable) return whole;
+  // Split to reach light_parts whatever ε says where blockers were cut into slabs (the slabs'
+  // error that ε does not measure; one plane per blocker has none); beyond, only when the
+  // target is missed.
+  const bool slabs = std::any_of(whole.triples.begin(), whole.triples.end(),
+                                 [](const Triple& t) { return t.split == "blocker depth"; });
+  const bool required = slabs && (1 << level) < in.light_parts;
+  if ((worst <= in.error_texels && !required) || !splittable) return whole;
   // The halves are planned at once, on their own threads.
   std::array<ConvolutionPlan, 2> half_plans;
   tbb::parallel_for(0, 2, [&](int side) {
@@ -691,7 +697,7 @@ ConvolutionPlan plan_light_part(const ConvolutionPlan& base, const PlanInputs& i
   });
   ConvolutionPlan halves = empty_like(base);
   for (ConvolutionPlan& h : half_plans) merge_plan(halves, std::move(h));
-  return halves.worst_error_texels() < worst ? std::move(halves) : std::move(whole);
+  return required || halves.worst_error_texels() < worst ? std::move(halves) : std::move(whole);
 }
 
 }  // namespace

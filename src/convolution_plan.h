@@ -39,6 +39,10 @@ struct PlanInputs {
   double error_texels = 1.0;  // the target ε, in receiver texels
   int max_image = 4096;       // largest image side, pixels
   int max_triples = 512;      // leaves per light: the work budget
+  // Each untextured rectangular light whose plan cuts blockers into depth slabs is split into at
+  // least this many parts (1, 2 or 4), whatever ε says: the slabs' error in the shares and in
+  // Euler's count scales with the light's size and ε does not measure it (docs/methods.md).
+  int light_parts = 2;
 };
 
 // One side of a receiver split: the part's texels have depth below (or above) `depth`, blended

@@ -30,6 +30,7 @@ struct BakeSettings {
   double error_texels = 1.0;
   int max_image = 4096;
   int max_triples = 128;  // leaf triples per light: the convolution's work budget
+  int light_parts = 2;    // convolution: each rectangular light split into at least this many
   std::string blocker_combine = "sum";  // how blocker clusters combine: "product" or "sum"
   // What the convolution's V averages the light's points by: "irradiance" (cos·cos/r², to first
   // order across the light, as the reference) or "emission" (V_u, exact for parallel planes)

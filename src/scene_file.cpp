@@ -296,7 +296,7 @@ bool is_valid_object_name(std::string_view name) {
 Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::table& table) {
   TableReader r(file, table, "[bake]");
   r.check_known_keys({"resolution", "method", "quantity", "samples", "margin", "seed",
-                      "error_texels", "max_image", "max_triples", "blocker_combine", "weighting", "shadow_map", "pcf_radius",
+                      "error_texels", "max_image", "max_triples", "light_parts", "blocker_combine", "weighting", "shadow_map", "pcf_radius",
                       "erosion_factor"});
   BakeSettings bake;
   const int int_max = std::numeric_limits<int>::max();
@@ -340,6 +340,13 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
     }
   }
   if (auto v = r.integer("max_triples", 1, 1 << 20)) bake.max_triples = static_cast<int>(*v);
+  if (auto v = r.integer("light_parts", 1, 4)) {
+    if (*v == 3) {
+      r.fail_got("light_parts", "1, 2 or 4");
+    } else {
+      bake.light_parts = static_cast<int>(*v);
+    }
+  }
   if (auto v = r.integer("shadow_map", 64, 16384)) bake.shadow_map = static_cast<int>(*v);
   if (auto v = r.number("pcf_radius", "a number >= 0", [](double x) {
         return std::isfinite(x) && x >= 0;

@@ -195,14 +195,15 @@ TEST(ConvolutionPlan, ConvexSolidsGetTheirSections) {
 
 // The acceptance figures of docs/methods.md, at 128² to stay fast: RMSE against a 256-sample
 // reference on the three subdivision scenes, with the tolerance set from the measured values
-// (table 0.016, posts 0.041, bracket floor 0.057 and bracket 0.035 at 128² when written) plus a
-// margin.
+// (table 0.0071, posts 0.0272, bracket floor 0.0263 and bracket 0.0140 at 128², with convex
+// solids counted by Euler's formula and light parts weighted by irradiance) plus a margin; when
+// first written they were 0.016, 0.041, 0.057 and 0.035.
 TEST(ConvolutionPlan, SubdivisionScenesAgainstReference) {
   struct Case {
     const char* scene;
     double tolerance;
   };
-  for (const Case c : {Case{"table", 0.02}, Case{"posts", 0.045}, Case{"bracket", 0.08}}) {
+  for (const Case c : {Case{"table", 0.011}, Case{"posts", 0.034}, Case{"bracket", 0.034}}) {
     Scene conv = load(c.scene, 128, "convolution");
     Scene ref = load(c.scene, 128, "reference");
     ref.bake.samples = 256;
@@ -271,12 +272,15 @@ TEST(ConvolutionPlan, PostShadowHardensAtContact) {
   Scene ref = *scene;
   ref.bake.method = "reference";
   ref.bake.samples = 256;
-  auto a = bake(*scene), b = bake(ref);
-  ASSERT_TRUE(a && b);
+  // The default, light_parts = 2, and the light whole.
+  Scene whole = *scene;
+  whole.bake.light_parts = 1;
+  auto a = bake(whole), b = bake(ref), h = bake(*scene);
+  ASSERT_TRUE(a && b && h);
   const Image& ci = a->receivers[0].image;
   const Image& ri = b->receivers[0].image;
+  const Image& hi = h->receivers[0].image;
   const int n = ci.width;
-  const double texel = 2.0 / n;
   // Width of the penumbra across the shadow (along y) at floor x: the distance between the
   // 10 % and 90 % crossings on the +y side, linearly interpolated, in texels.
   auto width_at = [&](const Image& img, double x) {
@@ -291,19 +295,23 @@ TEST(ConvolutionPlan, PostShadowHardensAtContact) {
   };
   // The shadow of the post runs in +x from its foot at x = 0.24 to its tip's image at
   // x = 0.2 + 0.5 · 1/1 ≈ 0.7.
-  double previous = 0;
+  double previous = 0, previous_halves = 0;
   for (const double x : {0.3, 0.45, 0.6}) {
-    const double wc = width_at(ci, x), wr = width_at(ri, x);
-    std::printf("post shadow at x = %.2f m: penumbra %.1f texels (convolution), %.1f (reference)\n",
-                x, wc, wr);
-    // Measured (docs/methods.md): 22.2 against 20.0 texels at x = 0.30, 47.2 against 44.7 at
-    // 0.45, 55.0 against 54.9 at 0.60. The issue asks for two texels; the slab planes' error
-    // across a solid's many slabs leaves up to 2.5 (halving the light brings it under 2).
-    EXPECT_NEAR(wc, wr, 3.0) << "at x = " << x;
+    const double wc = width_at(ci, x), wr = width_at(ri, x), wh = width_at(hi, x);
+    std::printf("post shadow at x = %.2f m: penumbra %.1f texels (convolution), %.1f with "
+                "light_parts = 1, %.1f (reference)\n",
+                x, wh, wc, wr);
+    // Measured (docs/methods.md): 21.2 against 20.0 texels at x = 0.30, 45.2 against 44.7 at
+    // 0.45, 55.3 against 54.9 at 0.60 at the default: within the two texels the issue asks for.
+    // The slab planes' error, summed over the post's slabs, scales with the light's size: whole,
+    // the light gives 22.2, 47.2 and 55.0.
+    EXPECT_NEAR(wh, wr, 2.0) << "at x = " << x;
+    EXPECT_NEAR(wc, wr, 3.0) << "at x = " << x << " with light_parts = 1";
     EXPECT_GT(wc, previous) << "the penumbra must widen away from the post's foot";
+    EXPECT_GT(wh, previous_halves) << "the penumbra must widen away from the post's foot";
     previous = wc;
+    previous_halves = wh;
   }
-  (void)texel;
 }
 
 }  // namespace

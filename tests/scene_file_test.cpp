@@ -251,13 +251,14 @@ TEST_F(SceneFile, RejectsUnknownMethod) {
 
 TEST_F(SceneFile, ReadsAndChecksMethodSettings) {
   const Scene scene = load_ok(
-      "[bake]\nerror_texels = 0.5\nmax_image = 2048\nmax_triples = 32\n"
+      "[bake]\nerror_texels = 0.5\nmax_image = 2048\nmax_triples = 32\nlight_parts = 2\n"
       "blocker_combine = \"product\"\nweighting = \"emission\"\nshadow_map = 1024\npcf_radius = 3\n"
       "erosion_factor = \"distance\"\n" +
       object_floor + light_panel);
   EXPECT_EQ(scene.bake.error_texels, 0.5);
   EXPECT_EQ(scene.bake.max_image, 2048);
   EXPECT_EQ(scene.bake.max_triples, 32);
+  EXPECT_EQ(scene.bake.light_parts, 2);
   EXPECT_EQ(scene.bake.blocker_combine, "product");
   EXPECT_EQ(scene.bake.weighting, "emission");
   EXPECT_EQ(scene.bake.shadow_map, 1024);
@@ -271,6 +272,10 @@ TEST_F(SceneFile, ReadsAndChecksMethodSettings) {
                "[bake]", "'weighting' must be \"irradiance\" or \"emission\"");
   expect_error("[bake]\nerosion_factor = 2\n" + object_floor + light_panel, "erosion_factor",
                "[bake]", "'erosion_factor' must be a string");
+  expect_error("[bake]\nlight_parts = 3\n" + object_floor + light_panel, "light_parts", "[bake]",
+               "'light_parts' must be 1, 2 or 4");
+  expect_error("[bake]\nlight_parts = 8\n" + object_floor + light_panel, "light_parts", "[bake]",
+               "'light_parts' must be an integer from 1 to 4");
   expect_error("[bake]\nmax_image = 10\n" + object_floor + light_panel, "max_image", "[bake]",
                "'max_image' must be an integer from 64 to 16384");
 }
