@@ -174,6 +174,20 @@ std::vector<float> nearest_layer_coverage(const ProjectedBlockers& layer,
     Vec3 inverse_depth;  // 1/depth in pixel coordinates
     bool mine;
   };
+  // Only samples inside one of the cluster's polygons within the slab can count: every raster
+  // is clipped to their pixel bounds, outside which the image stays 0 whatever lies there.
+  int mx0 = w, mx1 = -1, my0 = h, my1 = -1;
+  for (std::size_t i = 0; i < layer.polygons.size(); ++i) {
+    const auto& pg = layer.polygons[i];
+    if (!mine[i] || pg.depth_lo > depth_hi || pg.depth_hi < depth_lo) continue;
+    PixelPolygon box{Edges({}), 0, 0, 0, 0};
+    if (!to_pixels(pg, grid, &box)) continue;
+    mx0 = std::min(mx0, box.x0);
+    mx1 = std::max(mx1, box.x1);
+    my0 = std::min(my0, box.y0);
+    my1 = std::max(my1, box.y1);
+  }
+  if (mx0 > mx1 || my0 > my1) return coverage;
   std::vector<Raster> rasters;
   bool any_mine = false;
   for (std::size_t i = 0; i < layer.polygons.size(); ++i) {
@@ -183,6 +197,11 @@ std::vector<float> nearest_layer_coverage(const ProjectedBlockers& layer,
     if (pg.depth_lo > depth_hi) continue;
     Raster r{PixelPolygon{Edges({}), 0, 0, 0, 0}, Vec3::Zero(), mine[i] != 0};
     if (!to_pixels(pg, grid, &r.pixels)) continue;
+    r.pixels.x0 = std::max(r.pixels.x0, mx0);
+    r.pixels.x1 = std::min(r.pixels.x1, mx1);
+    r.pixels.y0 = std::max(r.pixels.y0, my0);
+    r.pixels.y1 = std::min(r.pixels.y1, my1);
+    if (r.pixels.x0 > r.pixels.x1 || r.pixels.y0 > r.pixels.y1) continue;
     // t = origin + pixel·q turns 1/depth = a·t + c into a function of pixel coordinates q.
     const Vec3& a = pg.inverse_depth;
     r.inverse_depth = Vec3(a.x() * grid.pixel, a.y() * grid.pixel,
@@ -195,11 +214,11 @@ std::vector<float> nearest_layer_coverage(const ProjectedBlockers& layer,
   const double inv_hi = depth_lo > 0 ? 1.0 / depth_lo : std::numeric_limits<double>::infinity();
   constexpr int kS = kSamplesPerSide * kSamplesPerSide;
   constexpr int kBand = 8;
-  tbb::parallel_for(tbb::blocked_range<int>(0, (h + kBand - 1) / kBand), [&](const auto& bands) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, (my1 - my0) / kBand + 1), [&](const auto& bands) {
     std::vector<float> nearest;      // per sample: largest 1/depth so far
     std::vector<std::uint8_t> owner;  // per sample: whether that polygon is mine
     for (int band = bands.begin(); band != bands.end(); ++band) {
-      const int row0 = band * kBand, row1 = std::min(h, row0 + kBand);
+      const int row0 = my0 + band * kBand, row1 = std::min(my1 + 1, row0 + kBand);
       nearest.assign(std::size_t(row1 - row0) * w * kS, 0.0f);
       owner.assign(nearest.size(), 0);
       for (const Raster& r : rasters) {
@@ -234,7 +253,7 @@ std::vector<float> nearest_layer_coverage(const ProjectedBlockers& layer,
         }
       }
       for (int y = row0; y < row1; ++y) {
-        for (int x = 0; x < w; ++x) {
+        for (int x = mx0; x <= mx1; ++x) {
           const std::size_t base = (std::size_t(y - row0) * w + x) * kS;
           int count = 0;
           for (int k = 0; k < kS; ++k) {
