@@ -284,11 +284,7 @@ void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& 
            30.0 * double(t.footprint_texels) + 20.0 * double(t.faces.size());
 }
 
-namespace {
-
-// A new child of `parent`, made by `split`: same frame, group, slab, cuts and layer, to be
-// narrowed by the caller and evaluated.
-Triple child_of(const Triple& parent, const char* split) {
+Triple child_triple(const Triple& parent, const char* split) {
   Triple c;
   c.frame = parent.frame;
   c.group = parent.group;
@@ -300,6 +296,8 @@ Triple child_of(const Triple& parent, const char* split) {
   c.receiver_box = parent.receiver_box;
   return c;
 }
+
+namespace {
 
 class Planner {
  public:
@@ -386,7 +384,7 @@ class Planner {
     // Blocker depth: two slabs at the middle of the geometry's depth range.
     if (t.blocker_depths.hi - t.blocker_depths.lo > 0.25 * texel) {
       const double mid = t.blocker_depths.mid();
-      Triple a = child_of(t, "blocker depth"), b = child_of(t, "blocker depth");
+      Triple a = child_triple(t, "blocker depth"), b = child_triple(t, "blocker depth");
       a.slab_hi = b.slab_lo = mid;
       std::vector<int> near_polys, far_polys;
       for (int p : all) {
@@ -435,7 +433,7 @@ class Planner {
       }
       auto add = [&](const std::vector<int>& near_side, const std::vector<int>& far_side) {
         if (near_side.empty() || far_side.empty()) return;
-        Triple a = child_of(t, "blocker space"), b = child_of(t, "blocker space");
+        Triple a = child_triple(t, "blocker space"), b = child_triple(t, "blocker space");
         a.faces = surviving(t, near_side);
         b.faces = surviving(t, far_side);
         out.push_back(pair(std::move(a), std::move(b)));
@@ -466,7 +464,7 @@ class Planner {
     if (t.receiver_depths.hi - t.receiver_depths.lo > 2 * texel) {
       const double mid = t.receiver_depths.mid();
       const double band = std::max(texel, 0.1 * (t.receiver_depths.hi - t.receiver_depths.lo));
-      Triple a = child_of(t, "receiver depth"), b = child_of(t, "receiver depth");
+      Triple a = child_triple(t, "receiver depth"), b = child_triple(t, "receiver depth");
       a.cuts.push_back({mid, band, true});
       b.cuts.push_back({mid, band, false});
       a.faces = b.faces = surviving(t, all);
@@ -492,138 +490,6 @@ class Planner {
 
 }  // namespace
 
-void add_sections(ConvolutionPlan& plan, const PlanInputs& in) {
-  if (!in.clusters) return;
-  const ClusterTree& tree = *in.clusters;
-  std::map<const Mesh*, int> mesh_index;
-  for (std::size_t m = 0; m < in.blockers.size(); ++m) mesh_index.emplace(in.blockers[m], int(m));
-  using Component = std::pair<int, int>;  // (mesh, connected component)
-  std::map<Component, int> root_of;       // its cluster tree's root node
-  for (int r : tree.roots) root_of.emplace(Component(tree.nodes[r].mesh, tree.nodes[r].component), r);
-  auto component_of = [&](const FaceRef& f) {
-    const int m = mesh_index.at(f.mesh);
-    return Component(m, tree.face_component[std::size_t(m)][std::size_t(f.face)]);
-  };
-  // Every face of a set of solids, by their cluster roots.
-  std::map<std::vector<int>, std::shared_ptr<const std::vector<FaceRef>>> solid_faces;
-
-  // A triple is complete when it holds every face of each component it touches that meets its
-  // slab: a root holding whole components, and its descendants, except where a blocker-space
-  // split shares a component between its two sides. Parents come before children in `triples`.
-  const std::size_t n = plan.triples.size();
-  std::vector<std::uint8_t> complete(n, 0);
-  for (std::size_t i = 0; i < n; ++i) {
-    Triple& t = plan.triples[i];
-    std::map<Component, std::size_t> count;
-    for (const FaceRef& f : t.faces) ++count[component_of(f)];
-    if (t.parent < 0) {
-      complete[i] = std::all_of(count.begin(), count.end(), [&](const auto& c) {
-        return c.second == tree.nodes[std::size_t(root_of.at(c.first))].faces.size();
-      });
-    } else {
-      const Triple& parent = plan.triples[std::size_t(t.parent)];
-      complete[i] = complete[std::size_t(t.parent)];
-      if (complete[i] && parent.split == "blocker space") {
-        for (int sibling : parent.children) {
-          if (sibling == int(i)) continue;
-          for (const FaceRef& f : plan.triples[std::size_t(sibling)].faces)
-            if (count.count(component_of(f))) complete[i] = 0;
-        }
-      }
-    }
-    if (!complete[i] || t.empty) continue;
-    const PlanFrame& fr = plan.frames[std::size_t(t.frame)];
-    std::vector<int> roots;
-    bool solid = true;
-    for (const auto& [component, faces] : count) {
-      const auto [m, c] = component;
-      // Convex only: a non-convex solid's capped slabs cost convolutions and measured no gain
-      // (the bracket), and Euler's count needs a line to meet the solid in one interval.
-      if (!tree.component_closed[std::size_t(m)][std::size_t(c)] ||
-          !tree.component_convex[std::size_t(m)][std::size_t(c)]) {
-        solid = false;
-        break;
-      }
-      const int root = root_of.at(component);
-      double lo = 0, hi = 0;
-      tree.nodes[std::size_t(root)].depth_range(fr.frame.origin, fr.frame.axis, &lo, &hi);
-      // A section counts crossings from the light's side: the solid must lie wholly before it.
-      if (!(lo > fr.near)) {
-        solid = false;
-        break;
-      }
-      roots.push_back(root);
-    }
-    if (!solid || roots.empty()) continue;
-    // Several solids count together only when no line from a receiver texel to the light can
-    // meet two of them within the slab: such a line's projection from the light's centre moves
-    // by at most the light's projected half extents times (1/d_lo − 1/d_hi) across the slab's
-    // depths, so solids whose projections lie further apart than that are never both met.
-    if (roots.size() > 1) {
-      const Light& light = plan.light_parts[std::size_t(fr.light_part)].part;
-      const Vec2 reach = projected_half_extents(light, fr.frame, t.view, t.receiver_depths.hi) *
-                         (1.0 / t.blocker_depths.lo - 1.0 / t.blocker_depths.hi);
-      std::vector<std::pair<Vec2, Vec2>> boxes;
-      for (int root : roots) {
-        Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-        for (const Vec3& p : tree.nodes[std::size_t(root)].hull) {
-          lo = lo.cwiseMin(fr.frame.tangent(p));
-          hi = hi.cwiseMax(fr.frame.tangent(p));
-        }
-        boxes.emplace_back(lo - reach, hi + reach);
-      }
-      for (std::size_t a = 0; a < boxes.size() && solid; ++a)
-        for (std::size_t b = a + 1; b < boxes.size() && solid; ++b)
-          solid = (boxes[a].second.array() < boxes[b].first.array()).any() ||
-                  (boxes[b].second.array() < boxes[a].first.array()).any();
-      if (!solid) continue;
-    }
-    std::sort(roots.begin(), roots.end());
-    auto& faces = solid_faces[roots];
-    if (!faces) {
-      auto all = std::make_shared<std::vector<FaceRef>>();
-      for (int root : roots) {
-        const Cluster& node = tree.nodes[std::size_t(root)];
-        for (int f : node.faces) all->push_back({in.blockers[std::size_t(node.mesh)], f});
-      }
-      faces = std::move(all);
-    }
-    t.solid_faces = faces;
-  }
-
-  // Euler's count for a convex solid: a line meets it in one interval, which touches k
-  // consecutive slabs and crosses the k − 1 sections between them inside the solid, so
-  // Σ slabs − Σ sections is 1 for a line that meets the solid and 0 for one that misses it.
-  for (std::size_t top = 0; top < n; ++top) {
-    const Triple& t = plan.triples[top];
-    if (!t.solid_faces || t.children.empty()) continue;
-    if (t.parent >= 0 && plan.triples[std::size_t(t.parent)].solid_faces) continue;
-    std::vector<int> subtree = {int(top)};
-    bool whole = true;
-    for (std::size_t k = 0; k < subtree.size() && whole; ++k) {
-      const Triple& s = plan.triples[std::size_t(subtree[k])];
-      if (!s.empty && !s.solid_faces) whole = false;
-      for (int child : s.children) subtree.push_back(child);
-    }
-    if (!whole) continue;
-    for (int s : subtree) plan.triples[std::size_t(s)].euler = int(top);
-    for (int s : subtree) {
-      if (plan.triples[std::size_t(s)].split != "blocker depth") continue;
-      const Triple& split = plan.triples[std::size_t(s)];
-      Triple section = child_of(split, "");
-      section.parent = s;
-      section.slab_lo = section.slab_hi = plan.triples[std::size_t(split.children[0])].slab_hi;
-      section.faces = split.faces;
-      section.solid_faces = split.solid_faces;
-      section.euler = int(top);
-      section.section = true;
-      evaluate_triple(plan, in, section);
-      if (section.empty) continue;
-      plan.triples[std::size_t(s)].children.push_back(int(plan.triples.size()));
-      plan.triples.push_back(std::move(section));
-    }
-  }
-}
 
 namespace {
 

@@ -249,9 +249,13 @@ ConvolutionPlan plan_convolution(const TexelSpace& space, const PlanInputs& in);
 // `light_part` (plan_frames.cpp; used by plan_convolution).
 void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part);
 
+// A new child of `parent` made by `split`: the same frame, group, slab, cuts and layer, for the
+// caller to narrow and evaluate.
+Triple child_triple(const Triple& parent, const char* split);
+
 // Marks the triples of `plan` that are slabs of convex closed solids and adds, under every depth
 // split between two of a solid's slabs, the section leaf at the split's depth (used by
-// plan_convolution).
+// plan_convolution; plan_sections.cpp).
 void add_sections(ConvolutionPlan& plan, const PlanInputs& in);
 
 // Evaluates one triple in place (used by the planner; exposed for tests).
