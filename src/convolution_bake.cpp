@@ -48,7 +48,6 @@
 #include <algorithm>
 #include <array>
 #include <limits>
-#include <map>
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -120,6 +119,30 @@ std::vector<Vec2> weight_gradients(const PlanFrame& fr, const TexelSpace& space,
   });
   return g;
 }
+
+// Euler's counts of a frame's convex solids (add_sections): the solid whose leaves are being
+// added (leaves are sorted so that each solid's come together), its count per frame texel, the
+// texels it touched, and per texel the largest count of the solids done.
+struct EulerCounts {
+  int solid = -1;
+  std::vector<Vec3f> count, largest;
+  std::vector<std::uint8_t> touched_flag;
+  std::vector<int> touched;
+
+  explicit EulerCounts(std::size_t texels)
+      : count(texels, Vec3f::Zero()), largest(texels, Vec3f::Zero()), touched_flag(texels, 0) {}
+  // Starts the count of `next`, folding the previous solid's into `largest`.
+  void begin(int next) {
+    if (next == solid) return;
+    for (int i : touched) {
+      largest[std::size_t(i)] = largest[std::size_t(i)].cwiseMax(count[std::size_t(i)]);
+      count[std::size_t(i)] = Vec3f::Zero();
+      touched_flag[std::size_t(i)] = 0;
+    }
+    touched.clear();
+    solid = next;
+  }
+};
 
 // One leaf's convolved images, made independently of every other leaf (so leaves run in
 // parallel) and then added into the frame's texels by accumulate_leaf.
@@ -218,7 +241,7 @@ LeafImages convolve_leaf(const ConvolutionPlan& plan, const Triple& leaf, Blocke
 void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const LeafImages& images,
                      BlockerCombine combine, const std::vector<Vec2>& gradient,
                      std::vector<Vec3f>& occlusion, std::vector<Vec3f>& largest,
-                     std::vector<Vec3f>* euler, PairReport& report) {
+                     EulerCounts* euler, PairReport& report) {
   const PlanFrame& fr = plan.frames[leaf.frame];
   const SourceKernel& kernel = images.kernel;
   report.seconds_source += images.seconds_source;
@@ -248,6 +271,13 @@ void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const Leaf
       return;
     texels.push_back(i);
   });
+  if (euler) {
+    for (int i : texels) {
+      if (euler->touched_flag[std::size_t(i)]) continue;
+      euler->touched_flag[std::size_t(i)] = 1;
+      euler->touched.push_back(i);
+    }
+  }
   const bool weighted = !images.moment[0].empty() && !gradient.empty();
   const bool with_full = combine == BlockerCombine::sum;
   const int w = leaf.grid.width, h = leaf.grid.height;
@@ -280,7 +310,7 @@ void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const Leaf
         const double o = std::clamp((share + first) / norm, 0.0, 1.0);
         if (leaf.section) {
           for (int out = kernel.grey ? 0 : c; out < (kernel.grey ? 3 : c + 1); ++out)
-            (*euler)[i][out] -= float(wt * o);
+            euler->count[i][out] -= float(wt * o);
           continue;
         }
         const double f = combine == BlockerCombine::sum ? o : -std::log(std::max(1e-6, 1.0 - o));
@@ -295,7 +325,7 @@ void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const Leaf
         for (int out = kernel.grey ? 0 : c; out < (kernel.grey ? 3 : c + 1); ++out) {
           occlusion[i][out] += float(wt * f);
           if (with_full) largest[i][out] = std::max(largest[i][out], whole);
-          if (euler) (*euler)[i][out] += whole;
+          if (euler) euler->count[i][out] += whole;
         }
       }
     }
@@ -341,8 +371,7 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
     report.seconds_configure = f == 0 ? plan_seconds : 0;
     std::vector<Vec3f> occlusion(fr.texels.size(), Vec3f::Zero());
     std::vector<Vec3f> largest(fr.texels.size(), Vec3f::Zero());
-    // Per convex solid (by the triple heading its slabs): Euler's count of the lines it blocks.
-    std::map<int, std::vector<Vec3f>> euler;
+    EulerCounts euler(in.combine == BlockerCombine::sum ? fr.texels.size() : 0);
     const std::vector<Vec2> gradient =
         in.weighted ? weight_gradients(fr, space, lp.part) : std::vector<Vec2>{};
     std::vector<std::size_t> leaves;
@@ -352,6 +381,10 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
       if (tr.section && in.combine != BlockerCombine::sum) continue;
       if (tr.frame == int(f) && tr.children.empty() && !tr.empty) leaves.push_back(t);
     }
+    // Each convex solid's leaves together, so that one count at a time is held.
+    std::stable_sort(leaves.begin(), leaves.end(), [&](std::size_t a, std::size_t b) {
+      return plan.triples[a].euler < plan.triples[b].euler;
+    });
     // Leaves are convolved in parallel, a batch at a time (their images held until added), with
     // one FFTW thread each: on 2 cores two threads slow a transform below ~400² down
     // (tests/bench/fft_bench.cpp). A larger leaf is convolved alone, with FFTW's threads.
@@ -380,13 +413,10 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
       for (std::size_t b = first; b < last; ++b) {
         Triple& tr = plan.triples[leaves[b]];
         const auto leaf_start = Clock::now();
-        std::vector<Vec3f>* count = nullptr;
-        if (tr.euler >= 0 && in.combine == BlockerCombine::sum) {
-          count = &euler[tr.euler];
-          if (count->empty()) count->assign(fr.texels.size(), Vec3f::Zero());
-        }
+        const bool counted = tr.euler >= 0 && in.combine == BlockerCombine::sum;
+        if (counted) euler.begin(tr.euler);
         accumulate_leaf(plan, tr, images[b - first], in.combine, gradient, occlusion, largest,
-                        count, report);
+                        counted ? &euler : nullptr, report);
         images[b - first] = LeafImages{};
         tr.seconds = seconds[b - first] + seconds_since(leaf_start);
         ++report.triples;
@@ -408,6 +438,7 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
       }
       first = last;
     }
+    euler.begin(-1);  // folds the last solid's count
     if (!blockers.empty()) {
       report.blocker_depth_lo = blockers.lo;
       report.blocker_depth_hi = blockers.hi;
@@ -439,7 +470,7 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
       Vec3f v;
       for (int c = 0; c < 3; ++c) {
         float o = std::max(occlusion[i][c], largest[i][c]);
-        for (const auto& [top, count] : euler) o = std::max(o, count[i][c]);
+        if (!euler.largest.empty()) o = std::max(o, euler.largest[i][c]);
         v[c] = in.combine == BlockerCombine::sum ? std::clamp(1.0f - o, 0.0f, 1.0f)
                                                  : std::exp(-occlusion[i][c]);
       }
