@@ -37,6 +37,7 @@
 
 #include "baselines.h"
 #include "sampling.h"
+#include "shadow_rays.h"
 
 namespace sb {
 
@@ -110,10 +111,7 @@ Image bake_accumulation(const TexelSpace& space, const BaselineInputs& in, Metho
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, space.texels.size(), 64),
       [&](const tbb::blocked_range<std::size_t>& range) {
-        std::vector<Vec3> origins(samples), directions(samples);
-        std::vector<double> lengths(samples);
-        std::vector<Vec3> weights(samples);  // per channel: w · tint
-        std::vector<std::uint8_t> hit(samples);
+        ShadowRays batch(samples);
         std::int64_t local_rays = 0, local_points = 0, local_pairs = 0;
         for (std::size_t t = range.begin(); t != range.end(); ++t) {
           const Texel& texel = space.texels[t];
@@ -123,36 +121,18 @@ Image bake_accumulation(const TexelSpace& space, const BaselineInputs& in, Metho
               texel.shadow_origin.cast<double>() + offset * texel.geometric_normal.cast<double>();
           for (std::size_t l = 0; l < lights.size(); ++l) {
             if (!lights[l].reaches(position, normal)) continue;
-            int n = 0;
-            Vec3 weight_sum = Vec3::Zero();
-            for (int k = 0; k < samples; ++k) {
-              const LightSample ls =
-                  constellation_point(lights[l], constellations[l], k, position, normal);
-              if (ls.weight <= 0) continue;
-              const Vec3 d = ls.point - origin;
-              const double len = d.norm();
-              if (len <= 2 * offset) continue;
-              origins[n] = origin;
-              directions[n] = d;
-              lengths[n] = 1.0 - offset / len;  // stop short of the light's own surface
-              weights[n] = ls.weight * ls.tint;
-              weight_sum += weights[n];
-              ++n;
-            }
+            batch.clear();
+            for (int k = 0; k < samples; ++k)
+              batch.add(origin, constellation_point(lights[l], constellations[l], k, position, normal),
+                        offset);
             ++local_pairs;
-            local_points += n;
+            local_points += batch.size();
             // No point of the constellation faces the texel (a sphere light with very few
             // points, a panel mostly below the horizon): like the reference, the light adds
             // nothing here rather than a guess.
-            if (n == 0 || weight_sum.maxCoeff() <= 0) continue;
-            rays.occluded(n, origins.data(), directions.data(), lengths.data(), hit.data());
-            local_rays += n;
-            Vec3 visible = Vec3::Zero();
-            for (int s = 0; s < n; ++s)
-              if (!hit[s]) visible += weights[s];
-            Vec3 v = Vec3::Zero();
-            for (int c = 0; c < 3; ++c)
-              if (weight_sum[c] > 0) v[c] = visible[c] / weight_sum[c];
+            Vec3 v;
+            if (!batch.visible_fraction(rays, &v)) continue;
+            local_rays += batch.size();
             mix.add(l, t, v);
           }
         }

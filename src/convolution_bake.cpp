@@ -195,7 +195,7 @@ LeafImages convolve_leaf(const ConvolutionPlan& plan, const Triple& leaf, Blocke
     }
     coverage = nearest_layer_coverage(*leaf.layer, mine, leaf.slab_lo, leaf.slab_hi, leaf.grid);
     if (combine == BlockerCombine::sum) {
-      // A slab of a closed solid is capped by the solid's section at its near side, so that its
+      // A slab of a convex closed solid is capped by its section at its near side, so that its
       // whole image is the solid slab's projection rather than the ring of its faces.
       if (leaf.solid_faces) {
         const ProjectedBlockers before = crossings(leaf.slab_lo);

@@ -11,6 +11,7 @@
 #include <tbb/parallel_for.h>
 
 #include "sampling.h"
+#include "shadow_rays.h"
 
 namespace sb {
 
@@ -26,10 +27,7 @@ Image bake_reference(const TexelSpace& space, const ReferenceInputs& in,
       tbb::blocked_range<std::size_t>(0, space.texels.size(), 64),
       [&](const tbb::blocked_range<std::size_t>& range) {
         std::vector<Vec2> strata;
-        std::vector<Vec3> origins(in.samples), directions(in.samples);
-        std::vector<double> lengths(in.samples);
-        std::vector<Vec3> weights(in.samples);  // per channel: w · tint
-        std::vector<std::uint8_t> hit(in.samples);
+        ShadowRays batch(in.samples);
         std::int64_t local_rays = 0;
         for (std::size_t t = range.begin(); t != range.end(); ++t) {
           const Texel& texel = space.texels[t];
@@ -44,32 +42,13 @@ Image bake_reference(const TexelSpace& space, const ReferenceInputs& in,
             Rng rng(stream_seed(in.seed, (in.stream << 32) ^ l,
                                 std::uint64_t(texel.y) * space.width + texel.x));
             stratified_samples(in.samples, rng, strata);
-            int n = 0;
-            Vec3 weight_sum = Vec3::Zero();
-            for (int s = 0; s < in.samples; ++s) {
-              const LightSample ls = lights[l].sample(position, normal, strata[s]);
-              if (ls.weight <= 0) continue;
-              const Vec3 d = ls.point - origin;
-              const double len = d.norm();
-              if (len <= 2 * offset) continue;
-              origins[n] = origin;
-              directions[n] = d;
-              // Stop short of the light's own surface, which may lie on a blocker (a panel
-              // on a ceiling).
-              lengths[n] = 1.0 - offset / len;
-              weights[n] = ls.weight * ls.tint;
-              weight_sum += weights[n];
-              ++n;
-            }
-            if (n == 0 || weight_sum.maxCoeff() <= 0) continue;
-            rays.occluded(n, origins.data(), directions.data(), lengths.data(), hit.data());
-            local_rays += n;
-            Vec3 visible = Vec3::Zero();
-            for (int s = 0; s < n; ++s)
-              if (!hit[s]) visible += weights[s];
-            for (int c = 0; c < 3; ++c) {
-              if (weight_sum[c] > 0) h_sum[c] += h0[c] * (visible[c] / weight_sum[c]);
-            }
+            batch.clear();
+            for (int s = 0; s < in.samples; ++s)
+              batch.add(origin, lights[l].sample(position, normal, strata[s]), offset);
+            Vec3 v;
+            if (!batch.visible_fraction(rays, &v)) continue;
+            local_rays += batch.size();
+            h_sum += h0.cwiseProduct(v);
             h0_sum += h0;
           }
           float* px = out.at(texel.x, texel.y);
