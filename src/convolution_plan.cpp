@@ -1,3 +1,5 @@
+#include <chrono>
+#include <cstdio>
 // The error-driven hierarchy of (light part, blocker cluster, receiver part) triples
 // (design-notes §4–5; ../shared/seeds/001_414ff95054935c53.txt, "Measuring the Error" and
 // "Subdivision"). One virtual configuration per triple gets every penumbra width wrong by at
@@ -148,6 +150,11 @@ namespace {
 // 100 texels wide may be off by a few texels unseen. (design-notes §4: "compare it with the texel
 // size, or with the penumbra width, for a relative error".)
 constexpr double kRelativeSpan = 16.0;
+// Image pixels across a leaf's narrowest penumbra, where that is wider than one texel per pixel.
+// Fewer cost accuracy where it is checked exactly: with 32 (or 16), bilinear reads of the
+// convolved image and the coarser kernel put the parallel square light's maximum error at 0.02
+// (0.05) against its closed form, above the 0.02 its test allows (convolution_bake_test.cpp).
+constexpr double kPenumbraPixels = 64.0;
 // Light splits: at most this many halvings (2^2 = 4 parts).
 constexpr int kMaxLightSplits = 2;
 
@@ -255,10 +262,10 @@ void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& 
   t.penumbra_error_texels = scale > 0 ? (t.config.penumbra_error + t.view_error) / scale : 0;
 
   // Image resolution: one pixel per receiver texel at the receiver plane, coarser only where the
-  // narrowest penumbra spans 64 pixels anyway (design-notes §5, "texture
+  // narrowest penumbra spans kPenumbraPixels pixels anyway (design-notes §5, "texture
   // resolution"); then within max_image, flagging any loss of detail.
   const double r_star = t.config.receiver_plane;
-  const double detail = std::max(plan.texel, t.smallest_penumbra / 64.0);
+  const double detail = std::max(plan.texel, t.smallest_penumbra / kPenumbraPixels);
   double pixel = (plan.texel > 0 ? detail : (thi - tlo).maxCoeff() / 512) / r_star;
   const double k = std::max(0.0, 1.0 / t.config.blocker_plane - 1.0 / r_star);
   const Vec2 kernel_extent = 2 * k * projected_half_extents(light, fr.frame, t.view, r_star);
@@ -523,28 +530,29 @@ ConvolutionPlan empty_like(const ConvolutionPlan& plan) {
   return p;
 }
 
-// Plans one light part within `budget` leaves; when the target is missed, tries the part's two
-// halves (a source subdivision, design-notes §5) with half the budget each and keeps the plan
-// with the smaller worst ε.
-ConvolutionPlan plan_light_part(const ConvolutionPlan& base, const PlanInputs& in, LightPart part,
-                                int budget, int level) {
+bool has_slabs(const ConvolutionPlan& plan) {
+  return std::any_of(plan.triples.begin(), plan.triples.end(),
+                     [](const Triple& t) { return t.split == "blocker depth"; });
+}
+
+ConvolutionPlan plan_whole_part(const ConvolutionPlan& base, const PlanInputs& in, LightPart part,
+                                int budget) {
   ConvolutionPlan whole = empty_like(base);
-  whole.light_parts.push_back(part);
+  whole.light_parts.push_back(std::move(part));
   add_frames(whole, in, 0);
   Planner(whole, in).refine(0, whole.frames.size(), budget);
   add_sections(whole, in);
-  const double worst = whole.worst_error_texels();
+  return whole;
+}
+
+ConvolutionPlan plan_light_part(const ConvolutionPlan& base, const PlanInputs& in, LightPart part,
+                                int budget, int level);
+
+// The part's two halves along its longer side, planned at once on their own threads with half
+// the budget each, merged into one plan.
+ConvolutionPlan plan_halves(const ConvolutionPlan& base, const PlanInputs& in, const LightPart& part,
+                            int budget, int level) {
   const LightDesc& d = part.part.desc();
-  const bool splittable =
-      d.shape == LightShape::rectangle && !part.part.textured() && level < kMaxLightSplits;
-  // Split to reach light_parts whatever ε says where blockers were cut into slabs (the slabs'
-  // error that ε does not measure; one plane per blocker has none); beyond, only when the
-  // target is missed.
-  const bool slabs = std::any_of(whole.triples.begin(), whole.triples.end(),
-                                 [](const Triple& t) { return t.split == "blocker depth"; });
-  const bool required = slabs && (1 << level) < in.light_parts;
-  if ((worst <= in.error_texels && !required) || !splittable) return whole;
-  // The halves are planned at once, on their own threads.
   std::array<ConvolutionPlan, 2> half_plans;
   tbb::parallel_for(0, 2, [&](int side) {
     LightDesc h = d;
@@ -563,7 +571,34 @@ ConvolutionPlan plan_light_part(const ConvolutionPlan& base, const PlanInputs& i
   });
   ConvolutionPlan halves = empty_like(base);
   for (ConvolutionPlan& h : half_plans) merge_plan(halves, std::move(h));
-  return required || halves.worst_error_texels() < worst ? std::move(halves) : std::move(whole);
+  return halves;
+}
+
+// Plans one light part within `budget` leaves; when the target is missed, tries the part's two
+// halves (a source subdivision, design-notes §5) and keeps the plan with the smaller worst ε.
+// Where blockers are cut into depth slabs, the part is split into at least `light_parts` pieces
+// whatever ε says (the slabs' plane error, which ε does not measure, scales with the light's
+// size; one plane per blocker has none). Below that count the halves are planned first: if they
+// cut blockers into slabs, the whole part (whose ε is larger) would too, and its plan, which
+// would be thrown away, is never made.
+ConvolutionPlan plan_light_part(const ConvolutionPlan& base, const PlanInputs& in, LightPart part,
+                                int budget, int level) {
+  const LightDesc& d = part.part.desc();
+  const bool splittable =
+      d.shape == LightShape::rectangle && !part.part.textured() && level < kMaxLightSplits;
+  if (splittable && (1 << level) < in.light_parts) {
+    ConvolutionPlan halves = plan_halves(base, in, part, budget, level);
+    if (has_slabs(halves)) return halves;
+    ConvolutionPlan whole = plan_whole_part(base, in, part, budget);
+    const double worst = whole.worst_error_texels();
+    const bool better = worst > in.error_texels && halves.worst_error_texels() < worst;
+    return has_slabs(whole) || better ? std::move(halves) : std::move(whole);
+  }
+  ConvolutionPlan whole = plan_whole_part(base, in, part, budget);
+  const double worst = whole.worst_error_texels();
+  if (worst <= in.error_texels || !splittable) return whole;
+  ConvolutionPlan halves = plan_halves(base, in, part, budget, level);
+  return halves.worst_error_texels() < worst ? std::move(halves) : std::move(whole);
 }
 
 }  // namespace
