@@ -216,21 +216,24 @@ LeafImages convolve_leaf(const ConvolutionPlan& plan, const Triple& leaf, Blocke
   out.th = leaf.fft_height;
   const int w = leaf.grid.width, h = leaf.grid.height;
   const int channels = kernel.grey ? 1 : 3;
-  for (int c = 0; c < channels; ++c) {
-    const auto spectrum = fft.kernel_spectrum(kernel.channels[c], kernel.width, kernel.height,
-                                              out.tw, out.th);
-    fft.convolve(coverage, w, h, *spectrum, out.occluded[c]);
-    if (!full.empty()) fft.convolve(full, w, h, *spectrum, out.occluded_full[c]);
-  }
   weighted = weighted && !kernel.moments[0].empty();
-  if (weighted) {
-    for (int m = 0; m < 2; ++m) {
-      const auto spectrum = fft.kernel_spectrum(kernel.moments[m], kernel.width, kernel.height,
-                                                out.tw, out.th);
-      fft.convolve(coverage, w, h, *spectrum, out.moment[m]);
-      if (!full.empty()) fft.convolve(full, w, h, *spectrum, out.moment_full[m]);
-    }
-  }
+  // Every kernel of the leaf (colour channels, then the two moments) against each image, which
+  // is transformed once for all of them.
+  std::vector<std::shared_ptr<const KernelSpectrum>> spectra;
+  std::vector<const KernelSpectrum*> kernels;
+  std::vector<std::vector<float>*> to_share, to_full;
+  auto add = [&](const std::vector<float>& values, std::vector<float>& share,
+                 std::vector<float>& whole) {
+    spectra.push_back(fft.kernel_spectrum(values, kernel.width, kernel.height, out.tw, out.th));
+    kernels.push_back(spectra.back().get());
+    to_share.push_back(&share);
+    to_full.push_back(&whole);
+  };
+  for (int c = 0; c < channels; ++c) add(kernel.channels[c], out.occluded[c], out.occluded_full[c]);
+  if (weighted)
+    for (int m = 0; m < 2; ++m) add(kernel.moments[m], out.moment[m], out.moment_full[m]);
+  fft.convolve(coverage, w, h, kernels, to_share);
+  if (!full.empty()) fft.convolve(full, w, h, kernels, to_full);
   out.seconds_fft = seconds_since(start);
   out.convolutions = (channels + (weighted ? 2 : 0)) * (full.empty() ? 1 : 2);
   return out;

@@ -271,16 +271,33 @@ std::shared_ptr<const KernelSpectrum> FftConvolver::kernel_spectrum(
 
 void FftConvolver::convolve(const std::vector<float>& image, int w, int h,
                             const KernelSpectrum& kernel, std::vector<float>& out) {
+  const KernelSpectrum* kernels[1] = {&kernel};
+  std::vector<float>* outs[1] = {&out};
+  convolve(image, w, h, kernels, outs);
+}
+
+void FftConvolver::convolve(const std::vector<float>& image, int w, int h,
+                            std::span<const KernelSpectrum* const> kernels,
+                            std::span<std::vector<float>* const> outs) {
   assert(w >= 1 && h >= 1);
   assert(image.size() == std::size_t(w) * std::size_t(h));
-  assert(kernel.tw >= w && kernel.th >= h);
-  const int tw = kernel.tw, th = kernel.th;
+  assert(!kernels.empty() && kernels.size() == outs.size());
+  const int tw = kernels[0]->tw, th = kernels[0]->th;
+  assert(std::all_of(kernels.begin(), kernels.end(),
+                     [&](const KernelSpectrum* k) { return k->tw == tw && k->th == th; }));
+  assert(tw >= w && th >= h);
   const std::size_t row = std::size_t(tw);
+  const std::size_t count = spectrum_count(tw, th);
   const Impl::Plans& plans = impl_->plans_for(tw, th);
 
-  Scratch& scratch = thread_scratch(row * std::size_t(th), spectrum_count(tw, th));
+  // With several kernels the image's spectrum is kept aside and each product made in `product`,
+  // which starts 64 bytes aligned like the arrays the plans were made for (FFTW's new-array
+  // execute requires the planned alignment).
+  const std::size_t offset = (count + 7) / 8 * 8;
+  Scratch& scratch = thread_scratch(row * std::size_t(th), kernels.size() > 1 ? offset + count : count);
   float* padded = scratch.real.get();
   fftwf_complex* spectrum = scratch.spectrum.get();
+  fftwf_complex* product = kernels.size() > 1 ? spectrum + offset : spectrum;
   // The image top-left, zeros around it; the scratch holds the previous call's output, so every
   // padding pixel is written.
   for (int y = 0; y < h; ++y) {
@@ -291,20 +308,24 @@ void FftConvolver::convolve(const std::vector<float>& image, int w, int h,
   std::fill(padded + std::size_t(h) * row, padded + std::size_t(th) * row, 0.0f);
 
   fftwf_execute_dft_r2c(plans.forward, padded, spectrum);
-  // Pointwise complex product, on interleaved (re, im) floats so the compiler vectorises it.
-  float* a = &spectrum[0][0];
-  const float* b = &kernel.values[0][0];
-  for (std::size_t i = 0; i < 2 * spectrum_count(tw, th); i += 2) {
-    const float re = a[i] * b[i] - a[i + 1] * b[i + 1];
-    const float im = a[i] * b[i + 1] + a[i + 1] * b[i];
-    a[i] = re;
-    a[i + 1] = im;
+  for (std::size_t k = 0; k < kernels.size(); ++k) {
+    // Pointwise complex product, on interleaved (re, im) floats so the compiler vectorises it.
+    const float* a = &spectrum[0][0];
+    const float* b = &kernels[k]->values[0][0];
+    float* p = &product[0][0];
+    for (std::size_t i = 0; i < 2 * count; i += 2) {
+      const float re = a[i] * b[i] - a[i + 1] * b[i + 1];
+      const float im = a[i] * b[i + 1] + a[i + 1] * b[i];
+      p[i] = re;
+      p[i + 1] = im;
+    }
+    // The c2r transform overwrites its input: `product`, never the kept spectrum.
+    fftwf_execute_dft_c2r(plans.inverse, product, padded);
+    std::vector<float>& out = *outs[k];
+    out.resize(std::size_t(w) * std::size_t(h));
+    for (int y = 0; y < h; ++y)
+      std::copy_n(padded + std::size_t(y) * row, w, out.data() + std::size_t(y) * std::size_t(w));
   }
-  fftwf_execute_dft_c2r(plans.inverse, spectrum, padded);
-
-  out.resize(std::size_t(w) * std::size_t(h));
-  for (int y = 0; y < h; ++y)
-    std::copy_n(padded + std::size_t(y) * row, w, out.data() + std::size_t(y) * std::size_t(w));
 }
 
 }  // namespace sb

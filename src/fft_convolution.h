@@ -5,6 +5,7 @@
 #pragma once
 
 #include <memory>
+#include <span>
 #include <vector>
 
 namespace sb {
@@ -47,6 +48,13 @@ class FftConvolver {
   // `out` is resized to w·h.
   void convolve(const std::vector<float>& image, int w, int h, const KernelSpectrum& kernel,
                 std::vector<float>& out);
+
+  // The same image convolved with several kernels of one transform size: the image is
+  // transformed once, then multiplied and transformed back per kernel (a leaf's occlusion and
+  // its two moments cost 4 transforms instead of 6). outs[i] gets kernels[i]'s result.
+  void convolve(const std::vector<float>& image, int w, int h,
+                std::span<const KernelSpectrum* const> kernels,
+                std::span<std::vector<float>* const> outs);
 
   // Number of FFTW threads used for one threaded() transform (default: all cores). Call before
   // baking.

@@ -90,6 +90,36 @@ TEST(FftConvolution, PaddedTransformMatchesDirectConvolutionEverywhere) {
   }
 }
 
+TEST(FftConvolution, SeveralKernelsShareOneImageTransform) {
+  // Three kernels against one image, at transform sizes whose spectra hold an odd number of
+  // complex values ((31/2 + 1) x 41 = 656 is even, (33/2 + 1) x 29 = 493 odd), so that the kept
+  // spectrum and the product would be misaligned without the rounding in convolve().
+  const int w = 25, h = 21, kw = 5, kh = 7;
+  const std::vector<float> image = random_values(std::size_t(w) * std::size_t(h), 11);
+  FftConvolver& convolver = FftConvolver::shared();
+  for (const auto& [tw, th] : {std::pair{31, 41}, std::pair{33, 29}}) {
+    SCOPED_TRACE(testing::Message() << "transform " << tw << " x " << th);
+    std::vector<std::vector<float>> kernels, expected;
+    std::vector<std::shared_ptr<const KernelSpectrum>> spectra;
+    std::vector<const KernelSpectrum*> pointers;
+    for (unsigned seed = 12; seed < 15; ++seed) {
+      kernels.push_back(random_values(std::size_t(kw) * std::size_t(kh), seed));
+      expected.push_back(direct_convolution(image, w, h, kernels.back(), kw, kh));
+      spectra.push_back(convolver.kernel_spectrum(kernels.back(), kw, kh, tw, th));
+      pointers.push_back(spectra.back().get());
+    }
+    std::vector<std::vector<float>> outs(3);
+    std::vector<std::vector<float>*> out_pointers = {&outs[0], &outs[1], &outs[2]};
+    convolver.convolve(image, w, h, pointers, out_pointers);
+    for (std::size_t k = 0; k < 3; ++k) {
+      ASSERT_EQ(outs[k].size(), expected[k].size());
+      const float tolerance = 1e-5f * kernel_sum(kernels[k]);
+      for (std::size_t i = 0; i < outs[k].size(); ++i)
+        ASSERT_NEAR(outs[k][i], expected[k][i], tolerance) << "kernel " << k << ", pixel " << i;
+    }
+  }
+}
+
 TEST(FftConvolution, UnpaddedTransformIsExactInInteriorAndWrapsAtBorder) {
   const int w = 37, h = 23, kw = 5, kh = 7;
   const std::vector<float> image = random_values(std::size_t(w) * std::size_t(h), 3);
