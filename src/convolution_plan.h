@@ -209,7 +209,7 @@ struct PlanFrame {
   std::int64_t outside_texels = 0;  // at or behind the light's plane: left unshadowed
   // Texels that share their blockers: all of them, or, for a receiver that is its own blocker,
   // those of one convex component, or of one plane of a non-convex one. Indices into the arrays
-  // above, sorted by depth; one root triple each.
+  // above, the deepest last; one root triple each.
   std::vector<std::vector<int>> groups;
   std::vector<TexelIndex> index;  // per group
   std::vector<int> roots;

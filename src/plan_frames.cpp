@@ -66,6 +66,9 @@ std::vector<TexelGroup> group_texels(const TexelSpace& space, const PlanInputs& 
                                      const std::vector<std::size_t>& lit, const Light& light) {
   const int own = own_index(in);
   std::map<std::pair<int, long long>, std::vector<std::size_t>> groups;
+  // Neighbouring texels mostly share their group: the last one found saves a map search.
+  std::pair<int, long long> last_key{-2, 0};
+  std::vector<std::size_t>* last = nullptr;
   for (std::size_t t : lit) {
     std::pair<int, long long> key{-1, 0};
     if (own >= 0 && in.clusters) {
@@ -84,7 +87,11 @@ std::vector<TexelGroup> group_texels(const TexelSpace& space, const PlanInputs& 
         key.second = h;
       }
     }
-    groups[key].push_back(t);
+    if (!last || key != last_key) {
+      last_key = key;
+      last = &groups[key];
+    }
+    last->push_back(t);
   }
   // A curved non-convex component has a plane per face: then fall back to one group per
   // component (its nearby faces may then shadow it a little: docs/methods.md).
@@ -139,7 +146,7 @@ std::vector<FaceRef> group_faces(const ConvolutionPlan& plan, const PlanInputs& 
     return faces;
   }
   Bounds3 bounds;
-  for (int i : group) bounds.extend(Vec3(plan.space->texels[fr.texels[i]].position.cast<double>()));
+  for (int i : group) bounds.extend(fr.position[std::size_t(i)]);
   const Shaft shaft(light_outline(light), bounds);
   for (int node : clusters_in_shaft(*in.clusters, shaft)) {
     const Cluster& c = in.clusters->nodes[node];
@@ -232,6 +239,12 @@ void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part) {
     f.light_part = light_part;
     std::vector<int> convex_component;
     double deepest = 0;
+    std::size_t members = 0;
+    for (const auto& m : fg.members) members += m.second.size();
+    f.texels.reserve(members);
+    f.depth.reserve(members);
+    f.position.reserve(members);
+    f.tangent.reserve(members);
     for (auto& [g, texels] : fg.members) {
       if (texels.empty()) continue;
       std::vector<int> members;
@@ -260,7 +273,11 @@ void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part) {
       auto& g = f.groups[k];
       std::erase_if(g, [&](int i) { return f.depth[std::size_t(i)] <= f.near; });
       if (g.empty()) continue;
-      std::sort(g.begin(), g.end(), [&](int a, int b) { return f.depth[a] < f.depth[b]; });
+      // The deepest texel last (evaluate_triple reads the group's depth there); a full sort by
+      // depth cost a tenth of the planning of a 2048² floor.
+      std::iter_swap(std::max_element(g.begin(), g.end(),
+                                      [&](int a, int b) { return f.depth[a] < f.depth[b]; }),
+                     g.end() - 1);
       kept.push_back(std::move(g));
       kept_component.push_back(convex_component[k]);
     }
@@ -280,8 +297,7 @@ void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part) {
       root.slab_lo = 0;
       root.slab_hi = std::numeric_limits<double>::infinity();
       root.faces = group_faces(plan, in, added, added.groups[g], light, convex_component[g]);
-      for (int i : added.groups[g])
-        root.receiver_box.extend(Vec3(space.texels[added.texels[i]].position.cast<double>()));
+      for (int i : added.groups[g]) root.receiver_box.extend(added.position[std::size_t(i)]);
       evaluate_triple(plan, in, root);
       added.roots.push_back(int(plan.triples.size()));
       plan.triples.push_back(std::move(root));
