@@ -53,6 +53,7 @@
 #include <numbers>
 
 #include "blocker_image.h"
+#include "buried_texels.h"
 #include "fft_convolution.h"
 #include "source_image.h"
 #include "convolution_plan.h"
@@ -66,6 +67,10 @@ using Clock = std::chrono::steady_clock;
 // Transform pixels of the leaves convolved together before their images are added in (about
 // 5 images of 4 bytes each per pixel: 64 MiB).
 constexpr std::size_t kBatchPixels = std::size_t(1) << 22;
+
+// How far outside a solid's face plane a texel may lie and still count as buried in it, in
+// receiver texels: a floor texel under a box's bottom face lies on that plane up to rounding.
+constexpr double kBuriedTolerance = 1e-3;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
@@ -483,6 +488,13 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
     if (reports) reports->push_back(std::move(report));
   }
 
+  // A texel inside a convex closed blocker (a floor under a box) sees no light: exactly, rather
+  // than through the slabs' approximate count (buried_texels.h).
+  const std::vector<std::uint8_t> buried =
+      in.clusters ? buried_texels(space, *in.receiver, in.blockers, *in.clusters,
+                                  kBuriedTolerance * plan.texel)
+                  : std::vector<std::uint8_t>(n, 0);
+
   // Lights combined as V = Σ H0_l·V_l / Σ H0_l. One light's visibility needs no closed form: its
   // weight is its exitance where it reaches the texel, so a channel it does not emit stays 0.
   const bool weights_needed = lights.size() > 1 || in.quantity == Quantity::irradiance;
@@ -492,7 +504,7 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
       const Texel& tx = space.texels[t];
       const Vec3 p = tx.position.cast<double>(), normal = tx.normal.cast<double>();
       Vec3 sum = Vec3::Zero(), weight = Vec3::Zero();
-      for (std::size_t l = 0; l < lights.size(); ++l) {
+      for (std::size_t l = 0; l < lights.size() && !buried[t]; ++l) {
         if (visible[l].empty() || reached[l][t] <= 0) continue;
         const Vec3 w = weights_needed ? lights[l].unoccluded_irradiance(p, normal)
                                       : lights[l].exitance();
