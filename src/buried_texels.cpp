@@ -49,9 +49,9 @@ std::vector<std::uint8_t> buried_texels(const TexelSpace& space, const Mesh& rec
           if (buried[t]) continue;
           if (own && clusters.face_component[m][std::size_t(tx.face)] == int(c)) continue;
           const Vec3 p = tx.position.cast<double>();
-          const Vec3 normal = tx.geometric_normal.cast<double>();
           if (((p - box.lo).array() < -tolerance).any() || ((p - box.hi).array() > tolerance).any())
             continue;
+          const Vec3 normal = tx.geometric_normal.cast<double>();
           bool inside = true;
           for (const auto& [n, offset] : planes[c]) {
             // A face lying against the receiver's surface (a box's bottom on the floor) holds

@@ -1,5 +1,3 @@
-#include <chrono>
-#include <cstdio>
 // The error-driven hierarchy of (light part, blocker cluster, receiver part) triples
 // (design-notes §4–5; ../shared/seeds/001_414ff95054935c53.txt, "Measuring the Error" and
 // "Subdivision"). One virtual configuration per triple gets every penumbra width wrong by at
