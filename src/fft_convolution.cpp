@@ -202,7 +202,12 @@ int FftConvolver::fast_size(int n) {
 }
 
 int FftConvolver::transform_size(int n) {
-  if (n <= 64) return fast_size(n);
+  if (n <= 8) return 8;
+  if (n <= 64) {
+    int octave = 2;
+    while (6 * octave < n) octave *= 2;
+    return 4 * octave >= n ? 4 * octave : 6 * octave;
+  }
   int octave = 16;  // 2^a with 4·2^a >= 64
   while (7 * octave < n) octave *= 2;
   for (const int step : {4, 5, 6, 7})

@@ -23,10 +23,12 @@ class FftConvolver {
   // The smallest size >= n whose prime factors are all 2, 3, 5 or 7 (sizes FFTW is fast at).
   static int fast_size(int n);
 
-  // The transform size for an image n pixels wide: fast_size up to 64, then the smallest of
-  // 2^a · {4, 5, 6, 7} / 4 >= n (at most 25 % padding). A few sizes per octave let the many
-  // images of a bake share FFTW plans, whose making (2–4 ms a pair) costs more than the
-  // transforms of a ~300² image (0.4 ms a round trip; tests/bench/fft_bench.cpp).
+  // The transform size for an image n pixels wide: at least 8, then the smallest of
+  // 2^a · {4, 6} / 4 >= n up to 64 (at most 50 % padding), and of 2^a · {4, 5, 6, 7} / 4 beyond
+  // (at most 25 %). A few sizes per octave let the many images of a bake share FFTW plans, whose
+  // making (0.5–4 ms a pair) costs more than the transforms of a ~300² image (0.4 ms a round
+  // trip; tests/bench/fft_bench.cpp); below 64 pixels a transform costs microseconds, and sharing
+  // plans matters more than padding.
   static int transform_size(int n);
 
   // Whether a tw × th transform runs on several FFTW threads (set_threads) or on one: two

@@ -215,8 +215,12 @@ TEST(FftConvolution, FastSizeHasOnlyFactorsTwoThreeFiveSeven) {
   EXPECT_EQ(FftConvolver::fast_size(2113), 2160);  // 2^4 · 3^3 · 5
 }
 
-TEST(FftConvolution, TransformSizesAreFewPerOctaveAndPadAtMostAQuarter) {
-  EXPECT_EQ(FftConvolver::transform_size(11), 12);  // fast_size below 65
+TEST(FftConvolution, TransformSizesAreFewPerOctave) {
+  EXPECT_EQ(FftConvolver::transform_size(1), 8);
+  EXPECT_EQ(FftConvolver::transform_size(11), 12);
+  EXPECT_EQ(FftConvolver::transform_size(13), 16);
+  EXPECT_EQ(FftConvolver::transform_size(25), 32);
+  EXPECT_EQ(FftConvolver::transform_size(33), 48);
   EXPECT_EQ(FftConvolver::transform_size(64), 64);
   EXPECT_EQ(FftConvolver::transform_size(65), 80);
   EXPECT_EQ(FftConvolver::transform_size(113), 128);
@@ -230,7 +234,15 @@ TEST(FftConvolution, TransformSizesAreFewPerOctaveAndPadAtMostAQuarter) {
     ASSERT_EQ(FftConvolver::fast_size(t), t) << n;  // FFTW-friendly factors
     sizes.insert(t);
   }
-  EXPECT_LE(sizes.size(), 4u * 6u + 1u);  // 4 per octave from 64 to 4096
+  EXPECT_LE(sizes.size(), 4u * 6u + 1u);  // 4 per octave from 64 to 4096, a quarter's padding
+  std::set<int> small;
+  for (int n = 9; n <= 64; ++n) {
+    const int t = FftConvolver::transform_size(n);
+    ASSERT_GE(t, n);
+    ASSERT_LE(t, n + n / 2 + 1) << n;
+    small.insert(t);
+  }
+  EXPECT_EQ(small, (std::set<int>{12, 16, 24, 32, 48, 64}));  // 2 per octave below 64
 }
 
 TEST(FftConvolution, SmallTransformsRunOnOneThread) {
