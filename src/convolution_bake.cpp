@@ -149,22 +149,105 @@ struct EulerCounts {
   }
 };
 
-// One leaf's convolved images, made independently of every other leaf (so leaves run in
-// parallel) and then added into the frame's texels by accumulate_leaf.
-struct LeafImages {
-  SourceKernel kernel;
+// One window of a leaf's grid and its convolved images: the whole grid, or, where the leaf's
+// blockers fall into islands whose shadows cannot meet (leaf_windows), the part around one
+// island. `lo`, `hi` bound the tangents of the texels that read it.
+struct LeafWindow {
+  TangentGrid grid;
+  Vec2 lo = Vec2::Zero(), hi = Vec2::Zero();
+  int tw = 0, th = 0;
   std::array<std::vector<float>, 3> occluded;       // share of the nearest layer ⊛ kernel
   std::array<std::vector<float>, 3> occluded_full;  // whole image ⊛ kernel; empty if equal
   std::array<std::vector<float>, 2> moment;         // share ⊛ moment kernels (weighting)
   std::array<std::vector<float>, 2> moment_full;    // whole ⊛ moment kernels, if whole differs
-  int tw = 0, th = 0;
+};
+
+// One leaf's convolved images, made independently of every other leaf (so leaves run in
+// parallel) and then added into the frame's texels by accumulate_leaf.
+struct LeafImages {
+  SourceKernel kernel;
+  std::vector<LeafWindow> windows;
   int convolutions = 0;
   double seconds_source = 0, seconds_blocker = 0, seconds_fft = 0;
 };
 
+// A leaf's blockers often fall into islands far apart: the four legs of a table, cut into the
+// same slab, project to four small squares at the corners of one large image. Convolution is
+// linear and the kernel reaches only `reach` from a blocker pixel, so each island can be
+// convolved on a window of its own, read by the texels within `reach` of it, as long as no such
+// texel is within reach of another island: the values are those of the whole grid, for a
+// fraction of its pixels. `boxes` are tangent boxes holding every polygon that can put coverage
+// into the leaf's images. Returns the windows (islands merged until their grown boxes are
+// disjoint), or the whole grid alone where the windows would not save at least a third of its
+// transform.
+std::vector<LeafWindow> leaf_windows(const Triple& leaf, const SourceKernel& kernel,
+                                     const std::vector<std::pair<Vec2, Vec2>>& boxes) {
+  const TangentGrid& g = leaf.grid;
+  std::vector<LeafWindow> whole(1);
+  whole[0].grid = g;
+  whole[0].lo = leaf.footprint_lo;
+  whole[0].hi = leaf.footprint_hi;
+  whole[0].tw = leaf.fft_width;
+  whole[0].th = leaf.fft_height;
+  // The kernel's half extents plus two pixels (rasterisation and bilinear reads).
+  const Vec2 reach = Vec2(kernel.width / 2 + 2, kernel.height / 2 + 2) * g.pixel;
+  const Vec2 grid_lo = g.origin, grid_hi = g.origin + Vec2(g.width, g.height) * g.pixel;
+  auto apart = [&](const std::pair<Vec2, Vec2>& a, const std::pair<Vec2, Vec2>& b) {
+    return ((a.second + reach).array() < (b.first - reach).array()).any() ||
+           ((b.second + reach).array() < (a.first - reach).array()).any();
+  };
+  std::vector<std::pair<Vec2, Vec2>> islands;
+  for (auto box : boxes) {
+    if (((box.second + reach).array() < grid_lo.array()).any() ||
+        ((box.first - reach).array() > grid_hi.array()).any())
+      continue;  // wholly outside the grid: rasterises to nothing
+    // Absorb every island this box (as it grows) comes within reach of.
+    for (bool merged = true; merged;) {
+      merged = false;
+      for (std::size_t i = 0; i < islands.size(); ++i) {
+        if (apart(box, islands[i])) continue;
+        box.first = box.first.cwiseMin(islands[i].first);
+        box.second = box.second.cwiseMax(islands[i].second);
+        islands.erase(islands.begin() + std::ptrdiff_t(i));
+        merged = true;
+        break;
+      }
+    }
+    islands.push_back(box);
+  }
+  if (islands.size() < 2) return whole;
+  std::vector<LeafWindow> windows;
+  int tw = 0, th = 0;
+  for (const auto& [lo, hi] : islands) {
+    LeafWindow w;
+    const Vec2 a = (lo - reach - g.origin) / g.pixel, b = (hi + reach - g.origin) / g.pixel;
+    const int x0 = std::max(0, int(std::floor(a.x()))), y0 = std::max(0, int(std::floor(a.y())));
+    const int x1 = std::min(g.width, int(std::ceil(b.x())) + 1);
+    const int y1 = std::min(g.height, int(std::ceil(b.y())) + 1);
+    if (x0 >= x1 || y0 >= y1) continue;
+    w.grid.pixel = g.pixel;
+    w.grid.origin = g.origin + Vec2(x0, y0) * g.pixel;
+    w.grid.width = x1 - x0;
+    w.grid.height = y1 - y0;
+    w.lo = (lo - reach).cwiseMax(leaf.footprint_lo);
+    w.hi = (hi + reach).cwiseMin(leaf.footprint_hi);
+    tw = std::max(tw, FftConvolver::transform_size(w.grid.width));
+    th = std::max(th, FftConvolver::transform_size(w.grid.height));
+    windows.push_back(std::move(w));
+  }
+  // One transform size for all windows: the kernel's spectra and FFTW's plans are shared.
+  if (double(windows.size()) * tw * th > (2.0 / 3.0) * double(leaf.fft_width) * leaf.fft_height)
+    return whole;
+  for (LeafWindow& w : windows) {
+    w.tw = tw;
+    w.th = th;
+  }
+  return windows;
+}
+
 // Renders one leaf's kernel and blocker images and convolves them.
 LeafImages convolve_leaf(const ConvolutionPlan& plan, const Triple& leaf, BlockerCombine combine,
-                         bool weighted) {
+                         bool weighted, bool windows) {
   LeafImages out;
   const PlanFrame& fr = plan.frames[leaf.frame];
   const Light& light = plan.light_parts[fr.light_part].part;
@@ -177,70 +260,84 @@ LeafImages convolve_leaf(const ConvolutionPlan& plan, const Triple& leaf, Blocke
   start = Clock::now();
   // A closed solid's surface clipped to depths before `depth`, unculled: the crossings whose
   // parity gives its section there (blocker_coverage).
-  auto crossings = [&](double depth) {
-    return project_faces(*leaf.solid_faces, fr.frame, fr.near, depth, ShadowCaster{});
-  };
-  std::vector<float> coverage, full;
-  if (leaf.section) {
-    const ProjectedBlockers before = crossings(leaf.slab_lo);
-    coverage = blocker_coverage(ProjectedBlockers{}, leaf.grid, &before);
-  } else {
-    // This cluster's share of the root layer's hard shadow (nearest_layer_coverage).
-    std::vector<std::uint8_t> mine(leaf.layer->polygons.size(), 0);
-    {
-      std::vector<std::pair<const Mesh*, int>> own;
-      for (const FaceRef& f : leaf.faces) own.emplace_back(f.mesh, f.face);
-      std::sort(own.begin(), own.end());
-      const Triple* root = &leaf;
-      while (root->parent >= 0) root = &plan.triples[std::size_t(root->parent)];
-      for (std::size_t i = 0; i < mine.size(); ++i) {
-        const FaceRef& f = root->faces[std::size_t(leaf.layer->polygons[i].source)];
-        mine[i] = std::binary_search(own.begin(), own.end(), std::make_pair(f.mesh, f.face));
-      }
-    }
-    coverage = nearest_layer_coverage(*leaf.layer, mine, leaf.slab_lo, leaf.slab_hi, leaf.grid);
-    if (combine == BlockerCombine::sum) {
-      // A slab of a convex closed solid is capped by its section at its near side, so that its
-      // whole image is the solid slab's projection rather than the ring of its faces.
-      if (leaf.solid_faces) {
-        const ProjectedBlockers before = crossings(leaf.slab_lo);
-        full = blocker_coverage(leaf.blockers, leaf.grid, &before);
-      } else {
-        full = blocker_coverage(leaf.blockers, leaf.grid);
-      }
-      // Nothing of the cluster hidden behind others: its full image is its share.
-      bool hidden = false;
-      for (std::size_t i = 0; i < full.size() && !hidden; ++i) hidden = full[i] > coverage[i] + 1e-6f;
-      if (!hidden) full.clear();
+  ProjectedBlockers before;
+  if (leaf.section || leaf.solid_faces)
+    before = project_faces(*leaf.solid_faces, fr.frame, fr.near, leaf.slab_lo, ShadowCaster{});
+  // Which polygons of the root layer are this cluster's, for its share of the layer's hard
+  // shadow (nearest_layer_coverage).
+  std::vector<std::uint8_t> mine;
+  if (!leaf.section) {
+    mine.assign(leaf.layer->polygons.size(), 0);
+    std::vector<std::pair<const Mesh*, int>> own;
+    for (const FaceRef& f : leaf.faces) own.emplace_back(f.mesh, f.face);
+    std::sort(own.begin(), own.end());
+    const Triple* root = &leaf;
+    while (root->parent >= 0) root = &plan.triples[std::size_t(root->parent)];
+    for (std::size_t i = 0; i < mine.size(); ++i) {
+      const FaceRef& f = root->faces[std::size_t(leaf.layer->polygons[i].source)];
+      mine[i] = std::binary_search(own.begin(), own.end(), std::make_pair(f.mesh, f.face));
     }
   }
-  out.seconds_blocker = seconds_since(start);
-  start = Clock::now();
+  // Everything that can put coverage into the images: the cluster's polygons in the layer that
+  // meet its slab, its own projected faces, and the solid's crossings.
+  std::vector<std::pair<Vec2, Vec2>> boxes;
+  if (windows) {
+    for (std::size_t i = 0; i < mine.size(); ++i) {
+      const auto& pg = leaf.layer->polygons[i];
+      if (mine[i] && pg.depth_lo <= leaf.slab_hi && pg.depth_hi >= leaf.slab_lo)
+        boxes.emplace_back(pg.lo, pg.hi);
+    }
+    for (const auto& pg : leaf.blockers.polygons) boxes.emplace_back(pg.lo, pg.hi);
+    for (const auto& pg : before.polygons) boxes.emplace_back(pg.lo, pg.hi);
+  }
+  out.windows = leaf_windows(leaf, kernel, boxes);
+  out.seconds_blocker += seconds_since(start);
+
   auto& fft = FftConvolver::shared();
-  out.tw = leaf.fft_width;
-  out.th = leaf.fft_height;
-  const int w = leaf.grid.width, h = leaf.grid.height;
   const int channels = kernel.grey ? 1 : 3;
   weighted = weighted && !kernel.moments[0].empty();
-  // Every kernel of the leaf (colour channels, then the two moments) against each image, which
-  // is transformed once for all of them.
-  std::vector<std::shared_ptr<const KernelSpectrum>> spectra;
-  std::vector<const KernelSpectrum*> kernels;
-  std::vector<std::vector<float>*> to_share, to_full;
-  auto add = [&](const std::vector<float>& values, std::vector<float>& share,
-                 std::vector<float>& whole) {
-    spectra.push_back(fft.kernel_spectrum(values, kernel.width, kernel.height, out.tw, out.th));
-    kernels.push_back(spectra.back().get());
-    to_share.push_back(&share);
-    to_full.push_back(&whole);
-  };
-  for (int c = 0; c < channels; ++c) add(kernel.channels[c], out.occluded[c], out.occluded_full[c]);
-  if (weighted)
-    for (int m = 0; m < 2; ++m) add(kernel.moments[m], out.moment[m], out.moment_full[m]);
-  fft.convolve(coverage, w, h, kernels, to_share);
-  if (!full.empty()) fft.convolve(full, w, h, kernels, to_full);
-  out.seconds_fft = seconds_since(start);
-  out.convolutions = (channels + (weighted ? 2 : 0)) * (full.empty() ? 1 : 2);
+  for (LeafWindow& win : out.windows) {
+    start = Clock::now();
+    std::vector<float> coverage, full;
+    if (leaf.section) {
+      coverage = blocker_coverage(ProjectedBlockers{}, win.grid, &before);
+    } else {
+      // This cluster's share of the root layer's hard shadow.
+      coverage = nearest_layer_coverage(*leaf.layer, mine, leaf.slab_lo, leaf.slab_hi, win.grid);
+      if (combine == BlockerCombine::sum) {
+        // A slab of a convex closed solid is capped by its section at its near side, so that
+        // its whole image is the solid slab's projection rather than the ring of its faces.
+        full = blocker_coverage(leaf.blockers, win.grid, leaf.solid_faces ? &before : nullptr);
+        // Nothing of the cluster hidden behind others: its full image is its share.
+        bool hidden = false;
+        for (std::size_t i = 0; i < full.size() && !hidden; ++i)
+          hidden = full[i] > coverage[i] + 1e-6f;
+        if (!hidden) full.clear();
+      }
+    }
+    out.seconds_blocker += seconds_since(start);
+    start = Clock::now();
+    // Every kernel of the leaf (colour channels, then the two moments) against each image,
+    // which is transformed once for all of them.
+    std::vector<std::shared_ptr<const KernelSpectrum>> spectra;
+    std::vector<const KernelSpectrum*> kernels;
+    std::vector<std::vector<float>*> to_share, to_full;
+    auto add = [&](const std::vector<float>& values, std::vector<float>& share,
+                   std::vector<float>& whole) {
+      spectra.push_back(fft.kernel_spectrum(values, kernel.width, kernel.height, win.tw, win.th));
+      kernels.push_back(spectra.back().get());
+      to_share.push_back(&share);
+      to_full.push_back(&whole);
+    };
+    for (int c = 0; c < channels; ++c) add(kernel.channels[c], win.occluded[c], win.occluded_full[c]);
+    if (weighted)
+      for (int m = 0; m < 2; ++m) add(kernel.moments[m], win.moment[m], win.moment_full[m]);
+    const int w = win.grid.width, h = win.grid.height;
+    fft.convolve(coverage, w, h, kernels, to_share);
+    if (!full.empty()) fft.convolve(full, w, h, kernels, to_full);
+    out.seconds_fft += seconds_since(start);
+    out.convolutions += (channels + (weighted ? 2 : 0)) * (full.empty() ? 1 : 2);
+  }
   return out;
 }
 
@@ -260,8 +357,10 @@ void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const Leaf
   report.image_height = std::max(report.image_height, leaf.grid.height);
   report.kernel_width = std::max(report.kernel_width, kernel.width);
   report.kernel_height = std::max(report.kernel_height, kernel.height);
-  report.fft_width = std::max(report.fft_width, images.tw);
-  report.fft_height = std::max(report.fft_height, images.th);
+  for (const LeafWindow& win : images.windows) {
+    report.fft_width = std::max(report.fft_width, win.tw);
+    report.fft_height = std::max(report.fft_height, win.th);
+  }
 
   const auto start = Clock::now();
   // How much of the slab's geometry lies in front of a texel, with half a texel of tolerance so
@@ -269,35 +368,39 @@ void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const Leaf
   const auto [lo, hi] = part_interval(leaf.cuts);
   const double g_lo = leaf.blocker_depths.lo, g_hi = leaf.blocker_depths.hi;
   const double bias = 0.5 * plan.texel;
-  std::vector<int> texels;
-  fr.index[std::size_t(leaf.group)].for_each(leaf.footprint_lo, leaf.footprint_hi, [&](int i) {
-    const double d = fr.depth[std::size_t(i)];
-    const Vec2& tc = fr.tangent[std::size_t(i)];
-    if (d <= g_lo || d < lo || d > hi) return;
-    if ((tc.array() < leaf.footprint_lo.array()).any() ||
-        (tc.array() > leaf.footprint_hi.array()).any())
-      return;
-    texels.push_back(i);
-  });
+  // The footprint's texels, each with the window it reads (windows' boxes are disjoint).
+  std::vector<std::pair<int, int>> texels;
+  for (std::size_t k = 0; k < images.windows.size(); ++k) {
+    const LeafWindow& win = images.windows[k];
+    fr.index[std::size_t(leaf.group)].for_each(win.lo, win.hi, [&](int i) {
+      const double d = fr.depth[std::size_t(i)];
+      const Vec2& tc = fr.tangent[std::size_t(i)];
+      if (d <= g_lo || d < lo || d > hi) return;
+      if ((tc.array() < win.lo.array()).any() || (tc.array() > win.hi.array()).any()) return;
+      texels.emplace_back(i, int(k));
+    });
+  }
   if (euler) {
-    for (int i : texels) {
+    for (const auto& [i, k] : texels) {
       if (euler->touched_flag[std::size_t(i)]) continue;
       euler->touched_flag[std::size_t(i)] = 1;
       euler->touched.push_back(i);
     }
   }
-  const bool weighted = !images.moment[0].empty() && !gradient.empty();
+  const bool weighted = !gradient.empty() && !images.windows.empty() &&
+                        !images.windows.front().moment[0].empty();
   const bool with_full = combine == BlockerCombine::sum;
-  const int w = leaf.grid.width, h = leaf.grid.height;
   const int channels = kernel.grey ? 1 : 3;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, texels.size(), 2048), [&](const auto& r) {
     for (std::size_t j = r.begin(); j != r.end(); ++j) {
-      const std::size_t i = std::size_t(texels[j]);
+      const std::size_t i = std::size_t(texels[j].first);
+      const LeafWindow& win = images.windows[std::size_t(texels[j].second)];
+      const int w = win.grid.width, h = win.grid.height;
       const double depth = fr.depth[i];
       double wt = g_hi > g_lo ? std::clamp((depth + bias - g_lo) / (g_hi - g_lo), 0.0, 1.0) : 1.0;
       for (const ReceiverCut& c : leaf.cuts) wt *= c.weight(depth);
       if (wt <= 0) continue;
-      const Vec2 at = leaf.grid.to_pixel(fr.tangent[i]);
+      const Vec2 at = win.grid.to_pixel(fr.tangent[i]);
       // The moments' correction is the same for every channel (grey kernels only); the whole
       // image takes it too, or the max rule would compare an irradiance-weighted share with an
       // emission-weighted whole and keep the darker of two different quantities.
@@ -305,16 +408,16 @@ void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const Leaf
       if (weighted) {
         // O_w = Σ S·w·P / Σ S·w with w ≈ w0·(1 + g·(a, b)): the occluded irradiance fraction.
         const Vec2& g = gradient[i];
-        first = g.x() * bilinear(images.moment[0], w, h, at) +
-                g.y() * bilinear(images.moment[1], w, h, at);
-        first_full = images.moment_full[0].empty()
+        first = g.x() * bilinear(win.moment[0], w, h, at) +
+                g.y() * bilinear(win.moment[1], w, h, at);
+        first_full = win.moment_full[0].empty()
                          ? first
-                         : g.x() * bilinear(images.moment_full[0], w, h, at) +
-                               g.y() * bilinear(images.moment_full[1], w, h, at);
+                         : g.x() * bilinear(win.moment_full[0], w, h, at) +
+                               g.y() * bilinear(win.moment_full[1], w, h, at);
         norm = std::max(0.1, 1.0 + g.dot(kernel.centroid));
       }
       for (int c = 0; c < channels; ++c) {
-        const double share = bilinear(images.occluded[c], w, h, at);
+        const double share = bilinear(win.occluded[c], w, h, at);
         const double o = std::clamp((share + first) / norm, 0.0, 1.0);
         if (leaf.section) {
           for (int out = kernel.grey ? 0 : c; out < (kernel.grey ? 3 : c + 1); ++out)
@@ -324,9 +427,9 @@ void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const Leaf
         const double f = combine == BlockerCombine::sum ? o : -std::log(std::max(1e-6, 1.0 - o));
         float whole = 0;
         if (with_full) {
-          const double v = images.occluded_full[c].empty()
+          const double v = win.occluded_full[c].empty()
                                ? share
-                               : bilinear(images.occluded_full[c], w, h, at);
+                               : bilinear(win.occluded_full[c], w, h, at);
           whole = float(wt * std::clamp((v + first_full) / norm, 0.0, 1.0));
         }
         // A grey kernel's one channel stands for all three.
@@ -415,7 +518,8 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
       std::vector<double> seconds(last - first, 0.0);
       tbb::parallel_for(std::size_t(first), last, [&](std::size_t b) {
         const auto leaf_start = Clock::now();
-        images[b - first] = convolve_leaf(plan, plan.triples[leaves[b]], in.combine, in.weighted);
+        images[b - first] = convolve_leaf(plan, plan.triples[leaves[b]], in.combine, in.weighted,
+                                          in.island_windows);
         seconds[b - first] = seconds_since(leaf_start);
       });
       for (std::size_t b = first; b < last; ++b) {

@@ -31,6 +31,10 @@ struct ConvolutionInputs {
   // §6: two more convolutions per leaf), so that V is the irradiance-weighted visibility the
   // reference computes rather than the emission-weighted V_u.
   bool weighted = true;
+  // Convolve a leaf's far-apart blocker islands (a table's legs) on windows of their own rather
+  // than on one grid spanning them all: the same values for a fraction of the pixels
+  // (convolution_bake.cpp, leaf_windows). Off only to measure what it saves.
+  bool island_windows = true;
 };
 
 // Bakes one receiver: plans its triples (plan_convolution), convolves every leaf and combines

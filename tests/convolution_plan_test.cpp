@@ -15,6 +15,7 @@
 #include "test_scenes.h"
 #include "blocker_image.h"
 #include "clusters.h"
+#include "convolution_bake.h"
 #include "convolution_plan.h"
 #include "mesh.h"
 #include "texel_space.h"
@@ -313,6 +314,36 @@ TEST(ConvolutionPlan, PostShadowHardensAtContact) {
     previous = wc;
     previous_halves = wh;
   }
+}
+
+// A leaf holding the table's four legs spans the table's whole footprint, though each leg's
+// shadow reaches only a few texels from it: its islands are convolved on windows of their own
+// (leaf_windows). Linearity makes that exact: the same texture as one grid per leaf, to float
+// rounding, for more but much smaller transforms.
+TEST(ConvolutionPlan, IslandWindowsChangeNothingButTheWork) {
+  const Scene scene = load("table", 256, "convolution");
+  const auto p = plan_scene(scene);
+  ConvolutionInputs in;
+  in.lights = &p->lights;
+  std::size_t receiver = 0;
+  while (!scene.objects[receiver].receiver) ++receiver;
+  in.receiver = &p->meshes[receiver];
+  in.blockers = p->blockers;
+  in.clusters = &p->clusters;
+  in.max_triples = scene.bake.max_triples;
+  std::vector<PairReport> with_reports, without_reports;
+  const Image with = bake_convolution(p->space, in, &with_reports);
+  in.island_windows = false;
+  const Image without = bake_convolution(p->space, in, &without_reports);
+  ASSERT_EQ(with.pixels.size(), without.pixels.size());
+  double worst = 0;
+  for (std::size_t i = 0; i < with.pixels.size(); ++i)
+    worst = std::max(worst, double(std::abs(with.pixels[i] - without.pixels[i])));
+  EXPECT_LT(worst, 1e-4);
+  int with_count = 0, without_count = 0;
+  for (const PairReport& r : with_reports) with_count += r.convolutions;
+  for (const PairReport& r : without_reports) without_count += r.convolutions;
+  EXPECT_GT(with_count, without_count) << "no leaf was cut into windows";
 }
 
 }  // namespace
