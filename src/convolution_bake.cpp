@@ -463,12 +463,9 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
   ConvolutionPlan plan = plan_convolution(space, pin);
   const double plan_seconds = seconds_since(start);
 
-  // Per texel and light: Σ over the light's parts of weight·V_part, and Σ weight over the parts
-  // that reach it. The weight is the part's share of the light: with the irradiance weighting,
-  // its own unoccluded irradiance at the texel (V is irradiance-weighted, and the part nearer the
-  // texel brings more of it); without, its share of the power (V_u weights the light by area).
-  std::vector<std::vector<Vec3f>> visible(lights.size());
-  std::vector<std::vector<float>> reached(lights.size());
+  // Per light part and texel: V, and whether one of the part's frames reaches the texel.
+  std::vector<std::vector<Vec3f>> part_visible(plan.light_parts.size());
+  std::vector<std::vector<std::uint8_t>> part_reached(plan.light_parts.size());
   for (std::size_t f = 0; f < plan.frames.size(); ++f) {
     PlanFrame& fr = plan.frames[f];
     const LightPart& lp = plan.light_parts[fr.light_part];
@@ -557,28 +554,13 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
       report.receiver_depth_lo = receivers.lo;
       report.receiver_depth_hi = receivers.hi;
     }
-    auto& vis = visible[std::size_t(fr.light)];
-    auto& reach = reached[std::size_t(fr.light)];
+    auto& vis = part_visible[std::size_t(fr.light_part)];
+    auto& hit = part_reached[std::size_t(fr.light_part)];
     if (vis.empty()) {
       vis.assign(n, Vec3f::Zero());
-      reach.assign(n, 0.0f);
-    }
-    const bool parts = lp.fraction < 1.0;
-    std::vector<float> share(parts ? fr.texels.size() : 0, float(lp.fraction));
-    if (parts && in.weighted) {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, share.size(), 4096), [&](const auto& r) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-          const Texel& tx = space.texels[fr.texels[i]];
-          // Plus a trace of the power share, so that a texel no part's closed form reaches
-          // still averages its parts by power rather than dropping the light.
-          share[i] = float(
-              lp.part.unoccluded_irradiance(tx.position.cast<double>(), tx.normal.cast<double>())
-                  .sum() + 1e-9 * lp.fraction);
-        }
-      });
+      hit.assign(n, 0);
     }
     for (std::size_t i = 0; i < fr.texels.size(); ++i) {
-      const float fraction = parts ? share[i] : 1.0f;
       Vec3f v;
       for (int c = 0; c < 3; ++c) {
         float o = std::max(occlusion[i][c], largest[i][c]);
@@ -586,10 +568,62 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
         v[c] = in.combine == BlockerCombine::sum ? std::clamp(1.0f - o, 0.0f, 1.0f)
                                                  : std::exp(-occlusion[i][c]);
       }
-      vis[fr.texels[i]] += fraction * v;
-      reach[fr.texels[i]] += fraction;
+      vis[fr.texels[i]] = v;
+      hit[fr.texels[i]] = 1;
     }
     if (reports) reports->push_back(std::move(report));
+  }
+
+  // Per light, its parts' V averaged at each texel by the parts' weights: with the irradiance
+  // weighting, each part's own unoccluded irradiance there (V is irradiance-weighted, and the
+  // part nearer the texel brings more of it); without, its share of the power (V_u weights the
+  // light by area). Where every part that reaches a texel sees the same V (fully lit or fully
+  // hidden, most texels), that is the average whatever the weights, and no closed form is
+  // evaluated.
+  std::vector<std::vector<Vec3f>> visible(lights.size());
+  std::vector<std::vector<std::uint8_t>> reached(lights.size());
+  for (std::size_t l = 0; l < lights.size(); ++l) {
+    std::vector<int> parts;
+    for (std::size_t p = 0; p < plan.light_parts.size(); ++p)
+      if (plan.light_parts[p].light == int(l) && !part_visible[p].empty()) parts.push_back(int(p));
+    if (parts.empty()) continue;
+    visible[l].assign(n, Vec3f::Zero());
+    reached[l].assign(n, 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& r) {
+      for (std::size_t t = r.begin(); t != r.end(); ++t) {
+        const Vec3f* first = nullptr;
+        bool same = true;
+        for (int p : parts) {
+          if (!part_reached[std::size_t(p)][t]) continue;
+          const Vec3f& v = part_visible[std::size_t(p)][t];
+          if (!first) first = &v;
+          same = same && (v - *first).cwiseAbs().maxCoeff() <= 1e-6f;
+        }
+        if (!first) continue;
+        reached[l][t] = 1;
+        if (same) {
+          visible[l][t] = *first;
+          continue;
+        }
+        const Texel& tx = space.texels[t];
+        Vec3 sum = Vec3::Zero();
+        double weight = 0;
+        for (int p : parts) {
+          if (!part_reached[std::size_t(p)][t]) continue;
+          const LightPart& lp = plan.light_parts[std::size_t(p)];
+          // Plus a trace of the power share, so that a texel no part's closed form reaches
+          // still averages its parts by power rather than dropping the light.
+          const double w =
+              in.weighted ? lp.part.unoccluded_irradiance(tx.position.cast<double>(),
+                                                          tx.normal.cast<double>())
+                                    .sum() + 1e-9 * lp.fraction
+                          : lp.fraction;
+          sum += w * part_visible[std::size_t(p)][t].cast<double>();
+          weight += w;
+        }
+        visible[l][t] = (sum / weight).cast<float>();
+      }
+    });
   }
 
   // A texel inside a convex closed blocker (a floor under a box) sees no light: exactly, rather
@@ -609,10 +643,10 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
       const Vec3 p = tx.position.cast<double>(), normal = tx.normal.cast<double>();
       Vec3 sum = Vec3::Zero(), weight = Vec3::Zero();
       for (std::size_t l = 0; l < lights.size() && !buried[t]; ++l) {
-        if (visible[l].empty() || reached[l][t] <= 0) continue;
+        if (visible[l].empty() || !reached[l][t]) continue;
         const Vec3 w = weights_needed ? lights[l].unoccluded_irradiance(p, normal)
                                       : lights[l].exitance();
-        sum += w.cwiseProduct((visible[l][t] / reached[l][t]).cast<double>());
+        sum += w.cwiseProduct(visible[l][t].cast<double>());
         weight += w;
       }
       float* px = out.at(tx.x, tx.y);
