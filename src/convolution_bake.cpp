@@ -98,28 +98,19 @@ std::vector<Vec2> weight_gradients(const PlanFrame& fr, const TexelSpace& space,
   std::vector<Vec2> g(fr.texels.size(), Vec2::Zero());
   if (light.shape() == LightShape::sphere) return g;
   const Vec3 c = light.centre(), n = light.normal();
-  const double h = 1e-3 * std::max(1e-3, light.extent_across(n.unitOrthogonal()));
   const Vec3 axes[2] = {light.right(), light.up()};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, g.size(), 4096), [&](const auto& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
       const Texel& t = space.texels[fr.texels[i]];
-      const Vec3 x = t.position.cast<double>(), nx = t.normal.cast<double>();
-      auto log_w = [&](const Vec3& y, double* out) {
-        const Vec3 d = x - y;
-        const double len2 = d.squaredNorm(), len = std::sqrt(len2);
-        const double cl = n.dot(d) / len, cr = -nx.dot(d) / len;
-        if (cl <= 1e-3 || cr <= 1e-3) return false;
-        *out = std::log(cl * cr / len2);
-        return true;
-      };
-      for (int a = 0; a < 2; ++a) {
-        double plus, minus;
-        if (!log_w(c + h * axes[a], &plus) || !log_w(c - h * axes[a], &minus)) {
-          g[i] = Vec2::Zero();
-          break;
-        }
-        g[i][a] = (plus - minus) / (2 * h);
-      }
+      const Vec3 nx = t.normal.cast<double>();
+      // w = (n·d)(−n_x·d)/|d|⁴ with d = x − y: moving y by s along a gives
+      // d ln w/ds = −(n·a)/(n·d) + (n_x·a)/(−n_x·d) + 4 (d·a)/|d|².
+      const Vec3 d = t.position.cast<double>() - c;
+      const double len2 = d.squaredNorm(), len = std::sqrt(len2);
+      const double nd = n.dot(d), xd = -nx.dot(d);
+      if (nd <= 1e-3 * len || xd <= 1e-3 * len) continue;
+      for (int a = 0; a < 2; ++a)
+        g[i][a] = -n.dot(axes[a]) / nd + nx.dot(axes[a]) / xd + 4 * d.dot(axes[a]) / len2;
     }
   });
   return g;
