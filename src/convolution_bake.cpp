@@ -76,19 +76,33 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// Bilinear read of a width × height image at continuous pixel coordinates (centres at integers),
-// clamped at the border.
-float bilinear(const std::vector<float>& image, int w, int h, const Vec2& p) {
-  const double fx = std::clamp(p.x(), 0.0, double(w - 1));
-  const double fy = std::clamp(p.y(), 0.0, double(h - 1));
-  const int x0 = std::max(0, std::min(int(fx), w - 2));
-  const int y0 = std::max(0, std::min(int(fy), h - 2));
-  const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
-  const double tx = fx - x0, ty = fy - y0;
-  const auto at = [&](int x, int y) { return double(image[std::size_t(y) * w + x]); };
-  return float((1 - ty) * ((1 - tx) * at(x0, y0) + tx * at(x1, y0)) +
-               ty * ((1 - tx) * at(x0, y1) + tx * at(x1, y1)));
-}
+// A bilinear read of width × height images at continuous pixel coordinates (centres at
+// integers), clamped at the border: the four pixels and weights found once, for the several
+// images of one grid a texel reads.
+class Bilinear {
+ public:
+  Bilinear(int w, int h, const Vec2& p) {
+    const double fx = std::clamp(p.x(), 0.0, double(w - 1));
+    const double fy = std::clamp(p.y(), 0.0, double(h - 1));
+    const int x0 = std::max(0, std::min(int(fx), w - 2));
+    const int y0 = std::max(0, std::min(int(fy), h - 2));
+    dx_ = std::min(x0 + 1, w - 1) - x0;
+    dy_ = std::size_t(std::min(y0 + 1, h - 1) - y0) * std::size_t(w);
+    first_ = std::size_t(y0) * std::size_t(w) + std::size_t(x0);
+    tx_ = fx - x0;
+    ty_ = fy - y0;
+  }
+  float operator()(const std::vector<float>& image) const {
+    const float* p = image.data() + first_;
+    return float((1 - ty_) * ((1 - tx_) * p[0] + tx_ * p[dx_]) +
+                 ty_ * ((1 - tx_) * p[dy_] + tx_ * p[dy_ + std::size_t(dx_)]));
+  }
+
+ private:
+  std::size_t first_ = 0, dy_ = 0;
+  int dx_ = 0;
+  double tx_ = 0, ty_ = 0;
+};
 
 // The irradiance weight w = cos θ_light · cos θ_receiver / distance² of the light's points seen
 // from each texel, to first order across the light: the gradient of ln w at the light's centre
@@ -391,7 +405,7 @@ void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const Leaf
       double wt = g_hi > g_lo ? std::clamp((depth + bias - g_lo) / (g_hi - g_lo), 0.0, 1.0) : 1.0;
       for (const ReceiverCut& c : leaf.cuts) wt *= c.weight(depth);
       if (wt <= 0) continue;
-      const Vec2 at = win.grid.to_pixel(fr.tangent[i]);
+      const Bilinear at(w, h, win.grid.to_pixel(fr.tangent[i]));
       // The moments' correction is the same for every channel (grey kernels only); the whole
       // image takes it too, or the max rule would compare an irradiance-weighted share with an
       // emission-weighted whole and keep the darker of two different quantities.
@@ -399,16 +413,14 @@ void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const Leaf
       if (weighted) {
         // O_w = Σ S·w·P / Σ S·w with w ≈ w0·(1 + g·(a, b)): the occluded irradiance fraction.
         const Vec2& g = gradient[i];
-        first = g.x() * bilinear(win.moment[0], w, h, at) +
-                g.y() * bilinear(win.moment[1], w, h, at);
+        first = g.x() * at(win.moment[0]) + g.y() * at(win.moment[1]);
         first_full = win.moment_full[0].empty()
                          ? first
-                         : g.x() * bilinear(win.moment_full[0], w, h, at) +
-                               g.y() * bilinear(win.moment_full[1], w, h, at);
+                         : g.x() * at(win.moment_full[0]) + g.y() * at(win.moment_full[1]);
         norm = std::max(0.1, 1.0 + g.dot(kernel.centroid));
       }
       for (int c = 0; c < channels; ++c) {
-        const double share = bilinear(win.occluded[c], w, h, at);
+        const double share = at(win.occluded[c]);
         const double o = std::clamp((share + first) / norm, 0.0, 1.0);
         if (leaf.section) {
           for (int out = kernel.grey ? 0 : c; out < (kernel.grey ? 3 : c + 1); ++out)
@@ -420,7 +432,7 @@ void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const Leaf
         if (with_full) {
           const double v = win.occluded_full[c].empty()
                                ? share
-                               : bilinear(win.occluded_full[c], w, h, at);
+                               : at(win.occluded_full[c]);
           whole = float(wt * std::clamp((v + first_full) / norm, 0.0, 1.0));
         }
         // A grey kernel's one channel stands for all three.
