@@ -9,6 +9,8 @@
 // of its footprint O read bilinearly at the texel's central projection through the light part's
 // centre. That projection makes hard-shadow positions exact for the light's centre whatever the
 // geometry; only penumbra widths are approximate, by at most the penumbra error ε reported.
+// A leaf whose blockers fall into islands far apart (a table's legs in one slab) is convolved on
+// a window per island (leaf_windows): the same values, by linearity, for far fewer pixels.
 //
 // Combining leaves at a texel: a receiver split's two parts are blended by their cut weights (a
 // partition of unity across the seam); a slab's shadow counts in proportion to the part of its
