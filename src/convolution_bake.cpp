@@ -108,8 +108,9 @@ class Bilinear {
 
 // The irradiance weight w = cos θ_light · cos θ_receiver / distance² of the light's points seen
 // from each texel, to first order across the light: the gradient of ln w at the light's centre
-// along its right and up axes, per metre (design-notes §6). Zero where the light crosses the
-// texel's horizon or its own, where a first-order weight would mislead.
+// along its right and up axes, per metre (design-notes §6). Zero where the light's centre lies
+// on or below the texel's horizon or the texel on or behind the light's plane (cosines under
+// 1e-3), where a first-order weight would mislead.
 std::vector<Vec2> weight_gradients(const PlanFrame& fr, const TexelSpace& space, const Light& light) {
   std::vector<Vec2> g(fr.texels.size(), Vec2::Zero());
   if (light.shape() == LightShape::sphere) return g;
@@ -268,7 +269,7 @@ LeafImages convolve_leaf(const ConvolutionPlan& plan, const Triple& leaf, Blocke
   // A closed solid's surface clipped to depths before `depth`, unculled: the crossings whose
   // parity gives its section there (blocker_coverage).
   ProjectedBlockers before;
-  if (leaf.section || leaf.solid_faces)
+  if (leaf.solid_faces)  // slabs and sections of convex solids
     before = project_faces(*leaf.solid_faces, fr.frame, fr.near, leaf.slab_lo, ShadowCaster{});
   // Which polygons of the root layer are this cluster's, for its share of the layer's hard
   // shadow (nearest_layer_coverage).
