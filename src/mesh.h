@@ -5,6 +5,7 @@
 
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -35,7 +36,10 @@ struct Mesh {
 // transforms and then obj.transform, takes UVs from obj.uv_channel, drops zero-area triangles
 // (counted in skipped_degenerate). Errors name scene_file, the object and the problem: an
 // unreadable file, no triangles, NaN/infinite vertices, or a receiver without the UV channel.
-Expected<Mesh> import_mesh(const ObjectDesc& obj, const std::filesystem::path& scene_file);
+// Mesh files larger than max_file_bytes are refused before they are read.
+inline constexpr std::uint64_t kDefaultMaxMeshFileBytes = std::uint64_t(1) << 32;
+Expected<Mesh> import_mesh(const ObjectDesc& obj, const std::filesystem::path& scene_file,
+                           std::uint64_t max_file_bytes = kDefaultMaxMeshFileBytes);
 
 // World-space triangle of face f, as three points.
 struct Triangle {

@@ -2,11 +2,19 @@
 // FBX, ...) and builds the project's working mesh (mesh.h) in world space.
 //
 // Why each choice:
-// - Assimp post-processing triangulates, joins identical vertices (so OpenMesh sees shared
-//   vertices and connectivity), pre-transforms vertices (node transforms applied; all meshes of
-//   the file become one object) and generates smooth normals only where the file has none. It is
-//   not asked to remove degenerate triangles (we count them, so the user is told) nor to convert
-//   axes (world coordinates are the file's own; the scene's transform places the object).
+// - Assimp post-processing triangulates, pre-transforms vertices (node transforms applied; all
+//   meshes of the file become one object) and generates smooth normals only where the file has
+//   none. It is not asked to remove degenerate triangles (we count them, so the user is told) nor
+//   to convert axes (world coordinates are the file's own; the scene's transform places the
+//   object).
+// - Vertices are welded here, not by Assimp's JoinIdenticalVertices: in Assimp 5.2.5 that step
+//   compares only the first UV channel, so on a mesh whose lightmap UVs (channel 1) have seams
+//   where its texture UVs (channel 0) have none, vertices on either side of a lightmap seam are
+//   merged and triangles stretch across the atlas. Two vertices are one when their position,
+//   normal and every UV channel are bitwise equal (weld_vertices), so OpenMesh sees the shared
+//   vertices and connectivity of each chart and no seam of any channel is lost.
+// - Before Assimp reads a file, check_mesh_file (mesh_file_checks.h) refuses files it would
+//   misread or exhaust memory on; Assimp's own warnings that it dropped faces are errors here.
 // - obj.transform is applied here, in double precision: points by the affine map, normals by the
 //   inverse transpose of its linear part. A mirroring transform (negative determinant) reverses
 //   every triangle's winding so that the winding-derived face normals keep agreeing with the
@@ -19,18 +27,25 @@
 //   receiver without its UV channel) is an Error, never a crash or an exception.
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <assimp/DefaultLogger.hpp>
 #include <assimp/Importer.hpp>
+#include <assimp/LogStream.hpp>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <exception>
 #include <filesystem>
+#include <mutex>
 #include <sstream>
 #include <string>
 #include <system_error>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
 #include "mesh.h"
+#include "mesh_file_checks.h"
 
 namespace sb {
 namespace {
@@ -57,6 +72,37 @@ class ErrorPrefix {
   std::string prefix_;
 };
 
+// Assimp reports what it dropped from a broken file only as a log warning ("Some faces had
+// out-of-range indices. Those faces were dropped." in its glTF 2 reader). Its logger is one global
+// object; the import holds kImportMutex while the stream below collects warnings and errors.
+class CapturedLog : public Assimp::LogStream {
+ public:
+  void write(const char* message) override { messages.emplace_back(message ? message : ""); }
+  std::vector<std::string> messages;
+};
+
+std::mutex kImportMutex;
+
+CapturedLog& assimp_log() {
+  static CapturedLog* log = [] {
+    Assimp::DefaultLogger::create("", Assimp::Logger::NORMAL, 0);
+    auto* stream = new CapturedLog;  // owned by the logger from here on
+    Assimp::DefaultLogger::get()->attachStream(stream, Assimp::Logger::Warn | Assimp::Logger::Err);
+    return stream;
+  }();
+  return *log;
+}
+
+// The first captured message that says part of the file was dropped, or "".
+std::string dropped_data_message(const std::vector<std::string>& messages) {
+  for (const std::string& m : messages) {
+    if (m.find("dropped") != std::string::npos || m.find("out-of-range") != std::string::npos ||
+        m.find("out of range") != std::string::npos)
+      return m;
+  }
+  return "";
+}
+
 // Assimp's messages may span lines and quote bytes of a broken file; errors are one line.
 std::string one_line(std::string text) {
   for (char& c : text) {
@@ -74,6 +120,12 @@ std::filesystem::path mesh_path(const ObjectDesc& obj, const std::filesystem::pa
   const std::filesystem::path beside_scene = scene_file.parent_path() / obj.mesh;
   if (std::filesystem::exists(beside_scene, ec)) return beside_scene;
   return obj.mesh;
+}
+
+// A captured Assimp message without its "Warn,  T0: " prefix, on one line.
+std::string assimp_message(const std::string& message) {
+  const auto colon = message.find(": ");
+  return one_line(colon != std::string::npos && colon < 16 ? message.substr(colon + 2) : message);
 }
 
 std::string format_vec(const Vec3& v) {
@@ -100,11 +152,67 @@ void add_triangle(TriMesh& mesh, TriMesh::VertexHandle a, TriMesh::VertexHandle 
 
   TriMesh::VertexHandle copies[3];
   for (int i = 0; i < 3; ++i) {
-    copies[i] = mesh.add_vertex(mesh.point(corners[i]));
-    mesh.set_normal(copies[i], mesh.normal(corners[i]));
-    mesh.set_texcoord2D(copies[i], mesh.texcoord2D(corners[i]));
+    // Copies first: point(), normal() and texcoord2D() return references into the vertex
+    // arrays that add_vertex may reallocate.
+    const TriMesh::Point point = mesh.point(corners[i]);
+    const TriMesh::Normal normal = mesh.normal(corners[i]);
+    const TriMesh::TexCoord2D uv = mesh.texcoord2D(corners[i]);
+    copies[i] = mesh.add_vertex(point);
+    mesh.set_normal(copies[i], normal);
+    mesh.set_texcoord2D(copies[i], uv);
   }
   mesh.add_face(copies[0], copies[1], copies[2]);
+}
+
+// For every vertex of the file (all meshes concatenated, in order), the index of the first vertex
+// that has the same position, normal and UVs in every channel, bit for bit: the welded vertex it
+// becomes. Bitwise, because "identical" is what a weld may merge without changing any attribute;
+// +0 and -0 stay apart, which only keeps a seam.
+std::vector<std::size_t> weld_vertices(const aiScene& scene) {
+  // Up to 3 + 3 + 3 * AI_MAX_NUMBER_OF_TEXTURECOORDS floats, and which of them are present.
+  struct Key {
+    std::uint32_t present = 0;
+    std::uint32_t bits[6 + 3 * AI_MAX_NUMBER_OF_TEXTURECOORDS] = {};
+    bool operator==(const Key& o) const {
+      return present == o.present && std::memcmp(bits, o.bits, sizeof bits) == 0;
+    }
+  };
+  struct KeyHash {
+    std::size_t operator()(const Key& k) const {
+      std::uint64_t h = 1469598103934665603ull ^ k.present;  // FNV-1a over the words
+      for (std::uint32_t w : k.bits) h = (h ^ w) * 1099511628211ull;
+      return std::size_t(h);
+    }
+  };
+  const auto put = [](std::uint32_t* out, const aiVector3D& v) {
+    std::memcpy(out + 0, &v.x, 4);
+    std::memcpy(out + 1, &v.y, 4);
+    std::memcpy(out + 2, &v.z, 4);
+  };
+  std::size_t total = 0;
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) total += scene.mMeshes[m]->mNumVertices;
+  std::vector<std::size_t> representative(total);
+  std::unordered_map<Key, std::size_t, KeyHash> first;
+  first.reserve(total);
+  std::size_t index = 0;
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh* am = scene.mMeshes[m];
+    for (unsigned i = 0; i < am->mNumVertices; ++i, ++index) {
+      Key key;
+      put(key.bits, am->mVertices[i]);
+      if (am->HasNormals()) {
+        key.present |= 1;
+        put(key.bits + 3, am->mNormals[i]);
+      }
+      for (unsigned c = 0; c < AI_MAX_NUMBER_OF_TEXTURECOORDS; ++c) {
+        if (!am->HasTextureCoords(c)) continue;
+        key.present |= 2u << c;
+        put(key.bits + 6 + 3 * c, am->mTextureCoords[c][i]);
+      }
+      representative[index] = first.try_emplace(key, index).first->second;
+    }
+  }
+  return representative;
 }
 
 Expected<Mesh> build_mesh(const aiScene& scene, const ObjectDesc& obj, const std::string& path,
@@ -209,6 +317,7 @@ Expected<Mesh> build_mesh(const aiScene& scene, const ObjectDesc& obj, const std
   const double min_area = kDegenerateAreaFraction * diagonal * diagonal;
 
   TriMesh& mesh = result.mesh;
+  const std::vector<std::size_t> welded = weld_vertices(scene);
   std::vector<TriMesh::VertexHandle> handle(vertices.size());  // made on first use
   auto vertex = [&](std::size_t index) {
     if (!handle[index].is_valid()) {
@@ -226,7 +335,7 @@ Expected<Mesh> build_mesh(const aiScene& scene, const ObjectDesc& obj, const std
       const aiFace& face = am->mFaces[f];
       if (face.mNumIndices != 3) continue;  // points and lines have no surface
       std::size_t index[3];
-      for (int k = 0; k < 3; ++k) index[k] = first_vertex[m] + face.mIndices[k];
+      for (int k = 0; k < 3; ++k) index[k] = welded[first_vertex[m] + face.mIndices[k]];
       if (mirrors) std::swap(index[1], index[2]);
       const Vec3& a = vertices[index[0]].position;
       const Vec3& b = vertices[index[1]].position;
@@ -263,23 +372,30 @@ Expected<Mesh> build_mesh(const aiScene& scene, const ObjectDesc& obj, const std
 
 }  // namespace
 
-Expected<Mesh> import_mesh(const ObjectDesc& obj, const std::filesystem::path& scene_file) {
+Expected<Mesh> import_mesh(const ObjectDesc& obj, const std::filesystem::path& scene_file,
+                           std::uint64_t max_file_bytes) {
   const ErrorPrefix error(obj, scene_file);
   const std::filesystem::path file = mesh_path(obj, scene_file);
   const std::string path = file.string();
   try {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(file, ec)) {
-      return error("cannot read mesh '" + path + "': " +
-                   (std::filesystem::exists(file, ec) ? "not a regular file" : "no such file"));
+    if (Status checked = check_mesh_file(file, max_file_bytes); !checked) {
+      return error("cannot read mesh '" + path + "': " + checked.error().message);
     }
+    const std::lock_guard lock(kImportMutex);
+    CapturedLog& log = assimp_log();
+    log.messages.clear();
     Assimp::Importer importer;
-    const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                           aiProcess_PreTransformVertices | aiProcess_GenSmoothNormals |
-                           aiProcess_ValidateDataStructure;
+    const unsigned flags = aiProcess_Triangulate | aiProcess_PreTransformVertices |
+                           aiProcess_GenSmoothNormals | aiProcess_ValidateDataStructure;
     const aiScene* scene = importer.ReadFile(path, flags);
+    const std::vector<std::string> messages = std::move(log.messages);
+    log.messages.clear();
     if (!scene) {
       return error("cannot read mesh '" + path + "': " + one_line(importer.GetErrorString()));
+    }
+    if (const std::string dropped = dropped_data_message(messages); !dropped.empty()) {
+      return error("'" + path + "' is broken: Assimp says \"" + assimp_message(dropped) +
+                   "\"; fix or re-export the mesh file");
     }
     if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || scene->mNumMeshes == 0) {
       return error("'" + path + "' has no triangles (an object needs a surface)");
