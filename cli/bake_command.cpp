@@ -95,7 +95,8 @@ void print_explanation(const sb::BakeResult& result) {
                  p.image_width, p.image_height, p.kernel_width, p.kernel_height, p.fft_width,
                  p.fft_height, p.convolutions);
       fmt::print(
-          "    time: configure {:.1f} ms; summed over threads: source {:.1f} ms, blocker {:.1f} ms, "
+          "    time: configure {:.1f} ms; summed over threads: source {:.1f} ms, blocker {:.1f} "
+          "ms, "
           "FFT {:.1f} ms, lookup {:.1f} ms\n",
           1e3 * p.seconds_configure, 1e3 * p.seconds_source, 1e3 * p.seconds_blocker,
           1e3 * p.seconds_fft, 1e3 * p.seconds_lookup);
@@ -117,6 +118,14 @@ int run_bake(const BakeArgs& args) {
   if (args.seed) settings.seed = *args.seed;
   if (args.error_texels) settings.error_texels = *args.error_texels;
 
+  // The output folder is locked and its names checked before the bake, so a bake that could not
+  // publish its files fails in a second, not after its work.
+  if (sb::Status names = sb::check_output_names(*scene); !names) return fail(names.error());
+  auto folder = sb::OutputFolder::open(args.out_dir);
+  if (!folder) return fail(folder.error());
+  if (sb::Status targets = folder->check_targets(sb::output_names(*scene)); !targets)
+    return fail(targets.error());
+
   const bool show_progress = !args.quiet && ::isatty(STDERR_FILENO);
   ProgressBar bar("baking " + settings.method);
   sb::BakeOptions options;
@@ -129,7 +138,8 @@ int run_bake(const BakeArgs& args) {
     std::fprintf(stderr, "shadowbake: warning: %s\n", w.c_str());
 
   const auto write_start = std::chrono::steady_clock::now();
-  auto written = sb::write_outputs(args.out_dir, *scene, settings, *result);
+  auto written = sb::write_outputs(*folder, *scene, settings, *result);
+  reraise_pending_interrupt();
   if (!written) return fail(written.error());
   const double write_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start).count();

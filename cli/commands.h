@@ -25,6 +25,12 @@ int exit_code(const sb::Error& e);
 // Prints "shadowbake: error: <message>" on stderr and returns exit_code(e).
 int fail(const sb::Error& e);
 
+// SIGINT, SIGTERM and SIGHUP remove the staging folder of an open sb::OutputFolder before they
+// end the process; one that arrives while the folder publishes ends it once publishing is done,
+// which reraise_pending_interrupt (called after publishing) sees to.
+void install_interrupt_handlers();
+void reraise_pending_interrupt();
+
 // A command adds its subcommand and options to the app and returns what to run once the command
 // line has parsed; that returns the exit code.
 using Runner = std::function<int()>;

@@ -16,6 +16,7 @@
 #include "commands.h"
 #include "image_io.h"
 #include "image_metrics.h"
+#include "output_folder.h"
 
 namespace sbcli {
 
@@ -239,10 +240,8 @@ int run_compare(const CompareArgs& args) {
   }
 
   if (!args.out_dir.empty()) {
-    const fs::path dir = args.out_dir;
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec) return fail(sb::output_error(dir.string() + ": cannot create folder: " + ec.message()));
+    auto folder = sb::OutputFolder::open(args.out_dir);
+    if (!folder) return fail(folder.error());
     const double scale = sb::heat_map_scale(*a, *reference, options.mask);
     const sb::Image heat = sb::difference_heat_map(*a, *reference, options.mask, scale, true);
 
@@ -264,19 +263,14 @@ int run_compare(const CompareArgs& args) {
     j["heat_map"] = {{"file", "difference.png"}, {"scale", scale}};
     j["gates"] = gate_results;
 
-    const fs::path png = dir / "difference.png", json = dir / "compare.json";
-    auto staged_png = sb::stage_image(png, heat, sb::PixelFormat::uint8);
-    if (!staged_png) return fail(staged_png.error());
-    auto staged_json = sb::stage_text(json, j.dump(2) + "\n");
-    if (!staged_json) {
-      sb::discard_file(*staged_png);
-      return fail(staged_json.error());
-    }
-    if (auto done = sb::commit_file(*staged_png, png); !done) {
-      sb::discard_file(*staged_json);
-      return fail(done.error());
-    }
-    if (auto done = sb::commit_file(*staged_json, json); !done) return fail(done.error());
+    if (auto s = sb::write_image(folder->staged("difference.png"), heat, sb::PixelFormat::uint8);
+        !s)
+      return fail(s.error());
+    if (auto s = sb::write_text_file(folder->staged("compare.json"), j.dump(2) + "\n"); !s)
+      return fail(s.error());
+    auto published = folder->publish({"difference.png", "compare.json"});
+    reraise_pending_interrupt();
+    if (!published) return fail(published.error());
   }
 
   for (const auto& f : failures) std::fprintf(stderr, "shadowbake: gate failed: %s\n", f.c_str());

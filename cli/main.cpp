@@ -1,5 +1,6 @@
 // The shadowbake command line: each subcommand parses its arguments, calls the library, prints,
 // and maps errors to exit codes (docs/cli.md). No algorithm lives here; this file dispatches.
+#include <csignal>
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -7,6 +8,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "output_folder.h"
 
 namespace sbcli {
 
@@ -28,6 +30,32 @@ int fail(const sb::Error& e) {
   return exit_code(e);
 }
 
+namespace {
+
+void on_interrupt(int signal) {
+  if (!sb::interrupt_output_folders(signal)) return;  // publishing: it re-raises when done
+  std::signal(signal, SIG_DFL);
+  std::raise(signal);
+}
+
+}  // namespace
+
+void install_interrupt_handlers() {
+  for (int signal : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction action = {};
+    action.sa_handler = on_interrupt;
+    sigemptyset(&action.sa_mask);
+    sigaction(signal, &action, nullptr);
+  }
+}
+
+void reraise_pending_interrupt() {
+  if (const int signal = sb::pending_interrupt()) {
+    std::signal(signal, SIG_DFL);
+    std::raise(signal);
+  }
+}
+
 }  // namespace sbcli
 
 int main(int argc, char** argv) {
@@ -40,6 +68,7 @@ int main(int argc, char** argv) {
       {"report", sbcli::add_report_command(app)},
       {"plan", sbcli::add_plan_command(app)},
   };
+  sbcli::install_interrupt_handlers();
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {

@@ -181,6 +181,8 @@ int run_report(ReportArgs args) {
   if (!scene) return fail(scene.error());
   if (args.resolution) scene->bake.resolution = *args.resolution;
 
+  auto folder = sb::OutputFolder::open(args.out_dir);
+  if (!folder) return fail(folder.error());
   std::error_code ec;
   fs::create_directories(fs::path(args.out_dir) / "runs", ec);
   if (ec) {
@@ -204,7 +206,8 @@ int run_report(ReportArgs args) {
     if (!runs.back().error.empty()) any_failed = true;
   }
 
-  auto written = sb::write_report(*scene, runs, reference, args.out_dir);
+  auto written = sb::write_report(*scene, runs, reference, *folder);
+  reraise_pending_interrupt();
   if (!written) return fail(written.error());
   if (!args.quiet) {
     fmt::print(stderr, "report: {}/index.html and report.json written{}\n", args.out_dir,

@@ -27,7 +27,16 @@ fs::path temporary_sibling(const fs::path& path) {
 
 }  // namespace
 
-Expected<fs::path> stage_image(const fs::path& path, const Image& image, PixelFormat format) {
+namespace {
+
+void remove_quietly(const fs::path& path) {
+  std::error_code ec;
+  fs::remove(path, ec);
+}
+
+}  // namespace
+
+Status write_image(const fs::path& path, const Image& image, PixelFormat format) {
   const fs::path tmp = temporary_sibling(path);
   // The format comes from the final name's extension; the temporary name has none OIIO knows.
   auto out = OIIO::ImageOutput::create(path.string());
@@ -42,7 +51,7 @@ Expected<fs::path> stage_image(const fs::path& path, const Image& image, PixelFo
   spec.attribute("DateTime", "");
   if (!out->open(tmp.string(), spec)) {
     std::string why = out->geterror();
-    discard_file(tmp);
+    remove_quietly(tmp);
     return output_error(path.string() + ": cannot write: " + why);
   }
   bool ok;
@@ -59,43 +68,16 @@ Expected<fs::path> stage_image(const fs::path& path, const Image& image, PixelFo
   ok = out->close() && ok;
   if (!ok) {
     std::string why = out->geterror();
-    discard_file(tmp);
+    remove_quietly(tmp);
     return output_error(path.string() + ": cannot write: " + why);
   }
-  return tmp;
-}
-
-Expected<fs::path> stage_text(const fs::path& path, const std::string& text) {
-  const fs::path tmp = temporary_sibling(path);
-  std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-  if (out) out << text;
-  if (out) out.close();
-  if (!out) {
-    discard_file(tmp);
-    return output_error(path.string() + ": cannot write: " + std::strerror(errno));
-  }
-  return tmp;
-}
-
-Status commit_file(const fs::path& staged, const fs::path& path) {
   std::error_code ec;
-  fs::rename(staged, path, ec);
+  fs::rename(tmp, path, ec);
   if (ec) {
-    discard_file(staged);
+    remove_quietly(tmp);
     return output_error(path.string() + ": cannot write: " + ec.message());
   }
   return Ok{};
-}
-
-void discard_file(const fs::path& staged) {
-  std::error_code ec;
-  fs::remove(staged, ec);
-}
-
-Status write_image(const fs::path& path, const Image& image, PixelFormat format) {
-  auto staged = stage_image(path, image, format);
-  if (!staged) return staged.error();
-  return commit_file(*staged, path);
 }
 
 Expected<Image> read_image(const fs::path& path, bool linearise) {

@@ -3,7 +3,9 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <map>
 #include <system_error>
 #include <utility>
 #include <vector>
@@ -47,35 +49,56 @@ double irradiance_white_point(const BakeResult& result) {
   return std::max(1e-12, double(values[k]));
 }
 
-Status write_outputs(const fs::path& dir, const Scene& scene, const BakeSettings& effective,
-                     const BakeResult& result) {
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir)) {
-    return output_error(dir.string() + ": cannot create the output folder: " +
-                        (ec ? ec.message() : std::string("not a folder")));
-  }
+namespace {
 
-  // A folder standing where a file must go would make its rename fail after others were
-  // published; refuse before writing anything.
-  for (const auto& r : result.receivers) {
-    for (const char* ext : {".exr", ".png", ".coverage.png"}) {
-      const fs::path p = dir / (r.name + ext);
-      if (fs::is_directory(p, ec)) {
-        return output_error(p.string() + ": cannot write: a folder of that name is in the way");
-      }
+// A receiver's files: the lightmap, its preview and its coverage mask.
+std::vector<std::string> receiver_files(const std::string& name) {
+  return {name + ".exr", name + ".png", name + ".coverage.png"};
+}
+
+constexpr const char* kManifestName = "manifest.json";
+
+std::string lower(std::string text) {
+  for (char& c : text) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return text;
+}
+
+}  // namespace
+
+std::vector<std::string> output_names(const Scene& scene) {
+  std::vector<std::string> names;
+  for (const auto& obj : scene.objects) {
+    if (!obj.receiver) continue;
+    for (std::string& file : receiver_files(obj.name)) names.push_back(std::move(file));
+  }
+  names.push_back(kManifestName);
+  return names;
+}
+
+Status check_output_names(const Scene& scene) {
+  std::map<std::string, const ObjectDesc*> owner;  // lower-case file name -> object
+  for (const auto& obj : scene.objects) {
+    if (!obj.receiver) continue;
+    for (const std::string& file : receiver_files(obj.name)) {
+      const std::string key = lower(file);
+      if (key == kManifestName) continue;  // no receiver file ends in .json
+      const auto [it, inserted] = owner.emplace(key, &obj);
+      if (inserted) continue;
+      const ObjectDesc& first = *it->second;
+      return scene_error(scene.file.string() + ":" + std::to_string(obj.line) + ": object '" +
+                         obj.name + "': its output file '" + file + "' is also a file of object '" +
+                         first.name + "' (line " + std::to_string(first.line) +
+                         "); rename one of them");
     }
   }
+  return Ok{};
+}
 
-  std::vector<std::pair<fs::path, fs::path>> staged;  // (temporary, final)
-  auto discard_all = [&] {
-    for (auto& [tmp, final_path] : staged) discard_file(tmp);
-  };
-  auto stage = [&](Expected<fs::path> tmp, const fs::path& final_path) -> bool {
-    if (!tmp) return false;
-    staged.emplace_back(*tmp, final_path);
-    return true;
-  };
+Status write_outputs(OutputFolder& folder, const Scene& scene, const BakeSettings& effective,
+                     const BakeResult& result) {
+  if (Status s = check_output_names(scene); !s) return s;
+  const std::vector<std::string> names = output_names(scene);
+  if (Status s = folder.check_targets(names); !s) return s;
 
   const bool irradiance = effective.quantity == Quantity::irradiance;
   const double white = irradiance ? irradiance_white_point(result) : 1.0;
@@ -97,29 +120,17 @@ Status write_outputs(const fs::path& dir, const Scene& scene, const BakeSettings
   manifest["receivers"] = nlohmann::ordered_json::array();
 
   for (const auto& r : result.receivers) {
-    const fs::path exr = dir / (r.name + ".exr");
-    const fs::path png = dir / (r.name + ".png");
-    auto tmp_exr = stage_image(exr, r.image, PixelFormat::float32);
-    if (!stage(tmp_exr, exr)) {
-      discard_all();
-      return tmp_exr.error();
-    }
+    const std::vector<std::string> files = receiver_files(r.name);
+    const fs::path exr = folder.staged(files[0]), png = folder.staged(files[1]),
+                   coverage = folder.staged(files[2]);
+    if (Status s = write_image(exr, r.image, PixelFormat::float32); !s) return s;
     const Image preview = irradiance ? tone_map_irradiance(r.image, white) : r.image;
-    auto tmp_png = stage_image(png, preview, PixelFormat::uint8);
-    if (!stage(tmp_png, png)) {
-      discard_all();
-      return tmp_png.error();
-    }
+    if (Status s = write_image(png, preview, PixelFormat::uint8); !s) return s;
     // Which texels the receiver's triangles cover: `compare` and `report` count only these.
-    const fs::path coverage = dir / (r.name + ".coverage.png");
     Image mask(r.image.width, r.image.height, 1, 0.0f);
     for (std::size_t i = 0; i < r.covered.size() && i < mask.pixels.size(); ++i)
       mask.pixels[i] = r.covered[i] ? 1.0f : 0.0f;
-    auto tmp_coverage = stage_image(coverage, mask, PixelFormat::uint8);
-    if (!stage(tmp_coverage, coverage)) {
-      discard_all();
-      return tmp_coverage.error();
-    }
+    if (Status s = write_image(coverage, mask, PixelFormat::uint8); !s) return s;
     manifest["receivers"].push_back({
         {"name", r.name},
         {"files",
@@ -179,20 +190,9 @@ Status write_outputs(const fs::path& dir, const Scene& scene, const BakeSettings
   manifest["bake_seconds"] = result.bake_seconds;
   manifest["shadow_rays"] = result.shadow_rays;
 
-  const fs::path manifest_path = dir / "manifest.json";
-  auto tmp_manifest = stage_text(manifest_path, manifest.dump(2) + "\n");
-  if (!stage(tmp_manifest, manifest_path)) {
-    discard_all();
-    return tmp_manifest.error();
-  }
-  for (std::size_t i = 0; i < staged.size(); ++i) {
-    auto ok = commit_file(staged[i].first, staged[i].second);
-    if (!ok) {
-      for (std::size_t j = i + 1; j < staged.size(); ++j) discard_file(staged[j].first);
-      return ok.error();
-    }
-  }
-  return Ok{};
+  if (Status s = write_text_file(folder.staged(kManifestName), manifest.dump(2) + "\n"); !s)
+    return s;
+  return folder.publish(names);
 }
 
 }  // namespace sb

@@ -4,19 +4,29 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "bake.h"
 #include "error.h"
+#include "output_folder.h"
 #include "scene.h"
 
 namespace sb {
 
-// Writes every output into `dir` (created if missing). All files are written under temporary
-// names first and renamed only when every one of them was written, so a failure leaves no
-// partial or mixed output. `effective` holds the settings the bake ran with (after CLI
-// overrides). The same inputs give the same image bytes; the manifest differs only in timings.
-Status write_outputs(const std::filesystem::path& dir, const Scene& scene,
-                     const BakeSettings& effective, const BakeResult& result);
+// The files a bake of `scene` writes, in the order they are published (manifest.json last).
+std::vector<std::string> output_names(const Scene& scene);
+
+// Refuses a scene whose receivers' output files would collide (compared without case, as on the
+// file systems outputs travel to): object `a.coverage` writes `a.coverage.png`, which is object
+// `a`'s coverage mask. The error names the scene file, the line and both objects.
+Status check_output_names(const Scene& scene);
+
+// Writes every output into `folder`'s staging folder and publishes them together
+// (output_folder.h): all files appear, or none and the previous bake stays. `effective` holds
+// the settings the bake ran with (after CLI overrides). The same inputs give the same image
+// bytes; the manifest differs only in timings.
+Status write_outputs(OutputFolder& folder, const Scene& scene, const BakeSettings& effective,
+                     const BakeResult& result);
 
 // The 8-bit preview of an irradiance image: extended Reinhard per channel with the white point
 // at `white` W/m², then the sRGB transfer curve. Visibility previews are written linearly.

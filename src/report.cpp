@@ -64,15 +64,13 @@ const json* find_receiver(const json& manifest, const std::string& name) {
   return nullptr;
 }
 
-// Copies a file through a staged temporary, so the copy appears whole or not at all.
-Status copy_file_atomically(const fs::path& from, const fs::path& to) {
+// Copies a file into the report's staging folder.
+Status copy_into_staging(const fs::path& from, const fs::path& to) {
   std::ifstream in(from, std::ios::binary);
   if (!in) return input_error(from.string() + ": cannot read");
   std::stringstream bytes;
   bytes << in.rdbuf();
-  auto staged = stage_text(to, bytes.str());
-  if (!staged) return staged.error();
-  return commit_file(*staged, to);
+  return write_text_file(to, bytes.str());
 }
 
 // NaN (an empty region) and +inf (a PSNR of identical images) have no JSON number: null.
@@ -183,13 +181,9 @@ window.addEventListener("load", function () {
 }  // namespace
 
 Status write_report(const Scene& scene, const std::vector<MethodRun>& runs_in,
-                    const MethodRun& reference, const fs::path& out_dir) {
-  std::error_code ec;
-  fs::create_directories(out_dir / "images", ec);
-  if (ec) {
-    return output_error((out_dir / "images").string() +
-                        ": cannot create the report's image folder: " + ec.message());
-  }
+                    const MethodRun& reference, OutputFolder& folder) {
+  const fs::path& out_dir = folder.dir();
+  std::vector<std::string> written;  // files to publish, relative to out_dir
   const bool irradiance = scene.bake.quantity == Quantity::irradiance;
   std::vector<MethodRun> runs = runs_in;
   std::vector<json> manifests(runs.size());
@@ -226,13 +220,16 @@ Status write_report(const Scene& scene, const std::vector<MethodRun>& runs_in,
   };
   // The texture shown for a bake: its preview, or for irradiance the EXR tone-mapped with the
   // reference's white point, so every method is shown at one exposure.
-  auto write_texture = [&](const fs::path& folder, const json& entry, const Image* exr,
+  auto write_texture = [&](const fs::path& bake_folder, const json& entry, const Image* exr,
                            const std::string& relative) -> Status {
     if (irradiance && exr) {
-      return write_image(out_dir / relative, tone_map_irradiance(*exr, white), PixelFormat::uint8);
+      written.push_back(relative);
+      return write_image(folder.staged(relative), tone_map_irradiance(*exr, white),
+                         PixelFormat::uint8);
     }
     const std::string png = entry.contains("files") ? entry["files"].value("png", "") : "";
-    return copy_file_atomically(folder / png, out_dir / relative);
+    written.push_back(relative);
+    return copy_into_staging(bake_folder / png, folder.staged(relative));
   };
 
   std::vector<ReceiverRow> rows;
@@ -309,7 +306,8 @@ Status write_report(const Scene& scene, const std::vector<MethodRun>& runs_in,
         cell.difference = image_name(runs[m].method + "_" + row.name + "_diff");
         const Image map =
             difference_heat_map(*images[m], *ref_image, options.mask, row.heat_scale, true);
-        if (auto s = write_image(out_dir / cell.difference, map, PixelFormat::uint8); !s)
+        written.push_back(cell.difference);
+        if (auto s = write_image(folder.staged(cell.difference), map, PixelFormat::uint8); !s)
           return s.error();
       }
       if (row.covered_texels == 0)
@@ -574,19 +572,12 @@ Status write_report(const Scene& scene, const std::vector<MethodRun>& runs_in,
   }
   html += "</body>\n</html>\n";
 
-  // Both files appear together or not at all.
-  auto staged_json = stage_text(out_dir / "report.json", report.dump(2) + "\n");
-  if (!staged_json) return staged_json.error();
-  auto staged_html = stage_text(out_dir / "index.html", html);
-  if (!staged_html) {
-    discard_file(*staged_json);
-    return staged_html.error();
-  }
-  if (auto s = commit_file(*staged_json, out_dir / "report.json"); !s) {
-    discard_file(*staged_html);
-    return s.error();
-  }
-  return commit_file(*staged_html, out_dir / "index.html");
+  // Every file appears together, or none does.
+  if (auto s = write_text_file(folder.staged("report.json"), report.dump(2) + "\n"); !s) return s;
+  if (auto s = write_text_file(folder.staged("index.html"), html); !s) return s;
+  written.push_back("report.json");
+  written.push_back("index.html");
+  return folder.publish(written);
 }
 
 }  // namespace sb

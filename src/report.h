@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "error.h"
+#include "output_folder.h"
 #include "scene.h"
 
 namespace sb {
@@ -22,10 +23,10 @@ struct MethodRun {
 };
 
 // Compares each run's textures with the reference's, receiver by receiver (image_metrics), and
-// writes into out_dir: report.json, index.html (no external resources: images are files in
-// out_dir referenced relatively, the plot is inline SVG), the textures and difference heat maps it
-// shows. A failed run appears with its error and without metrics.
+// publishes into `folder` (all or nothing): report.json, index.html (no external resources: images
+// are files in out_dir referenced relatively, the plot is inline SVG), the textures and difference
+// heat maps it shows. A failed run appears with its error and without metrics.
 Status write_report(const Scene& scene, const std::vector<MethodRun>& runs,
-                    const MethodRun& reference, const std::filesystem::path& out_dir);
+                    const MethodRun& reference, OutputFolder& folder);
 
 }  // namespace sb

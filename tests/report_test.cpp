@@ -112,7 +112,9 @@ TEST(Report, FailedRunKeepsItsErrorAndNamesAreEscaped) {
       {"<script>alert(1)</script>", {}, 0, {}, "unknown method '<script>' & more"},
   };
   const fs::path out = dir / "report";
-  ASSERT_TRUE(sb::write_report(tiny_scene(), runs, reference, out));
+  auto folder = sb::OutputFolder::open(out);
+  ASSERT_TRUE(folder);
+  ASSERT_TRUE(sb::write_report(tiny_scene(), runs, reference, *folder));
 
   const auto report = nlohmann::json::parse(slurp(out / "report.json"));
   ASSERT_EQ(report["methods"].size(), 2u);
@@ -155,7 +157,9 @@ TEST(Report, FailedReferenceStillWritesThePage) {
   sb::MethodRun reference{
       "reference", {}, 0, dir / "runs" / "reference-64spp", "scene.toml: out of memory"};
   std::vector<sb::MethodRun> runs = {{"convolution", {0.2}, 50, dir / "runs" / "convolution", ""}};
-  ASSERT_TRUE(sb::write_report(tiny_scene(), runs, reference, dir / "report"));
+  auto folder = sb::OutputFolder::open(dir / "report");
+  ASSERT_TRUE(folder);
+  ASSERT_TRUE(sb::write_report(tiny_scene(), runs, reference, *folder));
   const auto report = nlohmann::json::parse(slurp(dir / "report" / "report.json"));
   EXPECT_EQ(report["reference"]["error"], "scene.toml: out of memory");
   EXPECT_TRUE(report["methods"][0]["overall"].is_null());

@@ -114,7 +114,12 @@ void BM_WriteOutputs(benchmark::State& state) {
   }
   const auto dir = std::filesystem::temp_directory_path() / "shadowbake_bench_write";
   for (auto _ : state) {
-    auto written = write_outputs(dir, scene, scene.bake, *result);
+    auto folder = OutputFolder::open(dir);
+    if (!folder) {
+      state.SkipWithError(folder.error().message.c_str());
+      return;
+    }
+    auto written = write_outputs(*folder, scene, scene.bake, *result);
     if (!written) {
       state.SkipWithError(written.error().message.c_str());
       return;
