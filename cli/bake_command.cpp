@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -12,6 +13,7 @@
 
 #include "bake.h"
 #include "commands.h"
+#include "memory_budget.h"
 #include "outputs.h"
 #include "scene.h"
 
@@ -59,6 +61,7 @@ struct BakeArgs {
   std::optional<int> resolution, samples;
   std::optional<std::uint64_t> seed;
   std::optional<double> error_texels;
+  std::optional<std::uint64_t> max_memory;
   int threads = 0;
   bool quiet = false;
   bool explain = false;
@@ -117,6 +120,7 @@ int run_bake(const BakeArgs& args) {
   if (args.samples) settings.samples = *args.samples;
   if (args.seed) settings.seed = *args.seed;
   if (args.error_texels) settings.error_texels = *args.error_texels;
+  if (args.max_memory) settings.max_memory = *args.max_memory;
 
   // The output folder is locked and its names checked before the bake, so a bake that could not
   // publish its files fails in a second, not after its work.
@@ -168,8 +172,9 @@ Runner add_bake_command(CLI::App& app) {
     BakeArgs args;
     std::string method, quantity;
     int resolution = 0, samples = 0;
-    std::uint64_t seed = 0;
+    std::int64_t seed = 0;
     double error_texels = 1;
+    std::string max_memory;
   };
   auto o = std::make_shared<Options>();
   auto* bake = app.add_subcommand("bake", "bake every receiver of a scene into OUTDIR");
@@ -185,7 +190,20 @@ Runner add_bake_command(CLI::App& app) {
                              ->check(CLI::Range(1, 16384));
   auto* samples_opt = bake->add_option("--samples", o->samples, "light samples per texel")
                           ->check(CLI::Range(1, 1 << 20));
-  auto* seed_opt = bake->add_option("--seed", o->seed, "sampling seed");
+  auto* seed_opt =
+      bake->add_option("--seed", o->seed, "sampling seed (0 or more)")
+          ->check(CLI::Range(std::int64_t(0), std::numeric_limits<std::int64_t>::max()));
+  auto* memory_opt =
+      bake->add_option("--max-memory", o->max_memory,
+                       "memory the bake may use, e.g. \"8 GiB\" (overrides [bake] max_memory)")
+          ->check(CLI::Validator(
+              [](std::string& text) {
+                std::uint64_t bytes = 0;
+                return sb::parse_memory_size(text, bytes)
+                           ? std::string()
+                           : "must be a size such as 8GiB or 512MiB, got '" + text + "'";
+              },
+              "SIZE"));
   auto* error_opt =
       bake->add_option("--error-texels", o->error_texels,
                        "convolution: penumbra error allowed, receiver texels (overrides [bake])")
@@ -201,7 +219,12 @@ Runner add_bake_command(CLI::App& app) {
     if (*quantity_opt) o->args.quantity = o->quantity;
     if (*resolution_opt) o->args.resolution = o->resolution;
     if (*samples_opt) o->args.samples = o->samples;
-    if (*seed_opt) o->args.seed = o->seed;
+    if (*seed_opt) o->args.seed = std::uint64_t(o->seed);
+    if (*memory_opt) {
+      std::uint64_t bytes = 0;
+      sb::parse_memory_size(o->max_memory, bytes);
+      o->args.max_memory = bytes;
+    }
     if (*error_opt) o->args.error_texels = o->error_texels;
     return run_bake(o->args);
   };

@@ -223,12 +223,19 @@ int run_compare(const CompareArgs& args) {
   std::vector<std::string> failures;
   for (const auto& gate : gates) {
     const double value = gate_value(gate, c);
-    const bool failed = gate.fail_below ? value < gate.threshold : value > gate.threshold;
-    if (std::isnan(value)) {
-      std::fprintf(stderr, "shadowbake: warning: gate %s: no texels to measure; not checked\n",
-                   gate.metric.c_str());
-    }
-    if (failed) {
+    // A gate that has nothing to judge, or an image with texels that are not numbers, fails:
+    // a pipeline must not pass a bake it could not measure.
+    const bool unmeasured = std::isnan(value);
+    const bool broken = c.non_finite_a > 0;
+    const bool failed =
+        unmeasured || broken || (gate.fail_below ? value < gate.threshold : value > gate.threshold);
+    if (unmeasured) {
+      failures.push_back(
+          fmt::format("{}: no texels to judge (none covered, or none finite)", gate.metric));
+    } else if (broken) {
+      failures.push_back(fmt::format("{}: {} has {} non-finite texel value(s)", gate.metric, args.a,
+                                     c.non_finite_a));
+    } else if (failed) {
       failures.push_back(fmt::format("{} = {} {} {}", gate.metric, number(value),
                                      gate.fail_below ? "<" : ">", number(gate.threshold)));
     }

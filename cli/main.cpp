@@ -74,7 +74,12 @@ int main(int argc, char** argv) {
   } catch (const CLI::Success& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);
+    // One line, like every other error (CLI11's own exit() prints two).
+    std::string what = e.what();
+    for (char& c : what)
+      if (c == '\n' || c == '\r') c = ' ';
+    std::fprintf(stderr, "shadowbake: error: %s (shadowbake --help lists the options)\n",
+                 what.c_str());
     return sbcli::usage;
   }
   for (const auto& [name, run] : commands) {

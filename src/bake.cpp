@@ -16,6 +16,7 @@
 #include "convolution_bake.h"
 #include "fft_convolution.h"
 #include "lights.h"
+#include "memory_budget.h"
 #include "mesh.h"
 #include "ray_scene.h"
 #include "reference_bake.h"
@@ -29,12 +30,15 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// Every object's mesh, in scene order; skipped degenerate triangles become warnings.
+// Every object's mesh, in scene order; skipped degenerate triangles become warnings. A mesh file
+// may be a quarter of the memory budget: Assimp's scene and the working mesh take several times
+// its size.
 Expected<std::vector<Mesh>> load_meshes(const Scene& scene, std::vector<std::string>* warnings) {
   std::vector<Mesh> meshes;
   meshes.reserve(scene.objects.size());
+  const std::uint64_t max_file_bytes = memory_budget(scene.bake) / 4;
   for (const auto& obj : scene.objects) {
-    auto mesh = import_mesh(obj, scene.file);
+    auto mesh = import_mesh(obj, scene.file, max_file_bytes);
     if (!mesh) return mesh.error();
     if (mesh->skipped_degenerate > 0 && warnings) {
       warnings->push_back(scene.file.string() + ":" + std::to_string(obj.line) + ": object '" +
@@ -69,6 +73,12 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     return scene_error(scene.file.string() + ": [bake]: unknown method '" + scene.bake.method +
                        "' (known: " + known + ")");
   }
+  const std::vector<MemoryItem> estimate = bake_memory_estimate(scene);
+  if (Status fits = check_memory(scene, estimate, memory_budget(scene.bake),
+                                 "lower 'resolution' (--resolution) or raise max_memory "
+                                 "(--max-memory)");
+      !fits)
+    return fits.error();
   const auto thread_limit = limit_threads(options);
   FftConvolver::shared().set_threads(options.threads > 0
                                          ? options.threads
@@ -83,8 +93,7 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   // The methods that cast rays: the reference and accumulation for their shadows, erosion for
   // its hard shadow and blocker distances. The convolution and the shadow-map filters do not.
   const std::string& method = scene.bake.method;
-  const bool ray_traced =
-      method == "reference" || method == "accumulation" || method == "erosion";
+  const bool ray_traced = method == "reference" || method == "accumulation" || method == "erosion";
   std::optional<RayScene> rays;
   if (ray_traced) {
     auto built = RayScene::build(blockers);
@@ -167,11 +176,18 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
       in.max_image = scene.bake.max_image;
       in.max_triples = scene.bake.max_triples;
       in.light_parts = scene.bake.light_parts;
-      in.combine = scene.bake.blocker_combine == "sum" ? BlockerCombine::sum
-                                                       : BlockerCombine::product;
+      in.combine =
+          scene.bake.blocker_combine == "sum" ? BlockerCombine::sum : BlockerCombine::product;
       in.weighted = scene.bake.weighting == "irradiance";
+      // What the budget leaves the leaves' images, beyond what the estimate above counted.
+      in.memory_for_images = double(memory_budget(scene.bake)) - total_bytes(estimate);
       ConvolutionPlan plan;
-      out.image = bake_convolution(spaces[r], in, &out.pairs, &plan);
+      auto image = bake_convolution(spaces[r], in, &out.pairs, &plan);
+      if (!image) {
+        return scene_error(scene.file.string() + ":" + std::to_string(obj.line) + ": " +
+                           image.error().message);
+      }
+      out.image = std::move(*image);
       out.plan = describe_plan(plan);
       for (const auto& w : plan.warnings) result.warnings.push_back(scene.file.string() + ": " + w);
       texels_done += std::int64_t(spaces[r].texels.size());
@@ -192,6 +208,10 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
 }
 
 Expected<std::vector<std::string>> plan(const Scene& scene, const BakeOptions& options) {
+  if (Status fits = check_memory(scene, bake_memory_estimate(scene), memory_budget(scene.bake),
+                                 "lower 'resolution' (--resolution) or raise max_memory");
+      !fits)
+    return fits.error();
   const auto thread_limit = limit_threads(options);
   auto loaded = load_meshes(scene, nullptr);
   if (!loaded) return loaded.error();

@@ -49,16 +49,19 @@
 
 #include <algorithm>
 #include <array>
-#include <limits>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numbers>
+
+#include <fmt/format.h>
 
 #include "blocker_image.h"
 #include "buried_texels.h"
-#include "fft_convolution.h"
-#include "source_image.h"
 #include "convolution_plan.h"
+#include "fft_convolution.h"
+#include "memory_budget.h"
+#include "source_image.h"
 
 namespace sb {
 
@@ -69,6 +72,12 @@ using Clock = std::chrono::steady_clock;
 // Transform pixels of the leaves convolved together before their images are added in (about
 // 5 images of 4 bytes each per pixel: 64 MiB).
 constexpr std::size_t kBatchPixels = std::size_t(1) << 22;
+
+// Bytes per transform pixel of a leaf being convolved: its blocker images (share and whole, 8),
+// its results (3 colour channels and 2 moments, for the share and the whole: 40), FFTW's padded
+// input and spectrum (12) and the cached kernel spectra (5 kernels of half a spectrum: 20),
+// rounded up for the allocator.
+constexpr double kBytesPerTransformPixel = 96;
 
 // How far outside a solid's face plane a texel may lie and still count as buried in it, in
 // receiver texels: a floor texel under a box's bottom face lies on that plane up to rounding.
@@ -111,7 +120,8 @@ class Bilinear {
 // along its right and up axes, per metre (design-notes §6). Zero where the light's centre lies
 // on or below the texel's horizon or the texel on or behind the light's plane (cosines under
 // 1e-3), where a first-order weight would mislead.
-std::vector<Vec2> weight_gradients(const PlanFrame& fr, const TexelSpace& space, const Light& light) {
+std::vector<Vec2> weight_gradients(const PlanFrame& fr, const TexelSpace& space,
+                                   const Light& light) {
   std::vector<Vec2> g(fr.texels.size(), Vec2::Zero());
   if (light.shape() == LightShape::sphere) return g;
   const Vec3 c = light.centre(), n = light.normal();
@@ -260,9 +270,10 @@ LeafImages convolve_leaf(const ConvolutionPlan& plan, const Triple& leaf, Blocke
   const PlanFrame& fr = plan.frames[leaf.frame];
   const Light& light = plan.light_parts[fr.light_part].part;
   auto start = Clock::now();
-  const double k = std::max(0.0, 1.0 / leaf.config.blocker_plane - 1.0 / leaf.config.receiver_plane);
-  out.kernel = source_kernel(light, fr.frame, k, leaf.grid.pixel, leaf.view,
-                             leaf.config.receiver_plane);
+  const double k =
+      std::max(0.0, 1.0 / leaf.config.blocker_plane - 1.0 / leaf.config.receiver_plane);
+  out.kernel =
+      source_kernel(light, fr.frame, k, leaf.grid.pixel, leaf.view, leaf.config.receiver_plane);
   const SourceKernel& kernel = out.kernel;
   out.seconds_source = seconds_since(start);
   start = Clock::now();
@@ -337,7 +348,8 @@ LeafImages convolve_leaf(const ConvolutionPlan& plan, const Triple& leaf, Blocke
       to_share.push_back(&share);
       to_full.push_back(&whole);
     };
-    for (int c = 0; c < channels; ++c) add(kernel.channels[c], win.occluded[c], win.occluded_full[c]);
+    for (int c = 0; c < channels; ++c)
+      add(kernel.channels[c], win.occluded[c], win.occluded_full[c]);
     if (weighted)
       for (int m = 0; m < 2; ++m) add(kernel.moments[m], win.moment[m], win.moment_full[m]);
     const int w = win.grid.width, h = win.grid.height;
@@ -353,8 +365,8 @@ LeafImages convolve_leaf(const ConvolutionPlan& plan, const Triple& leaf, Blocke
 // image's occlusion into `largest` (the max rule of `sum`; see the file's header).
 void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const LeafImages& images,
                      BlockerCombine combine, const std::vector<Vec2>& gradient,
-                     std::vector<Vec3f>& occlusion, std::vector<Vec3f>& largest,
-                     EulerCounts* euler, PairReport& report) {
+                     std::vector<Vec3f>& occlusion, std::vector<Vec3f>& largest, EulerCounts* euler,
+                     PairReport& report) {
   const PlanFrame& fr = plan.frames[leaf.frame];
   const SourceKernel& kernel = images.kernel;
   report.seconds_source += images.seconds_source;
@@ -395,8 +407,8 @@ void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const Leaf
       euler->touched.push_back(i);
     }
   }
-  const bool weighted = !gradient.empty() && !images.windows.empty() &&
-                        !images.windows.front().moment[0].empty();
+  const bool weighted =
+      !gradient.empty() && !images.windows.empty() && !images.windows.front().moment[0].empty();
   const bool with_full = combine == BlockerCombine::sum;
   const int channels = kernel.grey ? 1 : 3;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, texels.size(), 2048), [&](const auto& r) {
@@ -433,9 +445,7 @@ void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const Leaf
         const double f = combine == BlockerCombine::sum ? o : -std::log(std::max(1e-6, 1.0 - o));
         float whole = 0;
         if (with_full) {
-          const double v = win.occluded_full[c].empty()
-                               ? share
-                               : at(win.occluded_full[c]);
+          const double v = win.occluded_full[c].empty() ? share : at(win.occluded_full[c]);
           whole = float(wt * std::clamp((v + first_full) / norm, 0.0, 1.0));
         }
         // A grey kernel's one channel stands for all three.
@@ -452,8 +462,20 @@ void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const Leaf
 
 }  // namespace
 
-Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
-                       std::vector<PairReport>* reports, ConvolutionPlan* plan_out) {
+double convolution_images_bytes(const ConvolutionPlan& plan) {
+  // The batches of bake_convolution: leaves together up to kBatchPixels, a larger one alone.
+  double largest_leaf = 0, all = 0;
+  for (const Triple& tr : plan.triples) {
+    if (!tr.children.empty() || tr.empty) continue;
+    const double pixels = double(tr.fft_width) * double(tr.fft_height);
+    largest_leaf = std::max(largest_leaf, pixels);
+    all += pixels;
+  }
+  return std::max(largest_leaf, std::min(all, double(kBatchPixels))) * kBytesPerTransformPixel;
+}
+
+Expected<Image> bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
+                                 std::vector<PairReport>* reports, ConvolutionPlan* plan_out) {
   const auto& lights = *in.lights;
   const std::size_t n = space.texels.size();
   auto start = Clock::now();
@@ -468,6 +490,22 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
   pin.light_parts = in.light_parts;
   ConvolutionPlan plan = plan_convolution(space, pin);
   const double plan_seconds = seconds_since(start);
+  if (const double needed = convolution_images_bytes(plan); needed > in.memory_for_images) {
+    int widest = 0, tallest = 0;
+    for (const Triple& tr : plan.triples) {
+      if (!tr.children.empty() || tr.empty) continue;
+      if (double(tr.fft_width) * tr.fft_height > double(widest) * tallest) {
+        widest = tr.fft_width;
+        tallest = tr.fft_height;
+      }
+    }
+    return scene_error(fmt::format(
+        "receiver '{}': the convolution's images need about {} (its largest transform is "
+        "{}x{}), more than the {} max_memory leaves them; lower 'max_image' or raise "
+        "'error_texels' or max_memory",
+        in.receiver->name, format_bytes(needed), widest, tallest,
+        format_bytes(in.memory_for_images)));
+  }
 
   // Per light part and texel: V, and whether one of the part's frames reaches the texel.
   std::vector<std::vector<Vec3f>> part_visible(plan.light_parts.size());
@@ -510,8 +548,8 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
       while (last < leaves.size()) {
         const Triple& tr = plan.triples[leaves[last]];
         const std::size_t area = std::size_t(tr.fft_width) * std::size_t(tr.fft_height);
-        if (last > first && (FftConvolver::threaded(tr.fft_width, tr.fft_height) ||
-                             pixels + area > kBatchPixels))
+        if (last > first &&
+            (FftConvolver::threaded(tr.fft_width, tr.fft_height) || pixels + area > kBatchPixels))
           break;
         pixels += area;
         ++last;
@@ -619,11 +657,11 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
           const LightPart& lp = plan.light_parts[std::size_t(p)];
           // Plus a trace of the power share, so that a texel no part's closed form reaches
           // still averages its parts by power rather than dropping the light.
-          const double w =
-              in.weighted ? lp.part.unoccluded_irradiance(tx.position.cast<double>(),
-                                                          tx.normal.cast<double>())
-                                    .sum() + 1e-9 * lp.fraction
-                          : lp.fraction;
+          const double w = in.weighted ? lp.part.unoccluded_irradiance(tx.position.cast<double>(),
+                                                                       tx.normal.cast<double>())
+                                                 .sum() +
+                                             1e-9 * lp.fraction
+                                       : lp.fraction;
           sum += w * part_visible[std::size_t(p)][t].cast<double>();
           weight += w;
         }
@@ -650,16 +688,16 @@ Image bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
       Vec3 sum = Vec3::Zero(), weight = Vec3::Zero();
       for (std::size_t l = 0; l < lights.size() && !buried[t]; ++l) {
         if (visible[l].empty() || !reached[l][t]) continue;
-        const Vec3 w = weights_needed ? lights[l].unoccluded_irradiance(p, normal)
-                                      : lights[l].exitance();
+        const Vec3 w =
+            weights_needed ? lights[l].unoccluded_irradiance(p, normal) : lights[l].exitance();
         sum += w.cwiseProduct(visible[l][t].cast<double>());
         weight += w;
       }
       float* px = out.at(tx.x, tx.y);
       for (int c = 0; c < 3; ++c) {
-        px[c] = float(in.quantity == Quantity::irradiance ? sum[c]
-                                                          : (weight[c] > 0 ? sum[c] / weight[c]
-                                                                           : 0.0));
+        px[c] =
+            float(in.quantity == Quantity::irradiance ? sum[c]
+                                                      : (weight[c] > 0 ? sum[c] / weight[c] : 0.0));
       }
     }
   });

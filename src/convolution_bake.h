@@ -6,10 +6,10 @@
 #include <vector>
 
 #include "bake.h"
+#include "convolution_plan.h"
 #include "lights.h"
 #include "mesh.h"
 #include "texel_space.h"
-#include "convolution_plan.h"
 #include "virtual_configuration.h"
 
 namespace sb {
@@ -35,13 +35,21 @@ struct ConvolutionInputs {
   // than on one grid spanning them all: the same values for a fraction of the pixels
   // (convolution_bake.cpp, leaf_windows). Off only to measure what it saves.
   bool island_windows = true;
+  // Bytes the leaves' images may take at once (what the bake's budget leaves them,
+  // memory_budget.h); a plan that needs more is refused before anything is convolved.
+  double memory_for_images = 1e18;
 };
+
+// The most memory the leaves' images of `plan` take at once, bytes: leaves are convolved a batch
+// at a time, and each transform pixel holds the images and spectra convolve_leaf makes.
+double convolution_images_bytes(const ConvolutionPlan& plan);
 
 // Bakes one receiver: plans its triples (plan_convolution), convolves every leaf and combines
 // them per texel; lights combined as V = Σ H0_l·V_l / Σ H0_l (or H = Σ H0_l·V_l). Appends one
 // report per (light part, frustum) to `reports`, and gives the executed plan, with each leaf's
-// measured seconds, in *plan (either may be null).
-Image bake_convolution(const TexelSpace& texels, const ConvolutionInputs& in,
-                       std::vector<PairReport>* reports, ConvolutionPlan* plan = nullptr);
+// measured seconds, in *plan (either may be null). The error: the plan needs more memory than
+// in.memory_for_images.
+Expected<Image> bake_convolution(const TexelSpace& texels, const ConvolutionInputs& in,
+                                 std::vector<PairReport>* reports, ConvolutionPlan* plan = nullptr);
 
 }  // namespace sb

@@ -2,20 +2,65 @@
 
 #include <OpenImageIO/imageio.h>
 #include <OpenImageIO/strutil.h>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <mutex>
+
+#include <fmt/format.h>
+
 #include <system_error>
+#include "memory_budget.h"
 
 namespace sb {
 
 namespace fs = std::filesystem;
 
 namespace {
+
+// OIIO's messages may span lines; errors are one line.
+std::string one_line(std::string text) {
+  for (char& c : text) {
+    if (c == '\n' || c == '\r' || c == '\t') c = ' ';
+  }
+  while (!text.empty() && text.back() == ' ') text.pop_back();
+  return text;
+}
+
+// libpng prints its errors and warnings ("libpng error: cHRM: Read error") on stderr itself, as
+// OpenImageIO 2.4 installs no handler of its own, and OIIO's error message repeats them. So while
+// OIIO reads or writes an image, file descriptor 2 points at /dev/null. One image is read or
+// written at a time (kStderrMutex); bakes do not read or write images while they work.
+std::mutex kStderrMutex;
+
+class QuietStderr {
+ public:
+  QuietStderr() : lock_(kStderrMutex) {
+    std::fflush(stderr);
+    const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+    saved_ = null >= 0 ? ::dup(STDERR_FILENO) : -1;
+    if (saved_ >= 0) ::dup2(null, STDERR_FILENO);
+    if (null >= 0) ::close(null);
+  }
+  ~QuietStderr() {
+    if (saved_ < 0) return;
+    std::fflush(stderr);
+    ::dup2(saved_, STDERR_FILENO);
+    ::close(saved_);
+  }
+  QuietStderr(const QuietStderr&) = delete;
+  QuietStderr& operator=(const QuietStderr&) = delete;
+
+ private:
+  std::lock_guard<std::mutex> lock_;
+  int saved_ = -1;
+};
 
 // A sibling of `path` that no other writer uses: hidden, with the process id.
 fs::path temporary_sibling(const fs::path& path) {
@@ -37,6 +82,7 @@ void remove_quietly(const fs::path& path) {
 }  // namespace
 
 Status write_image(const fs::path& path, const Image& image, PixelFormat format) {
+  QuietStderr quiet;
   const fs::path tmp = temporary_sibling(path);
   // The format comes from the final name's extension; the temporary name has none OIIO knows.
   auto out = OIIO::ImageOutput::create(path.string());
@@ -80,13 +126,31 @@ Status write_image(const fs::path& path, const Image& image, PixelFormat format)
   return Ok{};
 }
 
-Expected<Image> read_image(const fs::path& path, bool linearise) {
+Expected<Image> read_image(const fs::path& path, bool linearise, std::uint64_t max_bytes) {
+  std::error_code ec;
+  const auto status = fs::status(path, ec);
+  if (ec) return input_error(path.string() + ": cannot read image: " + ec.message());
+  if (!fs::is_regular_file(status)) {
+    return input_error(path.string() + ": cannot read image: " +
+                       (fs::is_directory(status) ? "it is a folder"
+                                                 : "not a regular file (a device, a FIFO or a "
+                                                   "socket)"));
+  }
+  QuietStderr quiet;
   auto in = OIIO::ImageInput::open(path.string());
-  if (!in) return input_error(path.string() + ": cannot read image: " + OIIO::geterror());
+  if (!in) return input_error(path.string() + ": cannot read image: " + one_line(OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();
+  const double bytes = double(spec.width) * spec.height * spec.nchannels * sizeof(float);
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || bytes > double(max_bytes)) {
+    return input_error(fmt::format(
+        "{}: cannot read image: its header says {}x{} pixels of {} channel(s), {} as float; at "
+        "most {} is read",
+        path.string(), spec.width, spec.height, spec.nchannels, format_bytes(bytes),
+        format_bytes(double(max_bytes))));
+  }
   Image image(spec.width, spec.height, spec.nchannels);
   if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data())) {
-    return input_error(path.string() + ": cannot read image: " + in->geterror());
+    return input_error(path.string() + ": cannot read image: " + one_line(in->geterror()));
   }
   if (linearise && OIIO::Strutil::iequals(spec.get_string_attribute("oiio:ColorSpace"), "sRGB")) {
     const int alpha = spec.alpha_channel;

@@ -21,7 +21,11 @@ Status write_image(const std::filesystem::path& path, const Image& image, PixelF
 
 // Reads any OIIO-readable image as float, keeping its channel count. With `linearise`, values
 // of an image whose colour space OIIO reports as sRGB (8-bit PNG, JPEG, ...) are decoded to
-// linear, so they can be used as emission.
-Expected<Image> read_image(const std::filesystem::path& path, bool linearise = false);
+// linear, so they can be used as emission. Only a regular file is read (a FIFO or a device is
+// refused before it is opened), and one whose pixels as float would take more than `max_bytes`
+// is refused from its header, before they are allocated.
+inline constexpr std::uint64_t kDefaultMaxImageBytes = std::uint64_t(4) << 30;
+Expected<Image> read_image(const std::filesystem::path& path, bool linearise = false,
+                           std::uint64_t max_bytes = kDefaultMaxImageBytes);
 
 }  // namespace sb

@@ -8,6 +8,8 @@
 // ones whose trust in the header is the problem; a check needs only counts and sizes, not a mesh.
 #include "mesh_file_checks.h"
 
+#include "memory_budget.h"
+
 #include <fmt/format.h>
 
 #include <charconv>
@@ -79,16 +81,6 @@ std::uint64_t saturating_multiply(std::uint64_t a, std::uint64_t b) {
 Error problem(std::string message) { return scene_error(std::move(message)); }
 
 }  // namespace
-
-std::string format_bytes(double bytes) {
-  const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
-  int unit = 0;
-  while (bytes >= 1024 && unit < 6) {
-    bytes /= 1024;
-    ++unit;
-  }
-  return unit == 0 ? fmt::format("{:.0f} B", bytes) : fmt::format("{:.3g} {}", bytes, units[unit]);
-}
 
 Status check_obj_text(std::string_view text) {
   // First pass: how many of each element the file holds (Assimp resolves indices after reading

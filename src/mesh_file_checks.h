@@ -23,7 +23,4 @@ Status check_mesh_file(const std::filesystem::path& file, std::uint64_t max_byte
 Status check_obj_text(std::string_view text);
 Status check_ply_bytes(std::string_view bytes, std::uint64_t file_bytes);
 
-// A byte count as people read it: "4.2 GiB", "512 MiB", "730 B".
-std::string format_bytes(double bytes);
-
 }  // namespace sb

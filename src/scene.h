@@ -25,6 +25,8 @@ struct BakeSettings {
   int samples = 256;       // light samples per texel, for sampling methods
   int margin = 4;          // texels of dilation around UV charts
   std::uint64_t seed = 0;  // sampling seed; same seed, same bytes
+  // Bytes the bake may use (memory_budget.h); 0: the default, 3/4 of the physical memory.
+  std::uint64_t max_memory = 0;
   // convolution: the penumbra error ε allowed per (light part, blocker cluster, receiver part)
   // triple, in receiver texels, and the largest convolution image side, pixels
   double error_texels = 1.0;

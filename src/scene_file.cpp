@@ -24,6 +24,7 @@
 #include <system_error>
 #include <vector>
 
+#include "memory_budget.h"
 #include "scene.h"
 
 namespace sb {
@@ -295,9 +296,9 @@ bool is_valid_object_name(std::string_view name) {
 
 Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::table& table) {
   TableReader r(file, table, "[bake]");
-  r.check_known_keys({"resolution", "method", "quantity", "samples", "margin", "seed",
-                      "error_texels", "max_image", "max_triples", "light_parts", "blocker_combine", "weighting", "shadow_map", "pcf_radius",
-                      "erosion_factor"});
+  r.check_known_keys({"resolution", "method", "quantity", "samples", "margin", "seed", "max_memory",
+                      "error_texels", "max_image", "max_triples", "light_parts", "blocker_combine",
+                      "weighting", "shadow_map", "pcf_radius", "erosion_factor"});
   BakeSettings bake;
   const int int_max = std::numeric_limits<int>::max();
   if (auto v = r.integer("resolution", 1, 16384)) bake.resolution = static_cast<int>(*v);
@@ -322,6 +323,18 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
   if (auto v = r.integer("margin", 0, int_max)) bake.margin = static_cast<int>(*v);
   if (auto v = r.integer("seed", 0, std::numeric_limits<std::int64_t>::max())) {
     bake.seed = static_cast<std::uint64_t>(*v);
+  }
+  if (const toml::node* node = r.find("max_memory"); node && !r.failed()) {
+    // A size with its unit ("8 GiB", "512 MiB") or a whole number of bytes.
+    const std::string_view requirement = "a size such as \"8 GiB\" or \"512 MiB\", or bytes";
+    std::uint64_t bytes = 0;
+    if (const auto* text = node->as_string(); text && parse_memory_size(text->get(), bytes)) {
+      bake.max_memory = bytes;
+    } else if (const auto* whole = node->as_integer(); whole && whole->get() > 0) {
+      bake.max_memory = std::uint64_t(whole->get());
+    } else {
+      r.fail_got("max_memory", requirement);
+    }
   }
   if (auto v = r.number("error_texels", "a number > 0", is_positive)) bake.error_texels = *v;
   if (auto v = r.integer("max_image", 64, 16384)) bake.max_image = static_cast<int>(*v);
@@ -348,9 +361,8 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
     }
   }
   if (auto v = r.integer("shadow_map", 64, 16384)) bake.shadow_map = static_cast<int>(*v);
-  if (auto v = r.number("pcf_radius", "a number >= 0", [](double x) {
-        return std::isfinite(x) && x >= 0;
-      })) {
+  if (auto v = r.number("pcf_radius", "a number >= 0",
+                        [](double x) { return std::isfinite(x) && x >= 0; })) {
     bake.pcf_radius = *v;
   }
   if (auto v = r.string("erosion_factor")) {
@@ -375,11 +387,16 @@ std::optional<std::filesystem::path> existing_file(TableReader& r,
   std::filesystem::path looked_for = std::filesystem::absolute(resolved, ec).lexically_normal();
   if (ec) looked_for = resolved;
   const std::string shown = single_quoted(*name);
+  const auto status = std::filesystem::status(looked_for, ec);
   if (name->empty()) {
     r.fail(key, fmt::format("'{}' must not be empty", key));
-  } else if (!std::filesystem::exists(looked_for, ec)) {
+  } else if (ec && ec != std::errc::no_such_file_or_directory) {
+    // A loop of symbolic links, a folder we may not enter, ...: say which.
+    r.fail(key, fmt::format("{} {} cannot be opened: {} (looked for {})", what, shown, ec.message(),
+                            looked_for.string()));
+  } else if (!std::filesystem::exists(status)) {
     r.fail(key, fmt::format("{} {} not found (looked for {})", what, shown, looked_for.string()));
-  } else if (!std::filesystem::is_regular_file(looked_for, ec)) {
+  } else if (!std::filesystem::is_regular_file(status)) {
     r.fail(key, fmt::format("{} {} is not a regular file (looked for {})", what, shown,
                             looked_for.string()));
   }
@@ -552,6 +569,9 @@ Expected<std::vector<const toml::table*>> tables_of(const std::filesystem::path&
                        fmt::format("'{0}' must be an array of tables, written [[{0}]]", key.str()));
 }
 
+// A scene file is a few kilobytes of TOML; one past this is not a scene file.
+constexpr std::uintmax_t kMaxSceneFileBytes = 16 << 20;
+
 Expected<std::string> read_text(const std::filesystem::path& file) {
   const auto fail = [&](const std::string& reason) {
     return scene_error(fmt::format("{}: cannot open scene file: {}", file.string(), reason));
@@ -560,6 +580,12 @@ Expected<std::string> read_text(const std::filesystem::path& file) {
   const auto status = std::filesystem::status(file, ec);
   if (ec) return fail(ec.message());
   if (std::filesystem::is_directory(status)) return fail("it is a directory");
+  // A FIFO would block the read for ever and a device (/dev/zero) never end it.
+  if (!std::filesystem::is_regular_file(status))
+    return fail("not a regular file (a device, a FIFO or a socket)");
+  if (std::filesystem::file_size(file, ec) > kMaxSceneFileBytes)
+    return fail(
+        fmt::format("larger than {} MiB, too large for a scene file", kMaxSceneFileBytes >> 20));
   std::ifstream in(file, std::ios::binary);
   if (!in) return fail(std::generic_category().message(errno));
   std::ostringstream text;

@@ -332,9 +332,9 @@ TEST(ConvolutionPlan, IslandWindowsChangeNothingButTheWork) {
   in.clusters = &p->clusters;
   in.max_triples = scene.bake.max_triples;
   std::vector<PairReport> with_reports, without_reports;
-  const Image with = bake_convolution(p->space, in, &with_reports);
+  const Image with = *bake_convolution(p->space, in, &with_reports);
   in.island_windows = false;
-  const Image without = bake_convolution(p->space, in, &without_reports);
+  const Image without = *bake_convolution(p->space, in, &without_reports);
   ASSERT_EQ(with.pixels.size(), without.pixels.size());
   double worst = 0;
   for (std::size_t i = 0; i < with.pixels.size(); ++i)
