@@ -2,6 +2,7 @@
 // method → dilation. Methods are chosen by name (methods.cpp lists them).
 #include "bake.h"
 
+#include <fmt/format.h>
 #include <tbb/global_control.h>
 
 #include <algorithm>
@@ -116,13 +117,50 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   std::vector<TexelSpace> spaces;
   std::vector<double> raster_seconds;
   std::int64_t total_texels = 0;
+  std::vector<UvLayoutReport> layouts;
   for (std::size_t i = 0; i < meshes.size(); ++i) {
-    if (!scene.objects[i].receiver) continue;
+    const ObjectDesc& obj = scene.objects[i];
+    if (!obj.receiver) continue;
     const auto start = std::chrono::steady_clock::now();
     receivers.push_back(i);
     spaces.push_back(rasterise_texels(meshes[i], res, res));
     raster_seconds.push_back(seconds_since(start));
     total_texels += std::int64_t(spaces.back().texels.size());
+    layouts.push_back(check_uv_layout(meshes[i], spaces.back(), scene.bake.margin));
+    const std::string where =
+        scene.file.string() + ":" + std::to_string(obj.line) + ": object '" + obj.name + "': ";
+    if (spaces.back().texels.empty()) {
+      const UvLayoutReport& uv = layouts.back();
+      const std::string problem = fmt::format(
+          "its lightmap UVs (channel {}) cover no texel at {}² (UV area {:.3g}, of which {:.3g} "
+          "inside [0, 1])",
+          obj.uv_channel, res, uv.uv_area, uv.uv_area - uv.uv_area_outside);
+      if (!obj.allow_uncovered) {
+        return scene_error(where + problem +
+                           "; fix the UVs, set 'uv' to the lightmap channel, or set "
+                           "allow_uncovered = true");
+      }
+      result.warnings.push_back(where + problem + "; its lightmap is black");
+    }
+    for (const std::string& w : uv_layout_warnings(layouts.back()))
+      result.warnings.push_back(where + w);
+  }
+
+  // A light that reaches no receiver texel (facing away, or below every texel's horizon) is
+  // most often a normal pointing the wrong way: say so.
+  for (std::size_t l = 0; l < lights.size(); ++l) {
+    bool reached = false;
+    for (std::size_t r = 0; r < spaces.size() && !reached; ++r)
+      for (const Texel& t : spaces[r].texels)
+        if ((reached = lights[l].reaches(t.position.cast<double>(), t.normal.cast<double>())))
+          break;
+    if (!reached) {
+      const LightDesc& d = scene.lights[l];
+      result.warnings.push_back(fmt::format(
+          "{}:{}: light '{}': reaches no texel of any receiver (is its 'normal' the right way, or "
+          "its 'position' behind the receivers?); it adds nothing",
+          scene.file.string(), d.line, d.name));
+    }
   }
 
   std::atomic<std::int64_t> texels_done{0};
@@ -198,6 +236,7 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     dilate(out.image, spaces[r].covered, scene.bake.margin);
     out.seconds_dilate = seconds_since(dilate_start);
     out.covered_texels = std::int64_t(spaces[r].texels.size());
+    out.uv = layouts[r];
     out.covered = spaces[r].covered;
     out.seconds = raster_seconds[r] + seconds_since(start);
     result.receivers.push_back(std::move(out));

@@ -11,6 +11,7 @@
 #include "error.h"
 #include "image.h"
 #include "scene.h"
+#include "uv_checks.h"
 
 namespace sb {
 
@@ -54,6 +55,7 @@ struct ReceiverBake {
   Image image;                        // RGB, width × height of the bake resolution, dilated
   std::vector<std::uint8_t> covered;  // width × height: 1 where a triangle covers the texel
   std::int64_t covered_texels = 0;
+  UvLayoutReport uv;   // the lightmap UV layout's checks
   double seconds = 0;  // texel space + method + dilation, this receiver only
   double seconds_texels = 0, seconds_method = 0, seconds_dilate = 0;  // its parts
   std::vector<PairReport> pairs;  // per (light part, frustum), for the convolution method

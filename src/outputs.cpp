@@ -143,6 +143,13 @@ Status write_outputs(OutputFolder& folder, const Scene& scene, const BakeSetting
         {"quantity", to_string(effective.quantity)},
         {"samples", effective.samples},
         {"covered_texels", r.covered_texels},
+        {"uv_layout",
+         {{"charts", r.uv.charts},
+          {"uv_area", r.uv.uv_area},
+          {"uv_area_outside", r.uv.uv_area_outside},
+          {"overlapping_texels", r.uv.overlapping_texels},
+          {"texels_near_other_charts", r.uv.texels_near_other_charts},
+          {"margin", r.uv.margin}}},
         {"seconds", r.seconds},
     });
     if (!r.stats.empty()) {

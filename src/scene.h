@@ -51,6 +51,9 @@ struct ObjectDesc {
   bool receiver = true;
   bool blocker = true;
   int uv_channel = 0;
+  // A receiver whose lightmap UVs cover no texel is an error unless this is set (its lightmap is
+  // then written black, with a warning).
+  bool allow_uncovered = false;
   Affine3 transform = Affine3::Identity();  // scale, then rotate (X, Y, Z), then translate
   int line = 0;  // line of the [[object]] table in the scene file, for errors
 };

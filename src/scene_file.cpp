@@ -419,12 +419,13 @@ Expected<ObjectDesc> read_object(const std::filesystem::path& file, const toml::
       }
     }
   }
-  r.check_known_keys(
-      {"name", "mesh", "receiver", "blocker", "uv", "translate", "rotate_deg", "scale"});
+  r.check_known_keys({"name", "mesh", "receiver", "blocker", "uv", "allow_uncovered", "translate",
+                      "rotate_deg", "scale"});
   r.require("mesh");
   if (auto mesh = existing_file(r, file, "mesh", "mesh file")) obj.mesh = *mesh;
   if (auto v = r.boolean("receiver")) obj.receiver = *v;
   if (auto v = r.boolean("blocker")) obj.blocker = *v;
+  if (auto v = r.boolean("allow_uncovered")) obj.allow_uncovered = *v;
   if (auto v = r.integer("uv", 0, std::numeric_limits<int>::max())) {
     obj.uv_channel = static_cast<int>(*v);
   }
@@ -544,6 +545,24 @@ Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::ta
 
   if (r.require("power")) {
     if (auto v = r.number("power", "a finite number > 0 (watts)", is_positive)) light.power = *v;
+  }
+  if (!r.failed() && light.power > 0) {
+    // Radiant exitance of the brightest channel. Irradiance never exceeds it (a form factor is at
+    // most 1); the bounds keep every lightmap value a normal 32-bit float.
+    const double area = is_rectangle ? light.width * light.height
+                        : is_sphere  ? 4 * std::numbers::pi * light.radius * light.radius
+                                     : std::numbers::pi * light.radius * light.radius;
+    const double exitance = light.power * light.color.maxCoeff() / area;
+    constexpr double kMaxExitance = 1e15;  // the Sun's surface: 6.3e7 W/m²
+    constexpr double kMinExitance = 1e-15;
+    if (!(exitance <= kMaxExitance) || !(exitance >= kMinExitance)) {
+      r.fail("power",
+             fmt::format("'power' {} W over {} m² is an exitance of {} W/m², outside "
+                         "the {} to {} W/m² a lightmap holds; check 'power' and the "
+                         "light's size",
+                         format_double(light.power), format_double(area), format_double(exitance),
+                         format_double(kMinExitance), format_double(kMaxExitance)));
+    }
   }
   if (is_sphere) {
     r.forbid("texture", "applies only to rectangle and disk lights, not sphere");

@@ -30,6 +30,9 @@ struct TexelSpace {
   int width = 0, height = 0;
   std::vector<Texel> texels;          // covered texels, in row-major order
   std::vector<std::uint8_t> covered;  // width * height; 1 where a texel of `texels` lies
+  // Texels whose centre two UV triangles claim (inside one, inside or on the other): charts that
+  // overlap in the lightmap, so one surface point stands for two (check_uv_layout reports it).
+  std::int64_t overlapping_texels = 0;
 };
 
 // Rasterises mesh's triangles in UV space at width × height. A texel whose centre lies inside a

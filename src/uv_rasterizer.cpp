@@ -28,6 +28,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cassert>
 #include <cmath>
 #include <cstddef>
@@ -313,9 +314,13 @@ TexelSpace rasterise_texels(const Mesh& mesh, int width, int height) {
   // Passes 1 and 2, row by row: the owner code of every texel, and covered texels per row.
   std::vector<std::int32_t> owner(texel_count, kUncovered);
   std::vector<std::size_t> row_count(std::size_t(height) + 1, 0);
+  std::atomic<std::int64_t> overlapping{0};
   tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
     std::vector<double> best_distance(static_cast<std::size_t>(width));
+    std::vector<std::uint8_t> row_strict(static_cast<std::size_t>(width));
+    std::vector<std::uint8_t> row_overlap(static_cast<std::size_t>(width));
     for (int y = rows.begin(); y != rows.end(); ++y) {
+      std::fill(row_overlap.begin(), row_overlap.end(), 0);
       std::int32_t* row_owner = &owner[std::size_t(y) * std::size_t(width)];
       const auto faces_begin = row_faces.begin() + std::ptrdiff_t(row_begin[std::size_t(y)]);
       const auto faces_end = row_faces.begin() + std::ptrdiff_t(row_begin[std::size_t(y) + 1]);
@@ -328,9 +333,19 @@ TexelSpace rasterise_texels(const Mesh& mesh, int width, int height) {
                                     fp.edge[2].row_term(centre_y)};
         for (int x = first; x <= last; ++x) {
           const double centre_x = x + 0.5;
-          if (row_owner[x] == kUncovered && fp.edge[0](centre_x, row_term[0]) >= 0.0 &&
-              fp.edge[1](centre_x, row_term[1]) >= 0.0 && fp.edge[2](centre_x, row_term[2]) >= 0.0)
+          const double e0 = fp.edge[0](centre_x, row_term[0]);
+          const double e1 = fp.edge[1](centre_x, row_term[1]);
+          const double e2 = fp.edge[2](centre_x, row_term[2]);
+          if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) continue;
+          const bool strictly = e0 > 0.0 && e1 > 0.0 && e2 > 0.0;
+          if (row_owner[x] == kUncovered) {
             row_owner[x] = fp.face;
+            row_strict[std::size_t(x)] = strictly;
+          } else if (strictly || row_strict[std::size_t(x)]) {
+            // Two triangles share a centre on a common edge or vertex (inside neither strictly);
+            // one strictly inside means their interiors overlap.
+            row_overlap[std::size_t(x)] = 1;
+          }
         }
       }
       const double centre_v = 1.0 - centre_y / height;
@@ -354,8 +369,13 @@ TexelSpace rasterise_texels(const Mesh& mesh, int width, int height) {
       std::size_t count = 0;
       for (int x = 0; x < width; ++x) count += row_owner[x] != kUncovered;
       row_count[std::size_t(y) + 1] = count;
+      std::int64_t overlaps = 0;
+      for (const std::uint8_t o : row_overlap) overlaps += o;
+      overlapping += overlaps;
     }
   });
+
+  space.overlapping_texels = overlapping.load();
 
   // Offsets of each row's texels in the row-major output, then the texels themselves.
   for (int y = 0; y < height; ++y) row_count[std::size_t(y) + 1] += row_count[std::size_t(y)];

@@ -220,7 +220,8 @@ TEST_F(SceneFile, ReportsTomlSyntaxErrorWithLineAndColumn) {
 TEST_F(SceneFile, RejectsUnknownKey) {
   const std::string text = object_floor + "recever = true\n" + light_panel;
   expect_error(text, "recever", "object 'floor'", "unknown key 'recever'");
-  EXPECT_NE(error_of(text).find("(known: name, mesh, receiver, blocker, uv, translate, "
+  EXPECT_NE(error_of(text).find("(known: name, mesh, receiver, blocker, uv, allow_uncovered, "
+                                "translate, "
                                 "rotate_deg, scale)"),
             std::string::npos);
 }
