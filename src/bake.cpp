@@ -148,7 +148,7 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
 
   // A light that reaches no receiver texel (facing away, or below every texel's horizon) is
   // most often a normal pointing the wrong way: say so.
-  for (std::size_t l = 0; l < lights.size(); ++l) {
+  for (std::size_t l = 0; l < lights.size() && total_texels > 0; ++l) {
     bool reached = false;
     for (std::size_t r = 0; r < spaces.size() && !reached; ++r)
       for (const Texel& t : spaces[r].texels)
