@@ -385,7 +385,9 @@ void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const Leaf
   const auto start = Clock::now();
   // How much of the slab's geometry lies in front of a texel, with half a texel of tolerance so
   // that a blocker standing on the receiver shadows the texels beside its foot.
-  const auto [lo, hi] = part_interval(leaf.cuts);
+  // Plain variables, not a structured binding: clang 14 (the fuzz build) cannot capture one.
+  const std::pair<double, double> interval = part_interval(leaf.cuts);
+  const double lo = interval.first, hi = interval.second;
   const double g_lo = leaf.blocker_depths.lo, g_hi = leaf.blocker_depths.hi;
   const double bias = 0.5 * plan.texel;
   // The footprint's texels, each with the window it reads (windows' boxes are disjoint).

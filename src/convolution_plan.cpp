@@ -184,7 +184,9 @@ void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& 
   t.footprint_texels = 0;
   t.polygons = 0;
   t.blockers = ProjectedBlockers{};
-  const auto [part_lo, part_hi] = part_interval(t.cuts);
+  // Plain variables, not a structured binding: clang 14 (the fuzz build) cannot capture one.
+  const std::pair<double, double> part = part_interval(t.cuts);
+  const double part_lo = part.first, part_hi = part.second;
   if (t.faces.empty() || group.empty()) return;
   const double part_depth_hi = std::min(part_hi, fr.depth[group.back()]);
 

@@ -216,7 +216,11 @@ Status check_ply_bytes(std::string_view bytes, std::uint64_t file_bytes) {
                                    line_number));
       }
       elements.push_back({std::string(t[1]), std::uint64_t(count), 0, line_number});
-    } else if (t[0] == "property" && !elements.empty()) {
+    } else if (t[0] == "property") {
+      if (elements.empty()) {
+        return problem(
+            fmt::format("PLY header line {}: a property before any element", line_number));
+      }
       // Smallest encoding of one value of this property.
       const auto size_of = [](std::string_view type) -> std::uint64_t {
         if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
@@ -225,13 +229,22 @@ Status check_ply_bytes(std::string_view bytes, std::uint64_t file_bytes) {
         return 4;
       };
       const bool list = t.size() >= 2 && t[1] == "list";
-      std::uint64_t bytes_per_value = ascii ? 2 : size_of(t.size() >= 2 ? t[list ? 2 : 1] : "");
+      const std::uint64_t bytes_per_value =
+          ascii ? 2 : size_of(t.size() >= 2 ? t[list ? 2 : 1] : "");
       elements.back().min_bytes += bytes_per_value;  // a list holds at least its count
+    } else if (t[0] != "ply" && t[0] != "comment" && t[0] != "obj_info" && t[0] != "end_header") {
+      return problem(
+          fmt::format("PLY header line {}: unknown keyword {}", line_number, shown(t[0])));
     }
   }
   const std::uint64_t body = file_bytes > header.size() ? file_bytes - header.size() : 0;
   std::uint64_t needed = 0;
   for (const Element& e : elements) {
+    // Each element still costs the reader a step, and in ASCII at least its line's end.
+    if (e.count > 0 && e.min_bytes == 0) {
+      return problem(fmt::format("PLY header line {} declares {} '{}' element(s) with no property",
+                                 e.line, e.count, e.name));
+    }
     const std::uint64_t element_bytes = saturating_multiply(e.count, e.min_bytes);
     needed = saturating_add(needed, element_bytes);
     if (needed > body) {
