@@ -113,6 +113,9 @@ struct Case {
   int code = 0;
 };
 
+// gtest prints a parameter in test lists and failures: its name, not its bytes.
+void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
+
 std::vector<Case> corpus_cases() {
   std::vector<Case> cases;
   std::ifstream in(kCorpus / "cases.json");

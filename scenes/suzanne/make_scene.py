@@ -13,6 +13,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(sys.argv[sys.arg
 import blender_assets as ba  # noqa: E402
 import bpy  # noqa: E402
 
+ba.run_single_threaded()
 here = ba.script_folder()
 ba.reset()
 

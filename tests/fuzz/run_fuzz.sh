@@ -31,6 +31,6 @@ PY
 cd "$build"
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:allocator_may_return_null=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
-export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$here/tests/tools/lsan.supp}
+export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$here/tests/tools/lsan.supp:print_suppressions=0}
 ./shadowbake_fuzz_scene -max_total_time="$seconds" -rss_limit_mb=4096 -malloc_limit_mb=2048 \
   -timeout=20 -print_final_stats=1 "$corpus"
