@@ -32,14 +32,16 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }
 
 // Every object's mesh, in scene order; skipped degenerate triangles become warnings. A mesh file
-// may be a quarter of the memory budget: Assimp's scene and the working mesh take several times
-// its size.
+// may be a quarter of the memory budget, and its reader may use half of it: Assimp's scene and
+// the working mesh take several times the file's size.
 Expected<std::vector<Mesh>> load_meshes(const Scene& scene, std::vector<std::string>* warnings) {
   std::vector<Mesh> meshes;
   meshes.reserve(scene.objects.size());
-  const std::uint64_t max_file_bytes = memory_budget(scene.bake) / 4;
+  ImportLimits limits;
+  limits.max_file_bytes = memory_budget(scene.bake) / 4;
+  limits.max_memory = memory_budget(scene.bake) / 2;
   for (const auto& obj : scene.objects) {
-    auto mesh = import_mesh(obj, scene.file, max_file_bytes);
+    auto mesh = import_mesh(obj, scene.file, limits);
     if (!mesh) return mesh.error();
     if (mesh->skipped_degenerate > 0 && warnings) {
       warnings->push_back(scene.file.string() + ":" + std::to_string(obj.line) + ": object '" +

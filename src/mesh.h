@@ -36,10 +36,15 @@ struct Mesh {
 // transforms and then obj.transform, takes UVs from obj.uv_channel, drops zero-area triangles
 // (counted in skipped_degenerate). Errors name scene_file, the object and the problem: an
 // unreadable file, no triangles, NaN/infinite vertices, or a receiver without the UV channel.
-// Mesh files larger than max_file_bytes are refused before they are read.
-inline constexpr std::uint64_t kDefaultMaxMeshFileBytes = std::uint64_t(1) << 32;
+// What a mesh file may cost: its size, and the memory and time its reader may take
+// (mesh_reader.h).
+struct ImportLimits {
+  std::uint64_t max_file_bytes = std::uint64_t(1) << 32;  // refused before it is read
+  std::uint64_t max_memory = std::uint64_t(4) << 30;      // Assimp's allocations
+  double max_seconds = 0;  // Assimp's time; 0: 60 s plus 10 s per MB of file
+};
 Expected<Mesh> import_mesh(const ObjectDesc& obj, const std::filesystem::path& scene_file,
-                           std::uint64_t max_file_bytes = kDefaultMaxMeshFileBytes);
+                           const ImportLimits& limits = {});
 
 // World-space triangle of face f, as three points.
 struct Triangle {

@@ -14,7 +14,9 @@
 //   normal and every UV channel are bitwise equal (weld_vertices), so OpenMesh sees the shared
 //   vertices and connectivity of each chart and no seam of any channel is lost.
 // - Before Assimp reads a file, check_mesh_file (mesh_file_checks.h) refuses files it would
-//   misread or exhaust memory on; Assimp's own warnings that it dropped faces are errors here.
+//   misread or exhaust memory on; Assimp then reads it in a child process (mesh_reader.h), so a
+//   crash, a hang or a runaway allocation inside Assimp is an error too; Assimp's own warnings
+//   that it dropped faces are errors here.
 // - obj.transform is applied here, in double precision: points by the affine map, normals by the
 //   inverse transpose of its linear part. A mirroring transform (negative determinant) reverses
 //   every triangle's winding so that the winding-derived face normals keep agreeing with the
@@ -25,18 +27,12 @@
 //   no triangle, hence no blocker or receiver surface, is ever lost.
 // - Bad input (unreadable file, no triangles, non-finite positions, only degenerate triangles, a
 //   receiver without its UV channel) is an Error, never a crash or an exception.
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
-#include <assimp/DefaultLogger.hpp>
-#include <assimp/Importer.hpp>
-#include <assimp/LogStream.hpp>
-
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <exception>
 #include <filesystem>
-#include <mutex>
 #include <sstream>
 #include <string>
 #include <system_error>
@@ -46,6 +42,7 @@
 
 #include "mesh.h"
 #include "mesh_file_checks.h"
+#include "mesh_reader.h"
 
 namespace sb {
 namespace {
@@ -73,27 +70,8 @@ class ErrorPrefix {
 };
 
 // Assimp reports what it dropped from a broken file only as a log warning ("Some faces had
-// out-of-range indices. Those faces were dropped." in its glTF 2 reader). Its logger is one global
-// object; the import holds kImportMutex while the stream below collects warnings and errors.
-class CapturedLog : public Assimp::LogStream {
- public:
-  void write(const char* message) override { messages.emplace_back(message ? message : ""); }
-  std::vector<std::string> messages;
-};
-
-std::mutex kImportMutex;
-
-CapturedLog& assimp_log() {
-  static CapturedLog* log = [] {
-    Assimp::DefaultLogger::create("", Assimp::Logger::NORMAL, 0);
-    auto* stream = new CapturedLog;  // owned by the logger from here on
-    Assimp::DefaultLogger::get()->attachStream(stream, Assimp::Logger::Warn | Assimp::Logger::Err);
-    return stream;
-  }();
-  return *log;
-}
-
-// The first captured message that says part of the file was dropped, or "".
+// out-of-range indices. Those faces were dropped." in its glTF 2 reader): the first such message
+// of the reader's, or "".
 std::string dropped_data_message(const std::vector<std::string>& messages) {
   for (const std::string& m : messages) {
     if (m.find("dropped") != std::string::npos || m.find("out-of-range") != std::string::npos ||
@@ -168,11 +146,11 @@ void add_triangle(TriMesh& mesh, TriMesh::VertexHandle a, TriMesh::VertexHandle 
 // that has the same position, normal and UVs in every channel, bit for bit: the welded vertex it
 // becomes. Bitwise, because "identical" is what a weld may merge without changing any attribute;
 // +0 and -0 stay apart, which only keeps a seam.
-std::vector<std::size_t> weld_vertices(const aiScene& scene) {
-  // Up to 3 + 3 + 3 * AI_MAX_NUMBER_OF_TEXTURECOORDS floats, and which of them are present.
+std::vector<std::size_t> weld_vertices(const RawMeshFile& file) {
+  // Up to 3 + 3 + 3 * kMaxUvChannels floats, and which of them are present.
   struct Key {
     std::uint32_t present = 0;
-    std::uint32_t bits[6 + 3 * AI_MAX_NUMBER_OF_TEXTURECOORDS] = {};
+    std::uint32_t bits[6 + 3 * kMaxUvChannels] = {};
     bool operator==(const Key& o) const {
       return present == o.present && std::memcmp(bits, o.bits, sizeof bits) == 0;
     }
@@ -184,30 +162,24 @@ std::vector<std::size_t> weld_vertices(const aiScene& scene) {
       return std::size_t(h);
     }
   };
-  const auto put = [](std::uint32_t* out, const aiVector3D& v) {
-    std::memcpy(out + 0, &v.x, 4);
-    std::memcpy(out + 1, &v.y, 4);
-    std::memcpy(out + 2, &v.z, 4);
-  };
   std::size_t total = 0;
-  for (unsigned m = 0; m < scene.mNumMeshes; ++m) total += scene.mMeshes[m]->mNumVertices;
+  for (const RawMeshPart& part : file.parts) total += part.vertex_count();
   std::vector<std::size_t> representative(total);
   std::unordered_map<Key, std::size_t, KeyHash> first;
   first.reserve(total);
   std::size_t index = 0;
-  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
-    const aiMesh* am = scene.mMeshes[m];
-    for (unsigned i = 0; i < am->mNumVertices; ++i, ++index) {
+  for (const RawMeshPart& part : file.parts) {
+    for (std::size_t i = 0; i < part.vertex_count(); ++i, ++index) {
       Key key;
-      put(key.bits, am->mVertices[i]);
-      if (am->HasNormals()) {
+      std::memcpy(key.bits, &part.positions[3 * i], 12);
+      if (!part.normals.empty()) {
         key.present |= 1;
-        put(key.bits + 3, am->mNormals[i]);
+        std::memcpy(key.bits + 3, &part.normals[3 * i], 12);
       }
-      for (unsigned c = 0; c < AI_MAX_NUMBER_OF_TEXTURECOORDS; ++c) {
-        if (!am->HasTextureCoords(c)) continue;
+      for (int c = 0; c < kMaxUvChannels; ++c) {
+        if (part.uvs[std::size_t(c)].empty()) continue;
         key.present |= 2u << c;
-        put(key.bits + 6 + 3 * c, am->mTextureCoords[c][i]);
+        std::memcpy(key.bits + 6 + 3 * c, &part.uvs[std::size_t(c)][3 * i], 12);
       }
       representative[index] = first.try_emplace(key, index).first->second;
     }
@@ -215,50 +187,43 @@ std::vector<std::size_t> weld_vertices(const aiScene& scene) {
   return representative;
 }
 
-Expected<Mesh> build_mesh(const aiScene& scene, const ObjectDesc& obj, const std::string& path,
+Expected<Mesh> build_mesh(const RawMeshFile& file, const ObjectDesc& obj, const std::string& path,
                           const ErrorPrefix& error) {
   Mesh result;
   result.name = obj.name;
 
   std::size_t triangle_count = 0;
-  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
-    const aiMesh* am = scene.mMeshes[m];
-    for (unsigned f = 0; f < am->mNumFaces; ++f) {
-      if (am->mFaces[f].mNumIndices == 3) ++triangle_count;
-    }
-  }
+  for (const RawMeshPart& part : file.parts) triangle_count += part.triangles.size() / 3;
   if (triangle_count == 0) {
     return error("'" + path + "' has no triangles (an object needs a surface)");
   }
 
-  // UV channel: every Assimp mesh must carry it for the object to have lightmap UVs.
-  const bool channel_in_range =
-      obj.uv_channel >= 0 && obj.uv_channel < static_cast<int>(AI_MAX_NUMBER_OF_TEXTURECOORDS);
+  // UV channel: every part must carry it for the object to have lightmap UVs.
+  const bool channel_in_range = obj.uv_channel >= 0 && obj.uv_channel < kMaxUvChannels;
   result.has_uv = channel_in_range;
-  const aiMesh* mesh_without_uv = nullptr;
-  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
-    const aiMesh* am = scene.mMeshes[m];
-    if (!channel_in_range || !am->HasTextureCoords(static_cast<unsigned>(obj.uv_channel))) {
+  const RawMeshPart* part_without_uv = nullptr;
+  for (const RawMeshPart& part : file.parts) {
+    if (!channel_in_range || part.uvs[std::size_t(obj.uv_channel)].empty()) {
       result.has_uv = false;
-      if (!mesh_without_uv) mesh_without_uv = am;
+      if (!part_without_uv) part_without_uv = &part;
     }
   }
 
-  // Vertices in world space, all meshes concatenated. UVs are copied only when every mesh has
+  // Vertices in world space, all parts concatenated. UVs are copied only when every part has
   // the channel, so has_uv says what the texcoords hold.
   const Mat3 linear = obj.transform.linear();
   const Mat3 normal_matrix = linear.inverse().transpose();
   const bool mirrors = linear.determinant() < 0;
   std::vector<ImportedVertex> vertices;
-  std::vector<std::size_t> first_vertex(scene.mNumMeshes);
+  std::vector<std::size_t> first_vertex(file.parts.size());
   bool uvs_finite = true;
-  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
-    const aiMesh* am = scene.mMeshes[m];
+  for (std::size_t m = 0; m < file.parts.size(); ++m) {
+    const RawMeshPart& part = file.parts[m];
     first_vertex[m] = vertices.size();
-    for (unsigned i = 0; i < am->mNumVertices; ++i) {
+    for (std::size_t i = 0; i < part.vertex_count(); ++i) {
       ImportedVertex v;
-      const aiVector3D& p = am->mVertices[i];
-      const Vec3 file_position(p.x, p.y, p.z);
+      const float* p = &part.positions[3 * i];
+      const Vec3 file_position(p[0], p[1], p[2]);
       if (!file_position.allFinite()) {
         return error("'" + path + "': vertex " + std::to_string(vertices.size()) +
                      " (as Assimp numbers them) has a non-finite position " +
@@ -266,15 +231,15 @@ Expected<Mesh> build_mesh(const aiScene& scene, const ObjectDesc& obj, const std
       }
       v.position = obj.transform * file_position;
       v.normal = Vec3::Zero();
-      if (am->HasNormals()) {
-        const aiVector3D& n = am->mNormals[i];
-        const Vec3 world_normal = normal_matrix * Vec3(n.x, n.y, n.z);
+      if (!part.normals.empty()) {
+        const float* n = &part.normals[3 * i];
+        const Vec3 world_normal = normal_matrix * Vec3(n[0], n[1], n[2]);
         const double length = world_normal.norm();
         if (std::isfinite(length) && length > 0) v.normal = world_normal / length;
       }
       if (result.has_uv) {
-        const aiVector3D& t = am->mTextureCoords[obj.uv_channel][i];
-        v.uv = Vec2(t.x, t.y);
+        const float* t = &part.uvs[std::size_t(obj.uv_channel)][3 * i];
+        v.uv = Vec2(t[0], t[1]);
         if (!v.uv.allFinite()) {
           if (obj.receiver) {
             return error("'" + path + "': vertex " + std::to_string(vertices.size()) +
@@ -292,7 +257,7 @@ Expected<Mesh> build_mesh(const aiScene& scene, const ObjectDesc& obj, const std
     for (ImportedVertex& v : vertices) v.uv = Vec2::Zero();
   }
   if (obj.receiver && !result.has_uv) {
-    const unsigned channels = mesh_without_uv ? mesh_without_uv->GetNumUVChannels() : 0;
+    const int channels = part_without_uv ? part_without_uv->uv_channel_count() : 0;
     const std::string channel = std::to_string(obj.uv_channel);
     return error("a receiver needs lightmap UVs in channel " + channel + " (uv = " + channel +
                  ") but '" + path + "' has " +
@@ -303,21 +268,14 @@ Expected<Mesh> build_mesh(const aiScene& scene, const ObjectDesc& obj, const std
 
   // Degenerate threshold relative to the object's size, from the vertices faces use.
   Bounds3 bounds;
-  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
-    const aiMesh* am = scene.mMeshes[m];
-    for (unsigned f = 0; f < am->mNumFaces; ++f) {
-      const aiFace& face = am->mFaces[f];
-      if (face.mNumIndices != 3) continue;
-      for (unsigned k = 0; k < 3; ++k) {
-        bounds.extend(vertices[first_vertex[m] + face.mIndices[k]].position);
-      }
-    }
-  }
+  for (std::size_t m = 0; m < file.parts.size(); ++m)
+    for (const std::uint32_t index : file.parts[m].triangles)
+      bounds.extend(vertices[first_vertex[m] + index].position);
   const double diagonal = bounds.diagonal();
   const double min_area = kDegenerateAreaFraction * diagonal * diagonal;
 
   TriMesh& mesh = result.mesh;
-  const std::vector<std::size_t> welded = weld_vertices(scene);
+  const std::vector<std::size_t> welded = weld_vertices(file);
   std::vector<TriMesh::VertexHandle> handle(vertices.size());  // made on first use
   auto vertex = [&](std::size_t index) {
     if (!handle[index].is_valid()) {
@@ -329,13 +287,12 @@ Expected<Mesh> build_mesh(const aiScene& scene, const ObjectDesc& obj, const std
     }
     return handle[index];
   };
-  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
-    const aiMesh* am = scene.mMeshes[m];
-    for (unsigned f = 0; f < am->mNumFaces; ++f) {
-      const aiFace& face = am->mFaces[f];
-      if (face.mNumIndices != 3) continue;  // points and lines have no surface
+  for (std::size_t m = 0; m < file.parts.size(); ++m) {
+    const std::vector<std::uint32_t>& triangles = file.parts[m].triangles;
+    for (std::size_t f = 0; f + 2 < triangles.size(); f += 3) {
       std::size_t index[3];
-      for (int k = 0; k < 3; ++k) index[k] = welded[first_vertex[m] + face.mIndices[k]];
+      for (int k = 0; k < 3; ++k)
+        index[k] = welded[first_vertex[m] + triangles[f + std::size_t(k)]];
       if (mirrors) std::swap(index[1], index[2]);
       const Vec3& a = vertices[index[0]].position;
       const Vec3& b = vertices[index[1]].position;
@@ -373,34 +330,27 @@ Expected<Mesh> build_mesh(const aiScene& scene, const ObjectDesc& obj, const std
 }  // namespace
 
 Expected<Mesh> import_mesh(const ObjectDesc& obj, const std::filesystem::path& scene_file,
-                           std::uint64_t max_file_bytes) {
+                           const ImportLimits& import_limits) {
   const ErrorPrefix error(obj, scene_file);
   const std::filesystem::path file = mesh_path(obj, scene_file);
   const std::string path = file.string();
   try {
-    if (Status checked = check_mesh_file(file, max_file_bytes); !checked) {
+    if (Status checked = check_mesh_file(file, import_limits.max_file_bytes); !checked) {
       return error("cannot read mesh '" + path + "': " + checked.error().message);
     }
-    const std::lock_guard lock(kImportMutex);
-    CapturedLog& log = assimp_log();
-    log.messages.clear();
-    Assimp::Importer importer;
-    const unsigned flags = aiProcess_Triangulate | aiProcess_PreTransformVertices |
-                           aiProcess_GenSmoothNormals | aiProcess_ValidateDataStructure;
-    const aiScene* scene = importer.ReadFile(path, flags);
-    const std::vector<std::string> messages = std::move(log.messages);
-    log.messages.clear();
-    if (!scene) {
-      return error("cannot read mesh '" + path + "': " + one_line(importer.GetErrorString()));
-    }
-    if (const std::string dropped = dropped_data_message(messages); !dropped.empty()) {
+    MeshReadLimits limits;
+    limits.max_memory = import_limits.max_memory;
+    std::error_code ec;
+    limits.max_seconds = import_limits.max_seconds > 0
+                             ? import_limits.max_seconds
+                             : 60 + 10 * double(std::filesystem::file_size(file, ec)) / 1e6;
+    auto raw = read_mesh_file(file, limits);
+    if (!raw) return error("cannot read mesh '" + path + "': " + raw.error().message);
+    if (const std::string dropped = dropped_data_message(raw->warnings); !dropped.empty()) {
       return error("'" + path + "' is broken: Assimp says \"" + assimp_message(dropped) +
                    "\"; fix or re-export the mesh file");
     }
-    if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || scene->mNumMeshes == 0) {
-      return error("'" + path + "' has no triangles (an object needs a surface)");
-    }
-    return build_mesh(*scene, obj, path, error);
+    return build_mesh(*raw, obj, path, error);
   } catch (const std::exception& e) {
     return error("cannot import mesh '" + path + "': " + one_line(e.what()));
   }

@@ -29,7 +29,7 @@ for scene in list(root.glob("scenes/*/scene.toml")) + list(root.glob("tests/bad_
         (out / hashlib.sha1(seed).hexdigest()).write_bytes(seed)
 PY
 cd "$build"
-export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:allocator_may_return_null=1}
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:allocator_may_return_null=1:max_allocation_size_mb=2048}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$here/tests/tools/lsan.supp:print_suppressions=0}
 ./shadowbake_fuzz_scene -max_total_time="$seconds" -rss_limit_mb=4096 -malloc_limit_mb=2048 \
