@@ -315,6 +315,12 @@ LeafImages convolve_leaf(const ConvolutionPlan& plan, const Triple& leaf, Blocke
   auto& fft = FftConvolver::shared();
   const int channels = kernel.grey ? 1 : 3;
   weighted = weighted && !kernel.moments[0].empty();
+  // A kernel wider than the window's transform (a light close to the blockers' depth, seen
+  // through a small window) must still fit in it: its pixels wrap around the transform.
+  for (LeafWindow& win : out.windows) {
+    win.tw = std::max(win.tw, FftConvolver::transform_size(kernel.width));
+    win.th = std::max(win.th, FftConvolver::transform_size(kernel.height));
+  }
   for (LeafWindow& win : out.windows) {
     start = Clock::now();
     std::vector<float> coverage, full;

@@ -5,6 +5,7 @@
 
 #include <cassert>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <variant>
@@ -68,5 +69,16 @@ class Expected {
 // For functions that return nothing but may fail.
 struct Ok {};
 using Status = Expected<Ok>;
+
+// An invariant whose violation would corrupt memory (an index past a buffer, a transform smaller
+// than its kernel) is checked in every build, not only where assert is compiled in: a violation
+// throws std::logic_error, which the CLI reports as an internal error (exit code 1) instead of
+// writing past an array.
+[[noreturn]] inline void invariant_failed(const char* condition, const char* file, int line) {
+  throw std::logic_error(std::string("invariant ") + condition + " failed at " + file + ":" +
+                         std::to_string(line));
+}
+#define SB_CHECK(condition) \
+  ((condition) ? void(0) : ::sb::invariant_failed(#condition, __FILE__, __LINE__))
 
 }  // namespace sb

@@ -28,6 +28,8 @@
 #include <thread>
 #include <vector>
 
+#include "error.h"
+
 namespace sb {
 namespace {
 
@@ -222,9 +224,10 @@ bool FftConvolver::threaded(int tw, int th) {
 
 std::shared_ptr<const KernelSpectrum> FftConvolver::kernel_spectrum(
     const std::vector<float>& kernel, int kw, int kh, int tw, int th) {
-  assert(kw >= 1 && kh >= 1 && kw % 2 == 1 && kh % 2 == 1);
-  assert(kernel.size() == std::size_t(kw) * std::size_t(kh));
-  assert(tw >= kw && th >= kh);
+  SB_CHECK(kw >= 1 && kh >= 1 && kw % 2 == 1 && kh % 2 == 1);
+  SB_CHECK(kernel.size() == std::size_t(kw) * std::size_t(kh));
+  // The kernel's pixels wrap around the transform: one wider than it would write before it.
+  SB_CHECK(tw >= kw && th >= kh);
   const std::uint64_t hash = hash_values(kernel);
   {
     std::lock_guard lock(impl_->spectra_mutex);
@@ -284,13 +287,13 @@ void FftConvolver::convolve(const std::vector<float>& image, int w, int h,
 void FftConvolver::convolve(const std::vector<float>& image, int w, int h,
                             std::span<const KernelSpectrum* const> kernels,
                             std::span<std::vector<float>* const> outs) {
-  assert(w >= 1 && h >= 1);
-  assert(image.size() == std::size_t(w) * std::size_t(h));
-  assert(!kernels.empty() && kernels.size() == outs.size());
+  SB_CHECK(w >= 1 && h >= 1);
+  SB_CHECK(image.size() == std::size_t(w) * std::size_t(h));
+  SB_CHECK(!kernels.empty() && kernels.size() == outs.size());
   const int tw = kernels[0]->tw, th = kernels[0]->th;
-  assert(std::all_of(kernels.begin(), kernels.end(),
-                     [&](const KernelSpectrum* k) { return k->tw == tw && k->th == th; }));
-  assert(tw >= w && th >= h);
+  SB_CHECK(std::all_of(kernels.begin(), kernels.end(),
+                       [&](const KernelSpectrum* k) { return k->tw == tw && k->th == th; }));
+  SB_CHECK(tw >= w && th >= h);
   const std::size_t row = std::size_t(tw);
   const std::size_t count = spectrum_count(tw, th);
   const Impl::Plans& plans = impl_->plans_for(tw, th);
@@ -299,7 +302,8 @@ void FftConvolver::convolve(const std::vector<float>& image, int w, int h,
   // which starts 64 bytes aligned like the arrays the plans were made for (FFTW's new-array
   // execute requires the planned alignment).
   const std::size_t offset = (count + 7) / 8 * 8;
-  Scratch& scratch = thread_scratch(row * std::size_t(th), kernels.size() > 1 ? offset + count : count);
+  Scratch& scratch =
+      thread_scratch(row * std::size_t(th), kernels.size() > 1 ? offset + count : count);
   float* padded = scratch.real.get();
   fftwf_complex* spectrum = scratch.spectrum.get();
   fftwf_complex* product = kernels.size() > 1 ? spectrum + offset : spectrum;

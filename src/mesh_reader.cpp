@@ -82,7 +82,7 @@ class Writer {
   template <class T>
   void put_array(const std::vector<T>& v) {
     put(std::uint64_t(v.size()));
-    bytes.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+    if (!v.empty()) bytes.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
   }
   std::string bytes;
 };
@@ -109,7 +109,7 @@ class Reader {
     std::uint64_t n = 0;
     if (!get(n) || n > (bytes_.size() - at_) / sizeof(T)) return false;
     v.resize(n);
-    std::memcpy(v.data(), bytes_.data() + at_, n * sizeof(T));
+    if (n > 0) std::memcpy(v.data(), bytes_.data() + at_, n * sizeof(T));
     at_ += n * sizeof(T);
     return true;
   }

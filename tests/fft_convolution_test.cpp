@@ -10,6 +10,7 @@
 #include <memory>
 #include <random>
 #include <set>
+#include <stdexcept>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -141,6 +142,22 @@ TEST(FftConvolution, UnpaddedTransformIsExactInInteriorAndWrapsAtBorder) {
       largest_wrap = std::max(largest_wrap, std::abs(out[i] - linear[i]));
     }
   EXPECT_GT(largest_wrap, 0.1f) << "the border should show the wrapped-around image";
+}
+
+// The atrium's wall sconce made a 63-pixel kernel for a 24-pixel window transform, and
+// kernel_spectrum wrote before its buffer (the index i - kw/2 + tw went negative; the assert that
+// guarded it is compiled out of release builds). The check holds in every build now.
+TEST(FftConvolution, KernelWiderThanTransformIsRefusedNotWrittenPast) {
+  FftConvolver& convolver = FftConvolver::shared();
+  const std::vector<float> kernel(63 * 9, 1.0f / (63 * 9));
+  EXPECT_THROW(convolver.kernel_spectrum(kernel, 63, 9, 24, 16), std::logic_error);
+  EXPECT_THROW(convolver.kernel_spectrum(kernel, 9, 63, 16, 24), std::logic_error);
+  // A kernel that fits is fine, and so is an image no larger than the transform.
+  const auto fits = convolver.kernel_spectrum(kernel, 63, 9, 64, 16);
+  std::vector<float> out;
+  EXPECT_NO_THROW(convolver.convolve(std::vector<float>(64 * 16, 1.0f), 64, 16, *fits, out));
+  EXPECT_THROW(convolver.convolve(std::vector<float>(65 * 16, 1.0f), 65, 16, *fits, out),
+               std::logic_error);
 }
 
 TEST(FftConvolution, IdentityKernelReturnsImage) {
