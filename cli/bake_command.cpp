@@ -65,6 +65,7 @@ struct BakeArgs {
   int threads = 0;
   bool quiet = false;
   bool explain = false;
+  bool no_trace = false;
 };
 
 // --explain: what the convolution method chose for each light and receiver, and what it cost.
@@ -121,6 +122,7 @@ int run_bake(const BakeArgs& args) {
   if (args.seed) settings.seed = *args.seed;
   if (args.error_texels) settings.error_texels = *args.error_texels;
   if (args.max_memory) settings.max_memory = *args.max_memory;
+  if (args.no_trace) settings.trace = false;
 
   // The output folder is locked and its names checked before the bake, so a bake that could not
   // publish its files fails in a second, not after its work.
@@ -211,6 +213,9 @@ Runner add_bake_command(CLI::App& app) {
   bake->add_option("--threads", o->args.threads, "worker threads (0: all cores)")
       ->check(CLI::Range(0, 1024));
   bake->add_flag("-q,--quiet", o->args.quiet, "no progress bar and no summary");
+  bake->add_flag("--no-trace", o->args.no_trace,
+                 "convolution: trace no shadow rays, even where it cannot vouch for its values "
+                 "(overrides [bake] trace)");
   bake->add_flag("--explain", o->args.explain,
                  "print, per light and receiver, the convolution's direction, planes, error "
                  "metric, image sizes and stage times");

@@ -21,7 +21,9 @@
 #include "mesh.h"
 #include "ray_scene.h"
 #include "reference_bake.h"
+#include "shaft_culling.h"
 #include "texel_space.h"
+#include "traced_convolution.h"
 
 namespace sb {
 
@@ -96,7 +98,8 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   // The methods that cast rays: the reference and accumulation for their shadows, erosion for
   // its hard shadow and blocker distances. The convolution and the shadow-map filters do not.
   const std::string& method = scene.bake.method;
-  const bool ray_traced = method == "reference" || method == "accumulation" || method == "erosion";
+  const bool ray_traced = method == "reference" || method == "accumulation" ||
+                          method == "erosion" || (method == "convolution" && scene.bake.trace);
   std::optional<RayScene> rays;
   if (ray_traced) {
     auto built = RayScene::build(blockers);
@@ -105,7 +108,11 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   }
   // The convolution's cluster hierarchy (clusters.h), over the blockers in this order.
   ClusterTree clusters;
-  if (method == "convolution") clusters = build_clusters(blockers);
+  std::optional<ShaftCuller> culler;
+  if (method == "convolution") {
+    clusters = build_clusters(blockers);
+    culler.emplace(blockers);
+  }
   auto lights_or = make_lights(scene.lights, scene.file);
   if (!lights_or) return lights_or.error();
   const std::vector<Light>& lights = *lights_or;
@@ -221,13 +228,30 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
       in.weighted = scene.bake.weighting == "irradiance";
       // What the budget leaves the leaves' images, beyond what the estimate above counted.
       in.memory_for_images = double(memory_budget(scene.bake)) - total_bytes(estimate);
+      TracedConvolutionInputs traced;
+      traced.convolution = in;
+      traced.culler = &*culler;
+      traced.rays = rays ? &*rays : nullptr;
+      traced.samples = scene.bake.samples;
+      traced.trace_error_texels = scene.bake.trace_error_texels;
+      traced.seed = scene.bake.seed;
+      traced.stream = receivers[r];
       ConvolutionPlan plan;
-      auto image = bake_convolution(spaces[r], in, &out.pairs, &plan);
+      TracedConvolutionStats stats;
+      auto image = bake_traced_convolution(spaces[r], traced, &out.pairs, &plan, &stats);
       if (!image) {
         return scene_error(scene.file.string() + ":" + std::to_string(obj.line) + ": " +
                            image.error().message);
       }
       out.image = std::move(*image);
+      result.shadow_rays += stats.rays;
+      const double pairs = std::max<double>(1.0, double(stats.pairs));
+      out.stats.emplace_back("clear_fraction", double(stats.clear) / pairs);
+      out.stats.emplace_back("convolved_fraction", double(stats.convolved) / pairs);
+      out.stats.emplace_back("traced_fraction", double(stats.traced) / pairs);
+      out.stats.emplace_back(
+          "rays_per_texel",
+          double(stats.rays) / std::max<double>(1.0, double(spaces[r].texels.size())));
       out.plan = describe_plan(plan);
       for (const auto& w : plan.warnings) result.warnings.push_back(scene.file.string() + ": " + w);
       texels_done += std::int64_t(spaces[r].texels.size());

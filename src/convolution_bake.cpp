@@ -371,8 +371,8 @@ LeafImages convolve_leaf(const ConvolutionPlan& plan, const Triple& leaf, Blocke
 // image's occlusion into `largest` (the max rule of `sum`; see the file's header).
 void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const LeafImages& images,
                      BlockerCombine combine, const std::vector<Vec2>& gradient,
-                     std::vector<Vec3f>& occlusion, std::vector<Vec3f>& largest, EulerCounts* euler,
-                     PairReport& report) {
+                     std::vector<Vec3f>& occlusion, std::vector<Vec3f>& largest,
+                     std::vector<float>& error, EulerCounts* euler, PairReport& report) {
   const PlanFrame& fr = plan.frames[leaf.frame];
   const SourceKernel& kernel = images.kernel;
   report.seconds_source += images.seconds_source;
@@ -428,6 +428,7 @@ void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const Leaf
       double wt = g_hi > g_lo ? std::clamp((depth + bias - g_lo) / (g_hi - g_lo), 0.0, 1.0) : 1.0;
       for (const ReceiverCut& c : leaf.cuts) wt *= c.weight(depth);
       if (wt <= 0) continue;
+      error[i] = std::max(error[i], float(leaf.penumbra_error_texels));
       const Bilinear at(w, h, win.grid.to_pixel(fr.tangent[i]));
       // The moments' correction is the same for every channel (grey kernels only); the whole
       // image takes it too, or the max rule would compare an irradiance-weighted share with an
@@ -468,13 +469,25 @@ void accumulate_leaf(const ConvolutionPlan& plan, const Triple& leaf, const Leaf
   report.seconds_lookup += seconds_since(start);
 }
 
+// A traced leaf's footprint texels: their value is not the convolution's to give (+infinity).
+void mark_traced(const ConvolutionPlan& plan, const Triple& leaf, std::vector<float>& error) {
+  const PlanFrame& fr = plan.frames[leaf.frame];
+  const std::pair<double, double> interval = part_interval(leaf.cuts);
+  const double g_lo = leaf.blocker_depths.lo;
+  fr.index[std::size_t(leaf.group)].for_each(leaf.footprint_lo, leaf.footprint_hi, [&](int i) {
+    const double d = fr.depth[std::size_t(i)];
+    if (d <= g_lo || d < interval.first || d > interval.second) return;
+    error[std::size_t(i)] = std::numeric_limits<float>::infinity();
+  });
+}
+
 }  // namespace
 
 double convolution_images_bytes(const ConvolutionPlan& plan) {
   // The batches of bake_convolution: leaves together up to kBatchPixels, a larger one alone.
   double largest_leaf = 0, all = 0;
   for (const Triple& tr : plan.triples) {
-    if (!tr.children.empty() || tr.empty) continue;
+    if (!tr.children.empty() || tr.empty || tr.traced) continue;
     const double pixels = double(tr.fft_width) * double(tr.fft_height);
     largest_leaf = std::max(largest_leaf, pixels);
     all += pixels;
@@ -483,7 +496,8 @@ double convolution_images_bytes(const ConvolutionPlan& plan) {
 }
 
 Expected<Image> bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
-                                 std::vector<PairReport>* reports, ConvolutionPlan* plan_out) {
+                                 std::vector<PairReport>* reports, ConvolutionPlan* plan_out,
+                                 ConvolutionVisibility* per_light) {
   const auto& lights = *in.lights;
   const std::size_t n = space.texels.size();
   auto start = Clock::now();
@@ -496,6 +510,9 @@ Expected<Image> bake_convolution(const TexelSpace& space, const ConvolutionInput
   pin.max_image = in.max_image;
   pin.max_triples = in.max_triples;
   pin.light_parts = in.light_parts;
+  pin.maybe_blocked = in.maybe_blocked;
+  pin.ray_cost_per_texel = in.ray_cost_per_texel;
+  pin.trace_error_texels = in.trace_error_texels;
   ConvolutionPlan plan = plan_convolution(space, pin);
   const double plan_seconds = seconds_since(start);
   if (const double needed = convolution_images_bytes(plan); needed > in.memory_for_images) {
@@ -518,6 +535,7 @@ Expected<Image> bake_convolution(const TexelSpace& space, const ConvolutionInput
   // Per light part and texel: V, and whether one of the part's frames reaches the texel.
   std::vector<std::vector<Vec3f>> part_visible(plan.light_parts.size());
   std::vector<std::vector<std::uint8_t>> part_reached(plan.light_parts.size());
+  std::vector<std::vector<float>> part_error(plan.light_parts.size());
   for (std::size_t f = 0; f < plan.frames.size(); ++f) {
     PlanFrame& fr = plan.frames[f];
     const LightPart& lp = plan.light_parts[fr.light_part];
@@ -531,6 +549,8 @@ Expected<Image> bake_convolution(const TexelSpace& space, const ConvolutionInput
     report.seconds_configure = f == 0 ? plan_seconds : 0;
     std::vector<Vec3f> occlusion(fr.texels.size(), Vec3f::Zero());
     std::vector<Vec3f> largest(fr.texels.size(), Vec3f::Zero());
+    // Negative until a leaf shades the texel: see ConvolutionVisibility::error_texels.
+    std::vector<float> error(fr.texels.size(), -1.0f);
     EulerCounts euler(in.combine == BlockerCombine::sum ? fr.texels.size() : 0);
     const std::vector<Vec2> gradient =
         in.weighted ? weight_gradients(fr, space, lp.part) : std::vector<Vec2>{};
@@ -539,7 +559,12 @@ Expected<Image> bake_convolution(const TexelSpace& space, const ConvolutionInput
       const Triple& tr = plan.triples[t];
       // Sections count only in the sum's Euler counts.
       if (tr.section && in.combine != BlockerCombine::sum) continue;
-      if (tr.frame == int(f) && tr.children.empty() && !tr.empty) leaves.push_back(t);
+      if (tr.frame != int(f) || !tr.children.empty() || tr.empty) continue;
+      if (tr.traced) {
+        mark_traced(plan, tr, error);
+      } else {
+        leaves.push_back(t);
+      }
     }
     // Each convex solid's leaves together, so that one count at a time is held.
     std::stable_sort(leaves.begin(), leaves.end(), [&](std::size_t a, std::size_t b) {
@@ -577,7 +602,7 @@ Expected<Image> bake_convolution(const TexelSpace& space, const ConvolutionInput
         const bool counted = tr.euler >= 0 && in.combine == BlockerCombine::sum;
         if (counted) euler.begin(tr.euler);
         accumulate_leaf(plan, tr, images[b - first], in.combine, gradient, occlusion, largest,
-                        counted ? &euler : nullptr, report);
+                        error, counted ? &euler : nullptr, report);
         images[b - first] = LeafImages{};
         tr.seconds = seconds[b - first] + seconds_since(leaf_start);
         ++report.triples;
@@ -608,10 +633,16 @@ Expected<Image> bake_convolution(const TexelSpace& space, const ConvolutionInput
     }
     auto& vis = part_visible[std::size_t(fr.light_part)];
     auto& hit = part_reached[std::size_t(fr.light_part)];
+    auto& err = part_error[std::size_t(fr.light_part)];
     if (vis.empty()) {
       vis.assign(n, Vec3f::Zero());
       hit.assign(n, 0);
+      err.assign(n, 0.0f);
     }
+    // Without a shaft test a texel no leaf reached is simply lit (0); with one, it lies in a
+    // shaft a blocker may cross, and the plan did not account for it (negative).
+    for (std::size_t i = 0; i < fr.texels.size(); ++i)
+      err[fr.texels[i]] = in.maybe_blocked ? error[i] : std::max(error[i], 0.0f);
     for (std::size_t i = 0; i < fr.texels.size(); ++i) {
       Vec3f v;
       for (int c = 0; c < 3; ++c) {
@@ -634,15 +665,27 @@ Expected<Image> bake_convolution(const TexelSpace& space, const ConvolutionInput
   // evaluated.
   std::vector<std::vector<Vec3f>> visible(lights.size());
   std::vector<std::vector<std::uint8_t>> reached(lights.size());
+  std::vector<std::vector<float>> error(lights.size());
   for (std::size_t l = 0; l < lights.size(); ++l) {
     std::vector<int> parts;
     for (std::size_t p = 0; p < plan.light_parts.size(); ++p)
       if (plan.light_parts[p].light == int(l) && !part_visible[p].empty()) parts.push_back(int(p));
-    if (parts.empty()) continue;
+    const std::vector<std::uint8_t>* maybe = in.maybe_blocked ? &(*in.maybe_blocked)[l] : nullptr;
+    if (parts.empty() && !maybe) continue;
     visible[l].assign(n, Vec3f::Zero());
     reached[l].assign(n, 0);
+    error[l].assign(n, 0.0f);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& r) {
       for (std::size_t t = r.begin(); t != r.end(); ++t) {
+        if (maybe && !(*maybe)[t]) {
+          // Nothing lies between the texel and the light (ShaftCuller): all of it is seen.
+          const Texel& tx = space.texels[t];
+          if (lights[l].reaches(tx.position.cast<double>(), tx.normal.cast<double>())) {
+            visible[l][t] = Vec3f::Ones();
+            reached[l][t] = 1;
+          }
+          continue;
+        }
         const Vec3f* first = nullptr;
         bool same = true;
         for (int p : parts) {
@@ -650,6 +693,9 @@ Expected<Image> bake_convolution(const TexelSpace& space, const ConvolutionInput
           const Vec3f& v = part_visible[std::size_t(p)][t];
           if (!first) first = &v;
           same = same && (v - *first).cwiseAbs().maxCoeff() <= 1e-6f;
+          const float e = part_error[std::size_t(p)][t];
+          error[l][t] =
+              (e < 0 || error[l][t] < 0) ? std::min(e, error[l][t]) : std::max(e, error[l][t]);
         }
         if (!first) continue;
         reached[l][t] = 1;
@@ -709,6 +755,12 @@ Expected<Image> bake_convolution(const TexelSpace& space, const ConvolutionInput
       }
     }
   });
+  if (per_light) {
+    per_light->visible = std::move(visible);
+    per_light->reached = std::move(reached);
+    per_light->error_texels = std::move(error);
+    per_light->buried = buried;
+  }
   if (plan_out) *plan_out = std::move(plan);
   return out;
 }

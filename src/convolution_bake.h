@@ -35,9 +35,31 @@ struct ConvolutionInputs {
   // than on one grid spanning them all: the same values for a fraction of the pixels
   // (convolution_bake.cpp, leaf_windows). Off only to measure what it saves.
   bool island_windows = true;
+  // Per light and texel: where a blocker may lie between them (ShaftCuller); only those texels
+  // are convolved for that light, the others see all of it. Null: every texel.
+  const std::vector<std::vector<std::uint8_t>>* maybe_blocked = nullptr;
+  // When the caller traces what the convolution cannot vouch for (traced_convolution.h): the cost
+  // of tracing a texel and the ε above which it does (PlanInputs). Traced leaves are not
+  // convolved; their texels' error is +infinity in ConvolutionVisibility.
+  double ray_cost_per_texel = 0;
+  double trace_error_texels = -1;
   // Bytes the leaves' images may take at once (what the bake's budget leaves them,
   // memory_budget.h); a plan that needs more is refused before anything is convolved.
   double memory_for_images = 1e18;
+};
+
+// Each light's own visibility at the receiver's texels, before lights are combined, and how far
+// the convolution can vouch for it: what a caller needs to replace some texels' values (by
+// shadow rays) before mixing the lights itself.
+struct ConvolutionVisibility {
+  // Per light (scene order), per texel: V (RGB), whether the light reaches the texel, and the
+  // worst penumbra error ε (receiver texels, as the plan counts it) of the leaves that shade it:
+  // 0 where no leaf does (nothing in the way that the plan saw), negative where the texel lies
+  // in a frame the plan convolved but no leaf reached although a blocker may lie in its shaft.
+  std::vector<std::vector<Vec3f>> visible;
+  std::vector<std::vector<std::uint8_t>> reached;
+  std::vector<std::vector<float>> error_texels;
+  std::vector<std::uint8_t> buried;  // per texel: inside a convex closed blocker (no light)
 };
 
 // The most memory the leaves' images of `plan` take at once, bytes: leaves are convolved a batch
@@ -50,6 +72,7 @@ double convolution_images_bytes(const ConvolutionPlan& plan);
 // measured seconds, in *plan (either may be null). The error: the plan needs more memory than
 // in.memory_for_images.
 Expected<Image> bake_convolution(const TexelSpace& texels, const ConvolutionInputs& in,
-                                 std::vector<PairReport>* reports, ConvolutionPlan* plan = nullptr);
+                                 std::vector<PairReport>* reports, ConvolutionPlan* plan = nullptr,
+                                 ConvolutionVisibility* per_light = nullptr);
 
 }  // namespace sb

@@ -68,13 +68,15 @@ std::vector<int> ConvolutionPlan::leaves() const {
 
 double ConvolutionPlan::worst_error_texels() const {
   double worst = 0;
-  for (int i : leaves()) worst = std::max(worst, triples[i].penumbra_error_texels);
+  for (int i : leaves())
+    if (!triples[i].traced) worst = std::max(worst, triples[i].penumbra_error_texels);
   return worst;
 }
 
 double ConvolutionPlan::estimated_cost() const {
   double cost = 0;
-  for (int i : leaves()) cost += triples[i].cost;
+  for (int i : leaves())
+    if (!triples[i].traced) cost += triples[i].cost;
   return cost;
 }
 
@@ -289,6 +291,8 @@ void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& 
   const double n = double(t.fft_width) * t.fft_height;
   t.cost = n * std::log2(std::max(2.0, n)) * (light.textured() ? 3 : 1) +
            30.0 * double(t.footprint_texels) + 20.0 * double(t.faces.size());
+  t.traced =
+      in.ray_cost_per_texel > 0 && t.cost > in.ray_cost_per_texel * double(t.footprint_texels);
 }
 
 Triple child_triple(const Triple& parent, const char* split) {
@@ -362,8 +366,9 @@ class Planner {
   }
 
  private:
+  // Above the target and worth refining: a leaf that will be traced is not.
   bool over(int t) const {
-    return !plan_.triples[t].empty &&
+    return !plan_.triples[t].empty && !plan_.triples[t].traced &&
            plan_.triples[t].penumbra_error_texels > in_.error_texels * (1 + 1e-9);
   }
 
@@ -425,8 +430,9 @@ class Planner {
           const FaceRef& f = t.faces[std::size_t(polys[i].source)];
           const auto m = std::find(in_.blockers.begin(), in_.blockers.end(), f.mesh);
           if (m == in_.blockers.end()) continue;
-          const int c = in_.clusters->face_component[std::size_t(m - in_.blockers.begin())]
-                                                    [std::size_t(f.face)];
+          const int c =
+              in_.clusters
+                  ->face_component[std::size_t(m - in_.blockers.begin())][std::size_t(f.face)];
           const auto [it, added] = index.emplace(std::pair(f.mesh, c), int(count.size()));
           if (added) {
             count.push_back(0);
@@ -455,7 +461,8 @@ class Planner {
         std::vector<std::uint8_t> first(parts.size(), 0);
         for (auto it = parts.begin(); it != middle; ++it) first[std::size_t(*it)] = 1;
         std::vector<int> near_side, far_side;
-        for (int p : all) (first[std::size_t(part[std::size_t(p)])] ? near_side : far_side).push_back(p);
+        for (int p : all)
+          (first[std::size_t(part[std::size_t(p)])] ? near_side : far_side).push_back(p);
         add(near_side, far_side);
       }
       if (hi[axis] > lo[axis]) {
@@ -478,9 +485,8 @@ class Planner {
       out.push_back(pair(std::move(a), std::move(b)));
     }
     // The candidates' children are independent of one another: evaluated on all threads.
-    tbb::parallel_for(std::size_t(0), 2 * out.size(), [&](std::size_t k) {
-      evaluate_triple(plan_, in_, out[k / 2][k % 2]);
-    });
+    tbb::parallel_for(std::size_t(0), 2 * out.size(),
+                      [&](std::size_t k) { evaluate_triple(plan_, in_, out[k / 2][k % 2]); });
     return out;
   }
 
@@ -497,9 +503,7 @@ class Planner {
 
 }  // namespace
 
-
 namespace {
-
 
 // Appends `from` (planned for the same receiver) to `to`, renumbering its indices.
 void merge_plan(ConvolutionPlan& to, ConvolutionPlan&& from) {
@@ -550,8 +554,8 @@ ConvolutionPlan plan_light_part(const ConvolutionPlan& base, const PlanInputs& i
 
 // The part's two halves along its longer side, planned at once on their own threads with half
 // the budget each, merged into one plan.
-ConvolutionPlan plan_halves(const ConvolutionPlan& base, const PlanInputs& in, const LightPart& part,
-                            int budget, int level) {
+ConvolutionPlan plan_halves(const ConvolutionPlan& base, const PlanInputs& in,
+                            const LightPart& part, int budget, int level) {
   const LightDesc& d = part.part.desc();
   std::array<ConvolutionPlan, 2> half_plans;
   tbb::parallel_for(0, 2, [&](int side) {
@@ -565,7 +569,8 @@ ConvolutionPlan plan_halves(const ConvolutionPlan& base, const PlanInputs& in, c
       h.position = d.position + sign * h.height * part.part.up();
     }
     h.power = 0.5 * d.power;
-    LightPart half{part.light, part.name + "." + std::to_string(side), Light(h), 0.5 * part.fraction};
+    LightPart half{part.light, part.name + "." + std::to_string(side), Light(h),
+                   0.5 * part.fraction};
     half_plans[std::size_t(side)] =
         plan_light_part(base, in, std::move(half), std::max(1, budget / 2), level + 1);
   });
@@ -614,8 +619,15 @@ ConvolutionPlan plan_convolution(const TexelSpace& space, const PlanInputs& in) 
     LightPart whole{int(l), light.desc().name, light, 1.0};
     merge_plan(plan, plan_light_part(plan, in, std::move(whole), in.max_triples, 0));
   }
+  // Leaves the budget left above the tracing threshold are traced rather than convolved: their
+  // values would be replaced anyway.
+  if (in.ray_cost_per_texel > 0 && in.trace_error_texels >= 0) {
+    for (Triple& t : plan.triples)
+      if (t.children.empty() && !t.empty && t.penumbra_error_texels > in.trace_error_texels)
+        t.traced = true;
+  }
   for (const Triple& t : plan.triples) {
-    if (t.children.empty() && t.blurred) {
+    if (t.children.empty() && t.blurred && !t.traced) {
       plan.warnings.push_back("receiver '" + plan.receiver +
                               "': a convolution image reached max_image and is coarser than "
                               "its sharpest penumbra; raise max_image to keep it sharp");

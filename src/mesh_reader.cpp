@@ -17,6 +17,7 @@
 #include <assimp/LogStream.hpp>
 
 #include <chrono>
+#include <csignal>
 #include <cstring>
 #include <exception>
 #include <fstream>
@@ -254,6 +255,10 @@ Expected<RawMeshFile> read_mesh_file(const fs::path& file, const MeshReadLimits&
     return scene_error(std::string("cannot start the mesh reader: ") + std::strerror(errno));
   }
   if (pid == 0) {
+    // A crash of Assimp's ends the child with its signal, which the parent reports; handlers
+    // inherited from the parent (a sanitizer's, a fuzzer's) would report it as their own.
+    for (const int signal : {SIGSEGV, SIGBUS, SIGILL, SIGFPE, SIGABRT})
+      std::signal(signal, SIG_DFL);
 #ifndef SB_UNDER_SANITIZER
     // Heap and anonymous mappings beyond what the process already holds.
     struct rlimit data = {};

@@ -24,7 +24,8 @@ std::vector<Vec3> light_outline(const Light& light) {
   std::vector<Vec3> pts;
   const Vec3 c = light.centre();
   if (light.shape() == LightShape::rectangle) {
-    const Vec3 a = 0.5 * light.desc().width * light.right(), b = 0.5 * light.desc().height * light.up();
+    const Vec3 a = 0.5 * light.desc().width * light.right(),
+               b = 0.5 * light.desc().height * light.up();
     for (const Vec3& p : {Vec3(c + a + b), Vec3(c + a - b), Vec3(c - a + b), Vec3(c - a - b)})
       pts.push_back(p);
   } else if (light.shape() == LightShape::disk) {
@@ -41,7 +42,6 @@ std::vector<Vec3> light_outline(const Light& light) {
   }
   return pts;
 }
-
 
 // The receiver's index among the blockers, or -1.
 int own_index(const PlanInputs& in) {
@@ -170,9 +170,14 @@ void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part) {
   const LightPart& lp = plan.light_parts[light_part];
   const Light& light = lp.part;
   std::vector<std::size_t> lit;
-  for (std::size_t t = 0; t < space.texels.size(); ++t)
-    if (light.reaches(space.texels[t].position.cast<double>(), space.texels[t].normal.cast<double>()))
+  const std::vector<std::uint8_t>* maybe =
+      in.maybe_blocked ? &(*in.maybe_blocked)[std::size_t(lp.light)] : nullptr;
+  for (std::size_t t = 0; t < space.texels.size(); ++t) {
+    if (maybe && !(*maybe)[t]) continue;  // nothing between it and the light
+    if (light.reaches(space.texels[t].position.cast<double>(),
+                      space.texels[t].normal.cast<double>()))
       lit.push_back(t);
+  }
   if (lit.empty()) return;
   auto position = [&](std::size_t t) { return Vec3(space.texels[t].position.cast<double>()); };
   const std::vector<TexelGroup> groups = group_texels(space, in, lit, light);
@@ -228,7 +233,8 @@ void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part) {
           const Vec3 d = position(t) - light.centre();
           int axis;
           d.cwiseAbs().maxCoeff(&axis);
-          frames[first + 2 * std::size_t(axis) + (d[axis] < 0 ? 1 : 0)].members[r].second.push_back(t);
+          frames[first + 2 * std::size_t(axis) + (d[axis] < 0 ? 1 : 0)].members[r].second.push_back(
+              t);
         }
       }
     }
@@ -263,8 +269,7 @@ void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part) {
     f.near = std::max(1e-4, 1e-3 * deepest);
     for (std::size_t i = 0; i < f.texels.size(); ++i) {
       f.position.push_back(position(f.texels[i]));
-      f.tangent.push_back(f.depth[i] > f.near ? f.frame.tangent(f.position.back())
-                                              : Vec2::Zero());
+      f.tangent.push_back(f.depth[i] > f.near ? f.frame.tangent(f.position.back()) : Vec2::Zero());
       if (f.depth[i] <= f.near) ++f.outside_texels;
     }
     std::vector<std::vector<int>> kept;

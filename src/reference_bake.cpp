@@ -10,7 +10,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "sampling.h"
 #include "shadow_rays.h"
 
 namespace sb {
@@ -20,54 +19,46 @@ Image bake_reference(const TexelSpace& space, const ReferenceInputs& in,
   Image out(space.width, space.height, 3, 0.0f);
   const auto& lights = *in.lights;
   const RayScene& rays = *in.rays;
-  const double offset = rays.surface_offset();
   std::atomic<std::int64_t> traced{0};
 
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, space.texels.size(), 64),
-      [&](const tbb::blocked_range<std::size_t>& range) {
-        std::vector<Vec2> strata;
-        ShadowRays batch(in.samples);
-        std::int64_t local_rays = 0;
-        for (std::size_t t = range.begin(); t != range.end(); ++t) {
-          const Texel& texel = space.texels[t];
-          const Vec3 position = texel.position.cast<double>();
-          const Vec3 normal = texel.normal.cast<double>();
-          Vec3 h_sum = Vec3::Zero(), h0_sum = Vec3::Zero();
-          const Vec3 origin =
-              (texel.shadow_origin.cast<double>() + offset * texel.geometric_normal.cast<double>());
-          for (std::size_t l = 0; l < lights.size(); ++l) {
-            const Vec3 h0 = lights[l].unoccluded_irradiance(position, normal);
-            if (h0.maxCoeff() <= 0) continue;
-            Rng rng(stream_seed(in.seed, (in.stream << 32) ^ l,
-                                std::uint64_t(texel.y) * space.width + texel.x));
-            stratified_samples(in.samples, rng, strata);
-            batch.clear();
-            for (int s = 0; s < in.samples; ++s)
-              batch.add(origin, lights[l].sample(position, normal, strata[s]), offset);
-            Vec3 v;
-            if (!batch.visible_fraction(rays, &v)) continue;
-            local_rays += batch.size();
-            h_sum += h0.cwiseProduct(v);
-            h0_sum += h0;
-          }
-          float* px = out.at(texel.x, texel.y);
-          for (int c = 0; c < 3; ++c) {
-            double v = 0;
-            if (in.quantity == Quantity::irradiance) {
-              v = h_sum[c];
-            } else if (h0_sum[c] > 0) {
-              v = h_sum[c] / h0_sum[c];
-            }
-            px[c] = float(v);
-          }
-        }
-        traced += local_rays;
-        if (in.texels_done) {
-          const auto done = (*in.texels_done += std::int64_t(range.size()));
-          if (in.progress) in.progress(double(done));
-        }
-      });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, space.texels.size(), 64),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      std::vector<Vec2> strata;
+                      ShadowRays batch(in.samples);
+                      std::int64_t local_rays = 0;
+                      for (std::size_t t = range.begin(); t != range.end(); ++t) {
+                        const Texel& texel = space.texels[t];
+                        const Vec3 position = texel.position.cast<double>();
+                        const Vec3 normal = texel.normal.cast<double>();
+                        Vec3 h_sum = Vec3::Zero(), h0_sum = Vec3::Zero();
+                        for (std::size_t l = 0; l < lights.size(); ++l) {
+                          const Vec3 h0 = lights[l].unoccluded_irradiance(position, normal);
+                          if (h0.maxCoeff() <= 0) continue;
+                          Vec3 v;
+                          if (!estimate_visibility(texel, l, lights[l], rays, in.samples, in.seed,
+                                                   in.stream, space.width, batch, strata, &v))
+                            continue;
+                          local_rays += batch.size();
+                          h_sum += h0.cwiseProduct(v);
+                          h0_sum += h0;
+                        }
+                        float* px = out.at(texel.x, texel.y);
+                        for (int c = 0; c < 3; ++c) {
+                          double v = 0;
+                          if (in.quantity == Quantity::irradiance) {
+                            v = h_sum[c];
+                          } else if (h0_sum[c] > 0) {
+                            v = h_sum[c] / h0_sum[c];
+                          }
+                          px[c] = float(v);
+                        }
+                      }
+                      traced += local_rays;
+                      if (in.texels_done) {
+                        const auto done = (*in.texels_done += std::int64_t(range.size()));
+                        if (in.progress) in.progress(double(done));
+                      }
+                    });
   if (rays_traced) *rays_traced += traced.load();
   return out;
 }

@@ -33,6 +33,11 @@ struct BakeSettings {
   int max_image = 4096;
   int max_triples = 128;  // leaf triples per light: the convolution's work budget
   int light_parts = 2;    // convolution: each rectangular light split into at least this many
+  // convolution: trace `samples` shadow rays per light at the (light, texel) pairs whose leaves'
+  // penumbra error exceeds trace_error_texels, or which a blocker may shadow unaccounted for
+  // (traced_convolution.h); false: the convolution's values stand everywhere
+  bool trace = true;
+  double trace_error_texels = 1.0;
   std::string blocker_combine = "sum";  // how blocker clusters combine: "product" or "sum"
   // What the convolution's V averages the light's points by: "irradiance" (cos·cos/r², to first
   // order across the light, as the reference) or "emission" (V_u, exact for parallel planes)

@@ -337,6 +337,11 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
     }
   }
   if (auto v = r.number("error_texels", "a number > 0", is_positive)) bake.error_texels = *v;
+  if (auto v = r.boolean("trace")) bake.trace = *v;
+  if (auto v = r.number("trace_error_texels", "a number >= 0",
+                        [](double x) { return std::isfinite(x) && x >= 0; })) {
+    bake.trace_error_texels = *v;
+  }
   if (auto v = r.integer("max_image", 64, 16384)) bake.max_image = static_cast<int>(*v);
   if (auto v = r.string("blocker_combine")) {
     if (*v == "product" || *v == "sum") {

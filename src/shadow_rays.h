@@ -3,18 +3,23 @@
 // texel, or one constellation for every texel).
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "lights.h"
 #include "ray_scene.h"
+#include "sampling.h"
+#include "texel_space.h"
 
 namespace sb {
 
 class ShadowRays {
  public:
   explicit ShadowRays(int capacity)
-      : origins_(std::size_t(capacity)), directions_(std::size_t(capacity)),
-        lengths_(std::size_t(capacity)), weights_(std::size_t(capacity)),
+      : origins_(std::size_t(capacity)),
+        directions_(std::size_t(capacity)),
+        lengths_(std::size_t(capacity)),
+        weights_(std::size_t(capacity)),
         hit_(std::size_t(capacity)) {}
 
   void clear() {
@@ -59,5 +64,26 @@ class ShadowRays {
   int n_ = 0;
   Vec3 weight_sum_ = Vec3::Zero();
 };
+
+// The reference's estimate of light `l`'s visibility at one texel (reference_bake.cpp): `samples`
+// stratified points, from the texel's own random stream (seed, receiver stream, light, pixel),
+// one shadow ray each from the lifted shadow origin. False when no point contributes. Any method
+// that traces a texel this way gets the reference's value at that many samples, bit for bit.
+inline bool estimate_visibility(const Texel& texel, std::size_t l, const Light& light,
+                                const RayScene& rays, int samples, std::uint64_t seed,
+                                std::uint64_t stream, int width, ShadowRays& batch,
+                                std::vector<Vec2>& strata, Vec3* v) {
+  const double offset = rays.surface_offset();
+  const Vec3 position = texel.position.cast<double>();
+  const Vec3 normal = texel.normal.cast<double>();
+  const Vec3 origin =
+      texel.shadow_origin.cast<double>() + offset * texel.geometric_normal.cast<double>();
+  Rng rng(stream_seed(seed, (stream << 32) ^ l, std::uint64_t(texel.y) * width + texel.x));
+  stratified_samples(samples, rng, strata);
+  batch.clear();
+  for (int s = 0; s < samples; ++s)
+    batch.add(origin, light.sample(position, normal, strata[s]), offset);
+  return batch.visible_fraction(rays, v);
+}
 
 }  // namespace sb
