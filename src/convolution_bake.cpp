@@ -513,6 +513,7 @@ Expected<Image> bake_convolution(const TexelSpace& space, const ConvolutionInput
   pin.maybe_blocked = in.maybe_blocked;
   pin.ray_cost_per_texel = in.ray_cost_per_texel;
   pin.trace_error_texels = in.trace_error_texels;
+  pin.cost_budget_per_texel = in.cost_budget_per_texel;
   ConvolutionPlan plan = plan_convolution(space, pin);
   const double plan_seconds = seconds_since(start);
   if (const double needed = convolution_images_bytes(plan); needed > in.memory_for_images) {

@@ -43,6 +43,7 @@ struct ConvolutionInputs {
   // convolved; their texels' error is +infinity in ConvolutionVisibility.
   double ray_cost_per_texel = 0;
   double trace_error_texels = -1;
+  double cost_budget_per_texel = 0;  // PlanInputs::cost_budget_per_texel
   // Bytes the leaves' images may take at once (what the bake's budget leaves them,
   // memory_budget.h); a plan that needs more is refused before anything is convolved.
   double memory_for_images = 1e18;

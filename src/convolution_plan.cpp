@@ -279,18 +279,37 @@ void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& 
   } else {
     t.blurred = false;
   }
-  const int kernel_w = 2 * int(std::ceil(kernel_extent.x() / (2 * pixel))) + 1;
-  const int kernel_h = 2 * int(std::ceil(kernel_extent.y() / (2 * pixel))) + 1;
-  const int margin_x = kernel_w / 2 + 1, margin_y = kernel_h / 2 + 1;
-  t.grid.pixel = pixel;
-  t.grid.origin = tlo - Vec2(margin_x, margin_y) * pixel;
-  t.grid.width = int(std::ceil(span.x() / pixel)) + 2 * margin_x + 1;
-  t.grid.height = int(std::ceil(span.y() / pixel)) + 2 * margin_y + 1;
-  t.fft_width = FftConvolver::transform_size(t.grid.width);
-  t.fft_height = FftConvolver::transform_size(t.grid.height);
-  const double n = double(t.fft_width) * t.fft_height;
-  t.cost = n * std::log2(std::max(2.0, n)) * (light.textured() ? 3 : 1) +
-           30.0 * double(t.footprint_texels) + 20.0 * double(t.faces.size());
+  // The grid and its cost at a pixel size: the transform, the kernel's splatting (about 9
+  // samples of the light per kernel pixel, source_image.cpp), the footprint's lookups and the
+  // faces' rasterisation.
+  const auto size_images = [&](double at) {
+    const int kernel_w = 2 * int(std::ceil(kernel_extent.x() / (2 * at))) + 1;
+    const int kernel_h = 2 * int(std::ceil(kernel_extent.y() / (2 * at))) + 1;
+    const int margin_x = kernel_w / 2 + 1, margin_y = kernel_h / 2 + 1;
+    t.grid.pixel = at;
+    t.grid.origin = tlo - Vec2(margin_x, margin_y) * at;
+    t.grid.width = int(std::ceil(span.x() / at)) + 2 * margin_x + 1;
+    t.grid.height = int(std::ceil(span.y() / at)) + 2 * margin_y + 1;
+    t.fft_width = FftConvolver::transform_size(t.grid.width);
+    t.fft_height = FftConvolver::transform_size(t.grid.height);
+    const double n = double(t.fft_width) * t.fft_height;
+    t.cost = (n * std::log2(std::max(2.0, n)) + 9.0 * double(kernel_w) * kernel_h) *
+                 (light.textured() ? 3 : 1) +
+             30.0 * double(t.footprint_texels) + 20.0 * double(t.faces.size());
+  };
+  size_images(pixel);
+  // Within the work budget (PlanInputs::cost_budget_per_texel): a leaf whose images would cost
+  // more than its footprint may takes coarser pixels. Its ε, which decides where it is traced,
+  // does not change; only the blur it adds, which ε's scale already allows for where the
+  // penumbra is wide (the case that makes images this large: blockers near the light's depth).
+  if (in.cost_budget_per_texel > 0) {
+    const double cap = in.cost_budget_per_texel * std::max(4096.0, double(t.footprint_texels));
+    for (int step = 0; step < 40 && t.cost > cap && t.grid.width * t.grid.height > 256; ++step) {
+      pixel *= 1.5;
+      size_images(pixel);
+      t.blurred = true;
+    }
+  }
   t.traced =
       in.ray_cost_per_texel > 0 && t.cost > in.ray_cost_per_texel * double(t.footprint_texels);
 }
@@ -328,7 +347,19 @@ class Planner {
         if (over(root)) queue.push(root);
       }
     }
-    while (!queue.empty() && leaves < budget) {
+    // The work budget: the leaves' estimated cost within cost_budget_per_texel per texel.
+    double cost = 0, cost_budget = std::numeric_limits<double>::infinity();
+    if (in_.cost_budget_per_texel > 0) {
+      double texels = 0;
+      for (std::size_t f = frame_begin; f < frame_end; ++f)
+        texels += double(plan_.frames[f].texels.size());
+      cost_budget = in_.cost_budget_per_texel * std::max(texels, 4096.0);
+      for (std::size_t f = frame_begin; f < frame_end; ++f)
+        for (int root : plan_.frames[f].roots)
+          if (!plan_.triples[root].empty && !plan_.triples[root].traced)
+            cost += plan_.triples[root].cost;
+    }
+    while (!queue.empty() && leaves < budget && cost < cost_budget) {
       const int worst = queue.top();
       queue.pop();
       std::vector<Triple> best;
@@ -347,6 +378,8 @@ class Planner {
         }
       }
       if (best.empty()) continue;  // no split helps: it stays a leaf above the target
+      cost -= plan_.triples[worst].traced ? 0.0 : plan_.triples[worst].cost;
+      for (const Triple& c : best) cost += c.empty || c.traced ? 0.0 : c.cost;
       plan_.triples[worst].split = best.front().split;
       best.front().split.clear();
       best.back().split.clear();

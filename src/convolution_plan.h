@@ -53,6 +53,10 @@ struct PlanInputs {
   double ray_cost_per_texel = 0;
   // Leaves whose ε stays above this are traced too (negative: never, for ε alone).
   double trace_error_texels = -1;
+  // The convolution's work budget, in Triple::cost units per planned texel (0: none): the
+  // leaves of a light part cost at most this much in all (refinement stops there), and a leaf
+  // at most this much per texel of its footprint (its images are made coarser).
+  double cost_budget_per_texel = 0;
 };
 
 // A shadow ray's cost in Triple::cost units (FFT pixel-log): 80 ns per ray and core (the

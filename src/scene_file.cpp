@@ -297,8 +297,9 @@ bool is_valid_object_name(std::string_view name) {
 Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::table& table) {
   TableReader r(file, table, "[bake]");
   r.check_known_keys({"resolution", "method", "quantity", "samples", "margin", "seed", "max_memory",
-                      "error_texels", "max_image", "max_triples", "light_parts", "blocker_combine",
-                      "weighting", "shadow_map", "pcf_radius", "erosion_factor"});
+                      "error_texels", "max_image", "max_triples", "light_parts", "trace",
+                      "trace_error_texels", "blocker_combine", "weighting", "shadow_map",
+                      "pcf_radius", "erosion_factor"});
   BakeSettings bake;
   const int int_max = std::numeric_limits<int>::max();
   if (auto v = r.integer("resolution", 1, 16384)) bake.resolution = static_cast<int>(*v);

@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <vector>
 
@@ -32,7 +33,8 @@ namespace {
 std::vector<Vec3> outline(const Light& light, const Vec3& along) {
   std::vector<Vec3> pts;
   if (light.shape() == LightShape::rectangle) {
-    const Vec3 a = 0.5 * light.desc().width * light.right(), b = 0.5 * light.desc().height * light.up();
+    const Vec3 a = 0.5 * light.desc().width * light.right(),
+               b = 0.5 * light.desc().height * light.up();
     pts = {a + b, a - b, -a + b, -a - b};
     return pts;
   }
@@ -81,7 +83,8 @@ Vec2 projected_half_extents(const Light& light, const ProjectionFrame& frame, co
 
 double depth_half_spread(const Light& light, const ProjectionFrame& frame) {
   double spread = 0;
-  for (const Vec3& c : outline(light, frame.axis)) spread = std::max(spread, std::abs(c.dot(frame.axis)));
+  for (const Vec3& c : outline(light, frame.axis))
+    spread = std::max(spread, std::abs(c.dot(frame.axis)));
   return light.shape() == LightShape::sphere ? 0.0 : spread;
 }
 
@@ -127,9 +130,10 @@ SourceKernel source_kernel(const Light& light, const ProjectionFrame& frame,
   }
   const double px_per_metre = scale * 1.5;  // perspective can stretch by r/(r − z)
   // Each sample stands for a cell of the light, and is splatted as that cell's bounding box
-  // (area-weighted over the pixels it overlaps, 2 × 2 at most at this density): the kernel's edge pixels then get their coverage
-  // to second order in the cell size, where dropping each sample into one pixel gets it to first
-  // order only, and needed 4× more samples per axis for the same error.
+  // (area-weighted over the pixels it overlaps, 2 × 2 at most at this density): the kernel's edge
+  // pixels then get their coverage to second order in the cell size, where dropping each sample
+  // into one pixel gets it to first order only, and needed 4× more samples per axis for the same
+  // error.
   const int per_pixel = 2;
   const int nu = std::clamp(int(std::ceil(per_pixel * extent_u * px_per_metre)), 8, 4096);
   const int nv = std::clamp(int(std::ceil(per_pixel * extent_v * px_per_metre)), 8, 4096);
@@ -163,18 +167,22 @@ SourceKernel source_kernel(const Light& light, const ProjectionFrame& frame,
       }
       const double area = 4 * half.x() * half.y();
       if (!(area > 0)) continue;
-      const int x0 = int(std::floor(centre.x() - half.x() + 0.5));
-      const int x1 = int(std::floor(centre.x() + half.x() + 0.5));
-      const int y0 = int(std::floor(centre.y() - half.y() + 0.5));
-      const int y1 = int(std::floor(centre.y() + half.y() + 0.5));
-      for (int y = y0; y <= y1; ++y) {
-        const double wy = std::min(centre.y() + half.y(), y + 0.5) - std::max(centre.y() - half.y(), y - 0.5);
-        if (wy <= 0) continue;
-        const int yc = std::clamp(y, 0, nh - 1);
-        for (int x = x0; x <= x1; ++x) {
-          const double wx = std::min(centre.x() + half.x(), x + 0.5) - std::max(centre.x() - half.x(), x - 0.5);
-          if (wx <= 0) continue;
-          const std::size_t at = std::size_t(yc) * nw + std::size_t(std::clamp(x, 0, nw - 1));
+      // The cell's extent split over the kernel's pixels; what falls beyond an edge goes to the
+      // edge pixel. The loops run over the kernel only: a light point near the receiver's depth
+      // stretches its cell over millions of pixels (r / (r − z)), which must not cost as many.
+      const auto spans = [](double lo, double hi, int n, auto&& visit) {
+        const int first = std::clamp(int(std::floor(lo + 0.5)), 0, n - 1);
+        const int last = std::clamp(int(std::floor(hi + 0.5)), 0, n - 1);
+        for (int x = first; x <= last; ++x) {
+          const double left = x == 0 ? -std::numeric_limits<double>::infinity() : x - 0.5;
+          const double right = x == n - 1 ? std::numeric_limits<double>::infinity() : x + 0.5;
+          const double w = std::min(hi, right) - std::max(lo, left);
+          if (w > 0) visit(x, w);
+        }
+      };
+      spans(centre.y() - half.y(), centre.y() + half.y(), nh, [&](int y, double wy) {
+        spans(centre.x() - half.x(), centre.x() + half.x(), nw, [&](int x, double wx) {
+          const std::size_t at = std::size_t(y) * nw + std::size_t(x);
           const double wgt = wx * wy / area;
           if (uniform) {
             acc[0][at] += wgt;
@@ -183,8 +191,8 @@ SourceKernel source_kernel(const Light& light, const ProjectionFrame& frame,
           }
           moment[0][at] += wgt * e0 * a;
           moment[1][at] += wgt * e0 * b;
-        }
-      }
+        });
+      });
       centroid += e0 * Vec2(a, b);
     }
   }
