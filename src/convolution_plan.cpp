@@ -293,9 +293,12 @@ void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& 
     t.fft_width = FftConvolver::transform_size(t.grid.width);
     t.fft_height = FftConvolver::transform_size(t.grid.height);
     const double n = double(t.fft_width) * t.fft_height;
+    // The blocker images: 4 × 4 coverage samples per pixel, for the share and the whole image
+    // (blocker_image.cpp); on the showcase they took three times the transforms' time.
+    const double blocker_pixels = 2.0 * 16.0 * double(t.grid.width) * t.grid.height;
     t.cost = (n * std::log2(std::max(2.0, n)) + 9.0 * double(kernel_w) * kernel_h) *
                  (light.textured() ? 3 : 1) +
-             30.0 * double(t.footprint_texels) + 20.0 * double(t.faces.size());
+             blocker_pixels + 30.0 * double(t.footprint_texels) + 20.0 * double(t.faces.size());
   };
   size_images(pixel);
   // Within the work budget (PlanInputs::cost_budget_per_texel): a leaf whose images would cost

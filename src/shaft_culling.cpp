@@ -60,6 +60,7 @@ struct Node {
 struct Tri {
   Vec3 v[3];
   Vec3 normal;  // unit (zero for a degenerate triangle, which blocks nothing)
+  Vec3 lo, hi;  // bounding box
 };
 
 constexpr int kLeafSize = 4;
@@ -118,17 +119,25 @@ struct ShaftCuller::Impl {
     return index;
   }
 
-  // The shaft between p and the light, as planes; false when the light cannot reach p.
-  static bool shaft(const Vec3& p, const Vec3& surface, const Vec3& n, const Light& light,
-                    std::vector<Plane>& planes, std::array<Vec3, 8>& base, int& corners,
-                    Plane& far) {
+  // The shaft between the apex and the light, as planes; false when the light cannot reach the
+  // apex. The apex is a point (one texel's ray origin; with its surface point and normal, whose
+  // horizon bounds the shaft too) or a box of several (a tile of texels, no horizon): for a box
+  // the planes are those of its centre, each pushed out by the box's reach along its normal,
+  // which holds every segment from a point of the box to the light (a point s·q + (1 − s)·b of
+  // one, q in the box and b on the light, is at most s times that reach outside the plane).
+  static bool shaft(const Box& apex, const Vec3* surface, const Vec3* n, const Light& light,
+                    std::vector<Plane>& planes, std::array<Vec3, 8>& base, int& corners) {
+    const Vec3 p = 0.5 * (apex.lo + apex.hi);
+    const Vec3 half = 0.5 * (apex.hi - apex.lo);
+    const bool point = half.isZero();
+    const auto reach = [&](const Vec3& normal) { return half.dot(normal.cwiseAbs()); };
     const Vec3 c = light.centre();
-    Vec3 e1, e2, base_normal;  // base plane's axes and its normal towards p
+    Vec3 e1 = Vec3::Zero(), e2 = Vec3::Zero(), base_normal = Vec3::UnitZ();  // base axes, normal
     Vec3 centre = c;
     double r = 0;
     switch (light.shape()) {
       case LightShape::rectangle: {
-        if ((p - c).dot(light.normal()) <= 0) return false;
+        if ((p - c).dot(light.normal()) - reach(light.normal()) <= 0) return false;
         const double hw = 0.5 * light.desc().width, hh = 0.5 * light.desc().height;
         const Vec3& right = light.right();
         const Vec3& up = light.up();
@@ -141,7 +150,7 @@ struct ShaftCuller::Impl {
       case LightShape::disk:
       case LightShape::sphere: {
         if (light.shape() == LightShape::disk) {
-          if ((p - c).dot(light.normal()) <= 0) return false;
+          if ((p - c).dot(light.normal()) - reach(light.normal()) <= 0) return false;
           e1 = light.right();
           e2 = light.up();
           base_normal = light.normal();
@@ -149,11 +158,18 @@ struct ShaftCuller::Impl {
         } else {
           const Vec3 to = c - p;
           const double dist = to.norm(), R = light.desc().radius;
-          if (dist <= R * (1 + 1e-9)) return false;
+          if (dist - half.norm() <= R * (1 + 1e-9)) return false;
           const Vec3 axis = to / dist;
-          // The silhouette: a circle of radius R·sqrt(L² − R²)/L at R²/L before the centre.
-          centre = c - axis * (R * R / dist);
-          r = R * std::sqrt(std::max(0.0, dist * dist - R * R)) / dist;
+          if (point) {
+            // The silhouette: a circle of radius R·sqrt(L² − R²)/L at R²/L before the centre.
+            centre = c - axis * (R * R / dist);
+            r = R * std::sqrt(std::max(0.0, dist * dist - R * R)) / dist;
+          } else {
+            // From a box no one silhouette holds: the tangent cone from the box's centre,
+            // which holds the whole sphere, cut beyond it.
+            centre = c + axis * R;
+            r = R * (dist + R) / std::sqrt(std::max(1e-300, dist * dist - R * R));
+          }
           base_normal = -axis;
           e1 = std::abs(axis.x()) < 0.9 ? axis.cross(Vec3::UnitX()).normalized()
                                         : axis.cross(Vec3::UnitY()).normalized();
@@ -169,13 +185,15 @@ struct ShaftCuller::Impl {
         break;
       }
     }
-    // The light must rise above the texel's horizon somewhere.
-    double highest = -std::numeric_limits<double>::infinity();
-    for (int k = 0; k < corners; ++k)
-      highest = std::max(highest, n.dot(base[std::size_t(k)] - surface));
-    if (light.shape() == LightShape::sphere)
-      highest = std::max(highest, n.dot(c - surface) + light.desc().radius);
-    if (highest <= 0) return false;
+    if (surface) {
+      // The light must rise above the texel's horizon somewhere.
+      double highest = -std::numeric_limits<double>::infinity();
+      for (int k = 0; k < corners; ++k)
+        highest = std::max(highest, n->dot(base[std::size_t(k)] - *surface));
+      if (light.shape() == LightShape::sphere)
+        highest = std::max(highest, n->dot(c - *surface) + light.desc().radius);
+      if (highest <= 0) return false;
+    }
 
     planes.clear();
     Vec3 mid = Vec3::Zero();
@@ -189,22 +207,23 @@ struct ShaftCuller::Impl {
       if (!(len > 0)) continue;
       normal /= len;
       if (normal.dot(mid - p) > 0) normal = -normal;
-      planes.push_back({normal, normal.dot(p)});
+      planes.push_back({normal, normal.dot(p) + reach(normal)});
     }
-    // Beyond the light's (or silhouette's) plane, and below the horizon of the surface point (the
-    // rays start a little above it, at p, and end above it).
-    far = {-base_normal, -base_normal.dot(base[0])};
-    planes.push_back(far);
-    planes.push_back({-n, -n.dot(surface)});
+    // Beyond the light's (or silhouette's) plane, and, for one texel, below the horizon of its
+    // surface point (its rays start a little above it and end above it).
+    planes.push_back({-base_normal, -base_normal.dot(base[0])});
+    if (surface) planes.push_back({-*n, -n->dot(*surface)});
     return true;
   }
 
-  // Whether the light lies wholly on one side of a triangle's plane through (normal, offset) as
-  // p does (or p lies on the plane): then the triangle cannot cut a segment from p to the light.
-  static bool same_side(const Tri& t, const Vec3& p, const std::array<Vec3, 8>& base, int corners,
+  // Whether the light lies wholly on one side of a triangle's plane as the whole apex does (or a
+  // point apex lies on the plane): then the triangle cannot cut a segment from it to the light.
+  static bool same_side(const Tri& t, const Box& apex, const std::array<Vec3, 8>& base, int corners,
                         const Light& light) {
+    const Vec3 p = 0.5 * (apex.lo + apex.hi);
+    const double spread = (0.5 * (apex.hi - apex.lo)).dot(t.normal.cwiseAbs());
     const double sp = t.normal.dot(p - t.v[0]);
-    if (std::abs(sp) <= kPlaneTolerance) return true;
+    if (spread == 0 && std::abs(sp) <= kPlaneTolerance) return true;
     // The light's extent along the normal: its base polygon, and for a sphere the sphere itself.
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (int k = 0; k < corners; ++k) {
@@ -217,17 +236,55 @@ struct ShaftCuller::Impl {
       lo = std::min(lo, s - light.desc().radius);
       hi = std::max(hi, s + light.desc().radius);
     }
-    return sp > 0 ? lo >= 0 : hi <= 0;
+    if (sp - spread > -kPlaneTolerance && sp - spread >= 0) return lo >= 0;
+    if (sp + spread < 0) return hi <= 0;
+    return false;
   }
 
-  bool query(const Vec3& p, const Vec3& surface, const Vec3& n, const Light& light) const {
+  // Whether a triangle may lie in the shaft (planes, base) from `apex`.
+  static bool in_shaft(const Tri& t, const Box& apex, const std::vector<Plane>& planes,
+                       const std::array<Vec3, 8>& base, int corners, const Light& light,
+                       std::vector<Vec3>& poly, std::vector<Vec3>& scratch) {
+    if (t.normal.isZero()) return false;
+    // The triangle's box wholly outside one plane: nothing of it is in the shaft.
+    for (const Plane& pl : planes) {
+      const Vec3 near(pl.n.x() >= 0 ? t.lo.x() : t.hi.x(), pl.n.y() >= 0 ? t.lo.y() : t.hi.y(),
+                      pl.n.z() >= 0 ? t.lo.z() : t.hi.z());
+      if (pl.eval(near) > 0) return false;
+    }
+    if (same_side(t, apex, base, corners, light)) return false;
+    poly.assign(std::begin(t.v), std::end(t.v));
+    for (const Plane& pl : planes) {
+      clip(poly, scratch, pl);
+      if (poly.empty()) return false;
+    }
+    return true;
+  }
+
+  // Whether a blocker may lie in the apex's shaft. With `candidates`, every triangle that may
+  // (by index) is collected instead of stopping at the first; `among`, when given, restricts
+  // the search to those triangles (a tile's candidates, for its texels).
+  bool query(const Box& apex, const Vec3* surface, const Vec3* n, const Light& light,
+             std::vector<std::uint32_t>* candidates = nullptr,
+             const std::vector<std::uint32_t>* among = nullptr) const {
     if (nodes.empty()) return false;
     std::vector<Plane> planes;
     std::array<Vec3, 8> base;
     int corners = 0;
-    Plane far;
-    if (!shaft(p, surface, n, light, planes, base, corners, far)) return false;
+    // A point the light cannot reach has nothing to block; a box of which some point it cannot
+    // reach is not decided here (its texels are tested one by one, among every triangle).
+    if (!shaft(apex, surface, n, light, planes, base, corners)) {
+      if (apex.lo == apex.hi) return false;
+      if (candidates) candidates->push_back(kAll);
+      return true;
+    }
     std::vector<Vec3> poly, scratch;
+    if (among) {
+      for (std::uint32_t i : *among)
+        if (in_shaft(tris[i], apex, planes, base, corners, light, poly, scratch)) return true;
+      return false;
+    }
+    bool found = false;
     int stack[64];
     int top = 0;
     stack[top++] = 0;
@@ -246,24 +303,32 @@ struct ShaftCuller::Impl {
       }
       if (outside) continue;
       if (node.count == 0) {
-        if (top + 2 > 64) return true;  // deeper than any balanced tree: keep, to be safe
+        if (top + 2 > 64) {  // deeper than any balanced tree: keep, to be safe
+          if (candidates) candidates->assign(1, kAll);
+          return true;
+        }
         stack[top++] = node.left;
         stack[top++] = node.right;
         continue;
       }
       for (int i = node.first; i < node.first + node.count; ++i) {
-        const Tri& t = tris[std::size_t(i)];
-        if (t.normal.isZero() || same_side(t, p, base, corners, light)) continue;
-        poly.assign(std::begin(t.v), std::end(t.v));
-        for (const Plane& pl : planes) {
-          clip(poly, scratch, pl);
-          if (poly.empty()) break;
+        if (!in_shaft(tris[std::size_t(i)], apex, planes, base, corners, light, poly, scratch))
+          continue;
+        if (!candidates) return true;
+        found = true;
+        candidates->push_back(std::uint32_t(i));
+        if (candidates->size() > kMaxCandidates) {  // a busy tile: search each texel afresh
+          candidates->assign(1, kAll);
+          return true;
         }
-        if (!poly.empty()) return true;
       }
     }
-    return false;
+    return found;
   }
+
+  // In a candidate list: "search every triangle".
+  static constexpr std::uint32_t kAll = 0xffffffffu;
+  static constexpr std::size_t kMaxCandidates = 32;
 };
 
 ShaftCuller::ShaftCuller(const std::vector<const Mesh*>& blockers)
@@ -276,6 +341,8 @@ ShaftCuller::ShaftCuller(const std::vector<const Mesh*>& blockers)
       const Vec3 cross = (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]);
       const double len = cross.norm();
       t.normal = len > 0 ? Vec3(cross / len) : Vec3::Zero();
+      t.lo = t.v[0].cwiseMin(t.v[1]).cwiseMin(t.v[2]);
+      t.hi = t.v[0].cwiseMax(t.v[1]).cwiseMax(t.v[2]);
       impl_->tris.push_back(t);
     }
   }
@@ -291,18 +358,49 @@ ShaftCuller::~ShaftCuller() = default;
 
 bool ShaftCuller::maybe_blocked(const Vec3& origin, const Vec3& surface, const Vec3& normal,
                                 const Light& light) const {
-  return impl_->query(origin, surface, normal, light);
+  Box apex;
+  apex.extend(origin);
+  return impl_->query(apex, &surface, &normal, light);
 }
 
 std::vector<std::uint8_t> ShaftCuller::maybe_blocked(const TexelSpace& space, const Light& light,
                                                      double offset) const {
+  // Tiles of kTile² texels (of the lightmap, so neighbours on the surface too, mostly) are
+  // tested as one box first: most of a floor is clear of every blocker, and one query says so
+  // for a whole tile. Only a tile that may be blocked is tested texel by texel.
+  constexpr int kTile = 8;
+  const int tiles_x = (space.width + kTile - 1) / kTile;
+  const int tiles_y = (space.height + kTile - 1) / kTile;
+  std::vector<std::vector<std::uint32_t>> tile_texels(std::size_t(tiles_x) * tiles_y);
+  std::vector<Vec3> origin(space.texels.size());
+  for (std::size_t i = 0; i < space.texels.size(); ++i) {
+    const Texel& t = space.texels[i];
+    origin[i] = t.shadow_origin.cast<double>() + offset * t.geometric_normal.cast<double>();
+    tile_texels[std::size_t(t.y / kTile) * tiles_x + std::size_t(t.x / kTile)].push_back(
+        std::uint32_t(i));
+  }
   std::vector<std::uint8_t> out(space.texels.size(), 0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, out.size(), 256), [&](const auto& r) {
-    for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      const Texel& t = space.texels[i];
-      const Vec3 origin =
-          t.shadow_origin.cast<double>() + offset * t.geometric_normal.cast<double>();
-      out[i] = impl_->query(origin, t.position.cast<double>(), t.normal.cast<double>(), light);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tile_texels.size(), 16), [&](const auto& r) {
+    std::vector<std::uint32_t> candidates;
+    for (std::size_t k = r.begin(); k != r.end(); ++k) {
+      const std::vector<std::uint32_t>& members = tile_texels[k];
+      if (members.empty()) continue;
+      // The tile's own shaft first: clear, or the triangles its texels need to look at.
+      candidates.clear();
+      const bool tile = members.size() > 1;
+      if (tile) {
+        Box box;
+        for (std::uint32_t i : members) box.extend(origin[i]);
+        if (!impl_->query(box, nullptr, nullptr, light, &candidates)) continue;
+      }
+      const bool all = !tile || (!candidates.empty() && candidates[0] == Impl::kAll);
+      for (std::uint32_t i : members) {
+        const Texel& t = space.texels[i];
+        Box apex;
+        apex.extend(origin[i]);
+        const Vec3 surface = t.position.cast<double>(), normal = t.normal.cast<double>();
+        out[i] = impl_->query(apex, &surface, &normal, light, nullptr, all ? nullptr : &candidates);
+      }
     }
   });
   return out;
