@@ -133,7 +133,9 @@ Light::Light(const LightDesc& desc, std::shared_ptr<const Image> texture)
     up_ = Vec3::UnitZ();
     right_ = Vec3::UnitX();
   } else {
-    up_ = desc_.up;
+    // In the light's plane whatever the description holds (the scene reader makes `up`
+    // perpendicular to the normal; a description built by hand may not).
+    up_ = (desc_.up - desc_.up.dot(desc_.normal) * desc_.normal).normalized();
     right_ = up_.cross(desc_.normal).normalized();
   }
   exitance_ = desc_.color * (desc_.power / area());

@@ -446,10 +446,12 @@ Expected<ObjectDesc> read_object(const std::filesystem::path& file, const toml::
   return obj;
 }
 
-// The default height axis of a rectangle or disk: +Y, or +Z where +Y is along the normal.
+// The default height axis of a rectangle or disk: +Y, or +Z where +Y is along the normal, made
+// perpendicular to the normal like a given `up` (Gram-Schmidt), so the light lies in its plane.
 Vec3 default_up(const Vec3& normal) {
   const Vec3 y = Vec3::UnitY();
-  return (y - y.dot(normal) * normal).norm() < parallel_sine ? Vec3::UnitZ() : y;
+  const Vec3 axis = (y - y.dot(normal) * normal).norm() < parallel_sine ? Vec3::UnitZ() : y;
+  return (axis - axis.dot(normal) * normal).normalized();
 }
 
 Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::table& table,
