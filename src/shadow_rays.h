@@ -86,4 +86,23 @@ inline bool estimate_visibility(const Texel& texel, std::size_t l, const Light& 
   return batch.visible_fraction(rays, v);
 }
 
+// Whether estimate_visibility would find a contributing point among the same samples, without
+// tracing: false where every sample lies below the texel's horizon or on the light's back.
+inline bool any_sample_contributes(const Texel& texel, std::size_t l, const Light& light,
+                                   const RayScene& rays, int samples, std::uint64_t seed,
+                                   std::uint64_t stream, int width, ShadowRays& batch,
+                                   std::vector<Vec2>& strata) {
+  const double offset = rays.surface_offset();
+  const Vec3 position = texel.position.cast<double>();
+  const Vec3 normal = texel.normal.cast<double>();
+  const Vec3 origin =
+      texel.shadow_origin.cast<double>() + offset * texel.geometric_normal.cast<double>();
+  Rng rng(stream_seed(seed, (stream << 32) ^ l, std::uint64_t(texel.y) * width + texel.x));
+  stratified_samples(samples, rng, strata);
+  batch.clear();
+  for (int s = 0; s < samples; ++s)
+    batch.add(origin, light.sample(position, normal, strata[s]), offset);
+  return batch.size() > 0;
+}
+
 }  // namespace sb

@@ -212,7 +212,10 @@ struct ShaftCuller::Impl {
     // Beyond the light's (or silhouette's) plane, and, for one texel, below the horizon of its
     // surface point (its rays start a little above it and end above it).
     planes.push_back({-base_normal, -base_normal.dot(base[0])});
-    if (surface) planes.push_back({-*n, -n->dot(*surface)});
+    // Through the lower of the surface point and the ray origin along the normal: the origin is
+    // lifted onto the smooth surface (uv_rasterizer.cpp), which may lie below the flat face's
+    // horizon, and the segment starts there.
+    if (surface) planes.push_back({-*n, -std::min(n->dot(*surface), n->dot(p))});
     return true;
   }
 

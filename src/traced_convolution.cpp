@@ -21,6 +21,34 @@
 
 namespace sb {
 
+namespace {
+
+// How close to 0 or 1 the convolution's V must be to count as wholly hidden or wholly seen.
+constexpr float kCertain = 2e-3f;
+// Texels around a traced one that are traced too (either axis), against a penumbra the
+// convolution placed up to its ε (1 texel at the default target) off.
+constexpr int kTraceMargin = 2;
+
+// Whether some of the light lies below the horizon of (p, n): a corner of a rectangle, the rim of
+// a disk, the far side of a sphere.
+bool partly_below_horizon(const Light& light, const Vec3& p, const Vec3& n) {
+  const Vec3 c = light.centre() - p;
+  const LightDesc& d = light.desc();
+  switch (light.shape()) {
+    case LightShape::rectangle:
+      return n.dot(c) - 0.5 * d.width * std::abs(n.dot(light.right())) -
+                 0.5 * d.height * std::abs(n.dot(light.up())) <
+             0;
+    case LightShape::disk:
+      return n.dot(c) - d.radius * (n - n.dot(light.normal()) * light.normal()).norm() < 0;
+    case LightShape::sphere:
+      return n.dot(c) - d.radius < 0;
+  }
+  return true;
+}
+
+}  // namespace
+
 Expected<Image> bake_traced_convolution(const TexelSpace& space, const TracedConvolutionInputs& in,
                                         std::vector<PairReport>* reports, ConvolutionPlan* plan,
                                         TracedConvolutionStats* stats) {
@@ -48,6 +76,47 @@ Expected<Image> bake_traced_convolution(const TexelSpace& space, const TracedCon
   auto convolved = bake_convolution(space, conv, reports, plan, &per_light);
   if (!convolved) return convolved.error();
 
+  // Which (light, texel) pairs are traced. The convolution's penumbra values are approximate
+  // beyond what ε measures (the slabs' shares, the first-order weighting), so a texel it finds
+  // partly lit is traced, as is one whose leaves' ε is above trace_error_texels or which no leaf
+  // accounted for; its own answer stands only where it finds the light wholly seen or wholly
+  // hidden, and not within kTraceMargin texels of a traced one (where a penumbra it placed up
+  // to ε off may begin).
+  std::vector<std::vector<std::uint8_t>> trace(lights.size());
+  if (in.rays) {
+    std::vector<std::int32_t> texel_at(std::size_t(space.width) * space.height, -1);
+    for (std::size_t t = 0; t < n; ++t)
+      texel_at[std::size_t(space.texels[t].y) * space.width + std::size_t(space.texels[t].x)] =
+          std::int32_t(t);
+    for (std::size_t l = 0; l < lights.size(); ++l) {
+      std::vector<std::uint8_t> seed(n, 0);
+      for (std::size_t t = 0; t < n; ++t) {
+        if (!maybe.empty() && !maybe[l][t]) continue;
+        const bool planned = !per_light.visible[l].empty() && per_light.reached[l][t];
+        const float e = planned ? per_light.error_texels[l][t] : -1.0f;
+        bool partial = false;
+        if (planned)
+          for (int c = 0; c < 3; ++c) {
+            const float v = per_light.visible[l][t][c];
+            partial = partial || (v > kCertain && v < 1 - kCertain);
+          }
+        seed[t] = e < 0 || e > in.trace_error_texels || partial;
+      }
+      trace[l].assign(n, 0);
+      for (std::size_t t = 0; t < n; ++t) {
+        if (!seed[t]) continue;
+        const int x = space.texels[t].x, y = space.texels[t].y;
+        for (int dy = -kTraceMargin; dy <= kTraceMargin; ++dy)
+          for (int dx = -kTraceMargin; dx <= kTraceMargin; ++dx) {
+            const int xx = x + dx, yy = y + dy;
+            if (xx < 0 || yy < 0 || xx >= space.width || yy >= space.height) continue;
+            const std::int32_t u = texel_at[std::size_t(yy) * space.width + std::size_t(xx)];
+            if (u >= 0 && (maybe.empty() || maybe[l][std::size_t(u)])) trace[l][std::size_t(u)] = 1;
+          }
+      }
+    }
+  }
+
   const bool weights_needed = lights.size() > 1 || conv.quantity == Quantity::irradiance;
   Image out(space.width, space.height, 3, 0.0f);
   std::atomic<std::int64_t> pairs{0}, clear{0}, traced{0}, rays_traced{0};
@@ -67,18 +136,22 @@ Expected<Image> bake_traced_convolution(const TexelSpace& space, const TracedCon
         Vec3 v = planned ? Vec3(per_light.visible[l][t].cast<double>()) : Vec3::Ones();
         if (!maybe.empty() && !maybe[l][t]) {
           ++local_clear;
-        } else if (in.rays) {
-          // A texel the plan left out (behind a frustum's near plane) is not vouched for either.
-          const float e = planned ? per_light.error_texels[l][t] : -1.0f;
-          if (e < 0 || e > in.trace_error_texels) {
-            Vec3 traced_v;
-            if (estimate_visibility(tx, l, lights[l], *in.rays, in.samples, in.seed, in.stream,
-                                    space.width, batch, strata, &traced_v)) {
-              v = traced_v;
-              local_rays += batch.size();
-            }
-            ++local_traced;
-          }
+          // Nothing blocks the light, but where most of it is below the horizon the reference's
+          // samples may all fall there, and it then leaves the light out: so does this method,
+          // so that the two agree to the texel (no ray is traced for it).
+          if (in.rays && partly_below_horizon(lights[l], p, normal) &&
+              !any_sample_contributes(tx, l, lights[l], *in.rays, in.samples, in.seed, in.stream,
+                                      space.width, batch, strata))
+            continue;
+        } else if (in.rays && trace[l][t]) {
+          Vec3 traced_v;
+          ++local_traced;
+          // As the reference does: a light none of whose samples contributes is left out.
+          if (!estimate_visibility(tx, l, lights[l], *in.rays, in.samples, in.seed, in.stream,
+                                   space.width, batch, strata, &traced_v))
+            continue;
+          v = traced_v;
+          local_rays += batch.size();
         }
         const Vec3 w =
             weights_needed ? lights[l].unoccluded_irradiance(p, normal) : lights[l].exitance();
