@@ -14,7 +14,7 @@
 //   normal and every UV channel are bitwise equal (weld_vertices), so OpenMesh sees the shared
 //   vertices and connectivity of each chart and no seam of any channel is lost.
 // - Before Assimp reads a file, check_mesh_file (mesh_file_checks.h) refuses files it would
-//   misread or exhaust memory on; Assimp then reads it in a child process (mesh_reader.h), so a
+//   misread or exhaust memory on; Assimp then reads it in a helper process (mesh_reader.h), so a
 //   crash, a hang or a runaway allocation inside Assimp is an error too; Assimp's own warnings
 //   that it dropped faces are errors here.
 // - obj.transform is applied here, in double precision: points by the affine map, normals by the

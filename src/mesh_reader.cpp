@@ -1,39 +1,29 @@
-// Assimp in a child process (mesh_reader.h). The child reads the file, copies what the project
-// uses into one buffer in an anonymous memory file (memfd) and ends with _exit; the parent waits
-// for it with a deadline, then checks and unpacks the buffer. Under sanitizers the child gets no
-// memory limit (their shadow memory needs terabytes of address space).
+// Assimp in a process of its own (mesh_reader.h): read_mesh_file starts the helper executable
+// shadowbake_mesh_reader (cli/mesh_reader/main.cpp) with posix_spawn, handing it an anonymous
+// memory file (memfd) as descriptor 3; the helper reads the file, writes what the project uses
+// there and exits; the parent waits for it with a deadline, then checks and unpacks the buffer.
+// A spawned program, not a forked copy of this one: a fork of a process whose other threads
+// (TBB's, a sanitizer's allocator) hold a lock gives a child that may wait on it for ever, as a
+// bake in the AddressSanitizer suite did.
 #include "mesh_reader.h"
 
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
+#include <fcntl.h>
 #include <fmt/format.h>
 #include <signal.h>
+#include <spawn.h>
 #include <sys/mman.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
-#include <assimp/DefaultLogger.hpp>
-#include <assimp/Importer.hpp>
-#include <assimp/LogStream.hpp>
 
 #include <chrono>
-#include <csignal>
+#include <cstdlib>
 #include <cstring>
-#include <exception>
-#include <fstream>
 #include <mutex>
 #include <string_view>
+#include <system_error>
 #include <thread>
 
 #include "memory_budget.h"
-
-#if defined(__SANITIZE_ADDRESS__)
-#define SB_UNDER_SANITIZER 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define SB_UNDER_SANITIZER 1
-#endif
-#endif
 
 namespace sb {
 
@@ -46,47 +36,6 @@ int RawMeshPart::uv_channel_count() const {
 }
 
 namespace {
-
-constexpr std::uint32_t kMagic = 0x524d4253;  // "SBMR"
-
-// Assimp's log: one global logger, whose stream collects what the reader warns about.
-class CapturedLog : public Assimp::LogStream {
- public:
-  void write(const char* message) override {
-    std::string m = message ? message : "";
-    while (!m.empty() && (m.back() == '\n' || m.back() == '\r')) m.pop_back();
-    messages.push_back(std::move(m));
-  }
-  std::vector<std::string> messages;
-};
-
-CapturedLog& assimp_log() {
-  static CapturedLog* log = [] {
-    Assimp::DefaultLogger::create("", Assimp::Logger::NORMAL, 0);
-    auto* stream = new CapturedLog;  // owned by the logger from here on
-    Assimp::DefaultLogger::get()->attachStream(stream, Assimp::Logger::Warn | Assimp::Logger::Err);
-    return stream;
-  }();
-  return *log;
-}
-
-class Writer {
- public:
-  template <class T>
-  void put(const T& v) {
-    bytes.append(reinterpret_cast<const char*>(&v), sizeof v);
-  }
-  void put_string(const std::string& s) {
-    put(std::uint64_t(s.size()));
-    bytes.append(s);
-  }
-  template <class T>
-  void put_array(const std::vector<T>& v) {
-    put(std::uint64_t(v.size()));
-    if (!v.empty()) bytes.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
-  }
-  std::string bytes;
-};
 
 class Reader {
  public:
@@ -121,90 +70,13 @@ class Reader {
   std::size_t at_ = 0;
 };
 
-std::string one_line(std::string text) {
-  for (char& c : text) {
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = ' ';
-  }
-  while (!text.empty() && text.back() == ' ') text.pop_back();
-  return text;
-}
-
-// What the child does: read, copy out, pack. Status 0 and the parts, or 1 and the error.
-std::string read_and_pack(const fs::path& file) {
-  Writer out;
-  out.put(kMagic);
-  CapturedLog& log = assimp_log();
-  log.messages.clear();
-  std::string error;
-  std::vector<RawMeshPart> parts;
-  try {
-    Assimp::Importer importer;
-    const unsigned flags = aiProcess_Triangulate | aiProcess_PreTransformVertices |
-                           aiProcess_GenSmoothNormals | aiProcess_ValidateDataStructure;
-    const aiScene* scene = importer.ReadFile(file.string(), flags);
-    if (!scene) {
-      error = one_line(importer.GetErrorString());
-    } else if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) {
-      error = "the file holds no complete mesh";
-    } else {
-      for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-        const aiMesh* am = scene->mMeshes[m];
-        RawMeshPart part;
-        const auto copy = [&](const aiVector3D* v, std::vector<float>& to) {
-          to.resize(std::size_t(am->mNumVertices) * 3);
-          for (unsigned i = 0; i < am->mNumVertices; ++i) {
-            to[3 * i] = v[i].x;
-            to[3 * i + 1] = v[i].y;
-            to[3 * i + 2] = v[i].z;
-          }
-        };
-        copy(am->mVertices, part.positions);
-        if (am->HasNormals()) copy(am->mNormals, part.normals);
-        for (unsigned c = 0; c < unsigned(kMaxUvChannels); ++c) {
-          if (!am->HasTextureCoords(c)) break;  // channels are used from 0 on
-          copy(am->mTextureCoords[c], part.uvs[c]);
-        }
-        for (unsigned f = 0; f < am->mNumFaces; ++f) {
-          const aiFace& face = am->mFaces[f];
-          if (face.mNumIndices != 3) continue;
-          for (unsigned k = 0; k < 3; ++k) {
-            if (face.mIndices[k] >= am->mNumVertices) {
-              error = fmt::format("mesh {} face {} names vertex {} of {}", m, f, face.mIndices[k],
-                                  am->mNumVertices);
-              break;
-            }
-            part.triangles.push_back(face.mIndices[k]);
-          }
-        }
-        parts.push_back(std::move(part));
-      }
-    }
-  } catch (const std::exception& e) {
-    error = one_line(e.what());
-  }
-  out.put(std::uint32_t(error.empty() ? 0 : 1));
-  out.put_string(error);
-  out.put(std::uint64_t(log.messages.size()));
-  for (const std::string& m : log.messages) out.put_string(one_line(m));
-  out.put(std::uint64_t(error.empty() ? parts.size() : 0));
-  if (error.empty()) {
-    for (const RawMeshPart& p : parts) {
-      out.put_array(p.positions);
-      out.put_array(p.normals);
-      for (const auto& uv : p.uvs) out.put_array(uv);
-      out.put_array(p.triangles);
-    }
-  }
-  return out.bytes;
-}
-
 Expected<RawMeshFile> unpack(std::string_view bytes) {
   Reader in(bytes);
   std::uint32_t magic = 0, status = 0;
   std::string error;
   std::uint64_t messages = 0, parts = 0;
   const auto broken = [] { return scene_error("the mesh reader's answer is incomplete"); };
-  if (!in.get(magic) || magic != kMagic || !in.get(status) || !in.get_string(error) ||
+  if (!in.get(magic) || magic != kMeshReaderMagic || !in.get(status) || !in.get_string(error) ||
       !in.get(messages))
     return broken();
   RawMeshFile file;
@@ -237,46 +109,69 @@ Expected<RawMeshFile> unpack(std::string_view bytes) {
   return file;
 }
 
-// Forks are made one at a time: the child of a process that forks from two threads at once could
-// inherit a lock another thread held.
-std::mutex kForkMutex;
+// Spawns are made one at a time, so that the descriptor made inheritable for one helper is not
+// inherited by another.
+std::mutex spawn_mutex;
+
+// The helper: $SHADOWBAKE_MESH_READER, else beside the running program (an installed or built
+// shadowbake, its tests and tools), else where this build put it.
+fs::path helper_path() {
+  if (const char* env = std::getenv("SHADOWBAKE_MESH_READER"); env && *env) return env;
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const fs::path beside = self.parent_path() / "shadowbake_mesh_reader";
+    if (fs::is_regular_file(beside, ec)) return beside;
+  }
+#ifdef SB_MESH_READER_BUILT
+  return SB_MESH_READER_BUILT;
+#else
+  return "shadowbake_mesh_reader";
+#endif
+}
 
 }  // namespace
 
 Expected<RawMeshFile> read_mesh_file(const fs::path& file, const MeshReadLimits& limits) {
-  const std::lock_guard lock(kForkMutex);
+  const fs::path helper = helper_path();
+  std::string path = file.string(), memory = std::to_string(limits.max_memory),
+              program = helper.string();
+  std::vector<char*> argv = {program.data(), path.data(), memory.data(), nullptr};
+
+  const std::unique_lock lock(spawn_mutex);
   const int fd = ::memfd_create("shadowbake-mesh", MFD_CLOEXEC);
   if (fd < 0)
     return scene_error(std::string("cannot start the mesh reader: ") + std::strerror(errno));
-  std::fflush(nullptr);
-  const pid_t pid = ::fork();
-  if (pid < 0) {
-    ::close(fd);
-    return scene_error(std::string("cannot start the mesh reader: ") + std::strerror(errno));
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+  if (fd != 3) {
+    posix_spawn_file_actions_adddup2(&actions, fd, 3);  // the copy is inherited
+  } else {
+    ::fcntl(fd, F_SETFD, 0);
   }
-  if (pid == 0) {
-    // A crash of Assimp's ends the child with its signal, which the parent reports; handlers
-    // inherited from the parent (a sanitizer's, a fuzzer's) would report it as their own.
-    for (const int signal : {SIGSEGV, SIGBUS, SIGILL, SIGFPE, SIGABRT})
-      std::signal(signal, SIG_DFL);
-#ifndef SB_UNDER_SANITIZER
-    // Heap and anonymous mappings beyond what the process already holds.
-    struct rlimit data = {};
-    std::ifstream status("/proc/self/status");
-    std::uint64_t held_kib = 0;
-    for (std::string line; std::getline(status, line);)
-      if (line.rfind("VmData:", 0) == 0) held_kib = std::stoull(line.substr(7));
-    data.rlim_cur = data.rlim_max = rlim_t(held_kib * 1024 + limits.max_memory);
-    ::setrlimit(RLIMIT_DATA, &data);
-#endif
-    const std::string packed = read_and_pack(file);
-    std::size_t written = 0;
-    while (written < packed.size()) {
-      const ssize_t n = ::write(fd, packed.data() + written, packed.size() - written);
-      if (n <= 0) ::_exit(3);
-      written += std::size_t(n);
-    }
-    ::_exit(0);
+  // Signals at their defaults and none blocked: a crash ends the helper with its signal, which
+  // is reported below, whatever the parent (a sanitizer, a fuzzer, the CLI's SIGINT) set up.
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  sigset_t all, none;
+  sigfillset(&all);
+  sigemptyset(&none);
+  posix_spawnattr_setsigdefault(&attributes, &all);
+  posix_spawnattr_setsigmask(&attributes, &none);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETSIGMASK);
+  pid_t pid = 0;
+  const int spawned =
+      ::posix_spawn(&pid, program.c_str(), &actions, &attributes, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  posix_spawnattr_destroy(&attributes);
+  if (fd == 3) ::fcntl(fd, F_SETFD, FD_CLOEXEC);
+  if (spawned != 0) {
+    ::close(fd);
+    return scene_error(
+        fmt::format("cannot start the mesh reader {}: {}", program, std::strerror(spawned)));
   }
 
   // Wait, with a deadline.
@@ -323,6 +218,9 @@ Expected<RawMeshFile> read_mesh_file(const fs::path& file, const MeshReadLimits&
         fmt::format("Assimp crashed reading it (signal {}); the file is broken or "
                     "of a kind it misreads",
                     signal));
+  }
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 127) {
+    return scene_error(fmt::format("cannot start the mesh reader {}", program));
   }
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || bytes.empty()) {
     return scene_error(fmt::format(

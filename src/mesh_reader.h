@@ -1,8 +1,9 @@
 // Reading a mesh file with Assimp, isolated in a child process. Assimp 5.2 (Debian) crashes,
 // hangs or exhausts memory on some broken files (the fuzzer finds such files in minutes, in its
 // PLY, glTF and FBX readers); a lightmap baker must refuse them with a message, not die with
-// them. So the file is read in a forked child under a memory limit and a time limit, and comes
-// back as plain arrays; a child that crashes, runs out of time or memory is an error naming what
+// them. So the file is read in a helper process (shadowbake_mesh_reader, beside the program or
+// named by $SHADOWBAKE_MESH_READER) under a memory limit and a time limit, and comes back as
+// plain arrays; a helper that crashes, runs out of time or memory is an error naming what
 // happened.
 #pragma once
 
@@ -17,6 +18,12 @@
 namespace sb {
 
 inline constexpr int kMaxUvChannels = 8;  // Assimp's AI_MAX_NUMBER_OF_TEXTURECOORDS
+
+// The helper's answer, in this machine's byte order: this magic; a status (u32: 0 read, 1
+// failed); the error (u64 length, bytes); Assimp's messages (u64 count, each a string); the parts
+// (u64 count; each: positions, normals, kMaxUvChannels UV arrays, triangles, each array a u64
+// count and its elements).
+inline constexpr std::uint32_t kMeshReaderMagic = 0x524d4253;  // "SBMR"
 
 // One of the file's meshes after Assimp's triangulation and pre-transformation: per vertex 3
 // floats of position, and of normal and of each UV channel where present (empty otherwise); the

@@ -4,14 +4,18 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <numbers>
 #include <string>
+#include <thread>
 #include <vector>
 
+#include <stdlib.h>
 #include <unistd.h>
 
 #include "mesh.h"
@@ -254,6 +258,38 @@ TEST_F(MeshImport, RejectsGarbageFile) {
   const auto empty = import_mesh(object(write("empty.obj", "")), scene_file());
   ASSERT_FALSE(empty);
   EXPECT_NE(empty.error().message.find("empty.obj"), std::string::npos);
+}
+
+// Assimp runs in a spawned helper, not a forked copy of this process: a fork while another thread
+// holds an allocator's lock gave a child that never finished (the AddressSanitizer suite, 60 s).
+TEST_F(MeshImport, ReadsWhileOtherThreadsAllocate) {
+  const fs::path quad = write("quad.obj", kQuadObj);
+  std::atomic<bool> stop{false};
+  std::vector<std::thread> busy;
+  for (int k = 0; k < 2; ++k)
+    busy.emplace_back([&stop, k] {
+      std::vector<std::unique_ptr<char[]>> held(64);
+      for (std::size_t i = 0; !stop; ++i)
+        held[i % held.size()].reset(new char[16 + (i * 37 + k) % 4096]);
+    });
+  for (int i = 0; i < 20; ++i) {
+    const auto mesh = import_mesh(object(quad), scene_file());
+    EXPECT_TRUE(mesh) << i << ": " << mesh.error().message;
+  }
+  stop = true;
+  for (auto& t : busy) t.join();
+}
+
+TEST_F(MeshImport, NamesAMissingMeshReader) {
+  ::setenv("SHADOWBAKE_MESH_READER", (dir_ / "no_such_reader").c_str(), 1);
+  const auto mesh = import_mesh(object(write("quad.obj", kQuadObj)), scene_file());
+  ::unsetenv("SHADOWBAKE_MESH_READER");
+  ASSERT_FALSE(mesh);
+  EXPECT_NE(mesh.error().message.find("quad.obj"), std::string::npos) << mesh.error().message;
+  EXPECT_NE(mesh.error().message.find("cannot start the mesh reader"), std::string::npos)
+      << mesh.error().message;
+  EXPECT_NE(mesh.error().message.find("no_such_reader"), std::string::npos);
+  EXPECT_EQ(mesh.error().message.find('\n'), std::string::npos);
 }
 
 TEST_F(MeshImport, RejectsFileWithoutTriangles) {

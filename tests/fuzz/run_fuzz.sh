@@ -6,7 +6,7 @@
 set -euo pipefail
 here=$(cd "$(dirname "$0")/../.." && pwd)
 seconds=${1:-60}
-build=${2:-$here/build-fuzz}
+build=$(realpath -m "${2:-$here/build-fuzz}")
 cmake -S "$here" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DSHADOWBAKE_FUZZ=ON \
   -DSHADOWBAKE_TESTS=OFF >/dev/null

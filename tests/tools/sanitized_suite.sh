@@ -7,7 +7,7 @@
 # OpenMesh's headers; the default build (SHADOWBAKE_WERROR) checks warnings.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/../.." && pwd)
-build=${1:-$here/build-sanitize}
+build=$(realpath -m "${1:-$here/build-sanitize}")
 cmake -S "$here" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DSHADOWBAKE_SANITIZE=address,undefined -DSHADOWBAKE_WERROR=OFF >/dev/null
 cmake --build "$build"
