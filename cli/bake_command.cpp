@@ -66,6 +66,7 @@ struct BakeArgs {
   bool quiet = false;
   bool explain = false;
   bool no_trace = false;
+  bool no_convolve = false;
 };
 
 // --explain: what the convolution method chose for each light and receiver, and what it cost.
@@ -123,6 +124,7 @@ int run_bake(const BakeArgs& args) {
   if (args.error_texels) settings.error_texels = *args.error_texels;
   if (args.max_memory) settings.max_memory = *args.max_memory;
   if (args.no_trace) settings.trace = false;
+  if (args.no_convolve) settings.convolve = false;
 
   // The output folder is locked and its names checked before the bake, so a bake that could not
   // publish its files fails in a second, not after its work.
@@ -216,6 +218,9 @@ Runner add_bake_command(CLI::App& app) {
   bake->add_flag("--no-trace", o->args.no_trace,
                  "convolution: trace no shadow rays, even where it cannot vouch for its values "
                  "(overrides [bake] trace)");
+  bake->add_flag("--no-convolve", o->args.no_convolve,
+                 "convolution: skip the convolution, trace every pair the shaft test keeps "
+                 "(overrides [bake] convolve)");
   bake->add_flag("--explain", o->args.explain,
                  "print, per light and receiver, the convolution's direction, planes, error "
                  "metric, image sizes and stage times");

@@ -78,6 +78,10 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     return scene_error(scene.file.string() + ": [bake]: unknown method '" + scene.bake.method +
                        "' (known: " + known + ")");
   }
+  if (scene.bake.method == "convolution" && !scene.bake.convolve && !scene.bake.trace)
+    return scene_error(scene.file.string() +
+                       ": [bake]: convolve = false needs trace = true (with neither, nothing "
+                       "would compute the shadows)");
   const std::vector<MemoryItem> estimate = bake_memory_estimate(scene);
   if (Status fits = check_memory(scene, estimate, memory_budget(scene.bake),
                                  "lower 'resolution' (--resolution) or raise max_memory "
@@ -110,7 +114,7 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   ClusterTree clusters;
   std::optional<ShaftCuller> culler;
   if (method == "convolution") {
-    clusters = build_clusters(blockers);
+    if (scene.bake.convolve || !scene.bake.trace) clusters = build_clusters(blockers);
     culler.emplace(blockers);
   }
   auto lights_or = make_lights(scene.lights, scene.file);
@@ -232,6 +236,7 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
       traced.convolution = in;
       traced.culler = &*culler;
       traced.rays = rays ? &*rays : nullptr;
+      traced.convolve = scene.bake.convolve;
       traced.samples = scene.bake.samples;
       traced.trace_error_texels = scene.bake.trace_error_texels;
       traced.seed = scene.bake.seed;

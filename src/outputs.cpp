@@ -112,6 +112,10 @@ Status write_outputs(OutputFolder& folder, const Scene& scene, const BakeSetting
   manifest["samples"] = effective.samples;
   manifest["seed"] = effective.seed;
   manifest["margin"] = effective.margin;
+  if (effective.method == "convolution") {
+    manifest["trace"] = effective.trace;
+    manifest["convolve"] = effective.convolve;
+  }
   manifest["lights"] = nlohmann::ordered_json::array();
   for (const auto& l : scene.lights) {
     manifest["lights"].push_back({{"name", l.name}, {"shape", to_string(l.shape)}});

@@ -37,6 +37,10 @@ struct BakeSettings {
   // penumbra error exceeds trace_error_texels, or which a blocker may shadow unaccounted for
   // (traced_convolution.h); false: the convolution's values stand everywhere
   bool trace = true;
+  // convolution: false skips the convolution, so that the shaft test's clear pairs are V = 1 and
+  // every other pair is traced (needs trace): what the convolution contributes is measured
+  // against this (docs/performance.md)
+  bool convolve = true;
   double trace_error_texels = 1.0;
   std::string blocker_combine = "sum";  // how blocker clusters combine: "product" or "sum"
   // What the convolution's V averages the light's points by: "irradiance" (cos·cos/r², to first

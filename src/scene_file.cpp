@@ -298,8 +298,8 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
   TableReader r(file, table, "[bake]");
   r.check_known_keys({"resolution", "method", "quantity", "samples", "margin", "seed", "max_memory",
                       "error_texels", "max_image", "max_triples", "light_parts", "trace",
-                      "trace_error_texels", "blocker_combine", "weighting", "shadow_map",
-                      "pcf_radius", "erosion_factor"});
+                      "convolve", "trace_error_texels", "blocker_combine", "weighting",
+                      "shadow_map", "pcf_radius", "erosion_factor"});
   BakeSettings bake;
   const int int_max = std::numeric_limits<int>::max();
   if (auto v = r.integer("resolution", 1, 16384)) bake.resolution = static_cast<int>(*v);
@@ -339,6 +339,7 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
   }
   if (auto v = r.number("error_texels", "a number > 0", is_positive)) bake.error_texels = *v;
   if (auto v = r.boolean("trace")) bake.trace = *v;
+  if (auto v = r.boolean("convolve")) bake.convolve = *v;
   if (auto v = r.number("trace_error_texels", "a number >= 0",
                         [](double x) { return std::isfinite(x) && x >= 0; })) {
     bake.trace_error_texels = *v;

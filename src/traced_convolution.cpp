@@ -73,8 +73,14 @@ Expected<Image> bake_traced_convolution(const TexelSpace& space, const TracedCon
     conv.maybe_blocked = &maybe;
   }
   ConvolutionVisibility per_light;
-  auto convolved = bake_convolution(space, conv, reports, plan, &per_light);
-  if (!convolved) return convolved.error();
+  if (in.convolve || !in.rays) {
+    auto convolved = bake_convolution(space, conv, reports, plan, &per_light);
+    if (!convolved) return convolved.error();
+  } else {  // no leaf: every pair the shaft test keeps is traced
+    per_light.visible.resize(lights.size());
+    per_light.reached.resize(lights.size());
+    per_light.error_texels.resize(lights.size());
+  }
 
   // Which (light, texel) pairs are traced. The convolution's penumbra values are approximate
   // beyond what ε measures (the slabs' shares, the first-order weighting), so a texel it finds

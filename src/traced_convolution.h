@@ -20,6 +20,7 @@ struct TracedConvolutionInputs {
   ConvolutionInputs convolution;
   const ShaftCuller* culler = nullptr;  // null: no shaft test, the convolution shades every pair
   const RayScene* rays = nullptr;       // null: no rays, the convolution's values stand
+  bool convolve = true;                 // false: no convolution, every pair not clear is traced
   int samples = 64;                     // rays per light per traced texel
   double trace_error_texels = 1.0;      // leaves' ε above this are traced
   std::uint64_t seed = 0, stream = 0;   // as the reference's, so a traced texel matches it

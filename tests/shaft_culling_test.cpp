@@ -5,12 +5,15 @@
 // what is lit, so that methods may skip it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <string>
 #include <vector>
 
 #include <tbb/parallel_for.h>
 
+#include "bake.h"
 #include "lights.h"
 #include "mesh.h"
 #include "ray_scene.h"
@@ -18,6 +21,7 @@
 #include "scene.h"
 #include "shadow_rays.h"
 #include "shaft_culling.h"
+#include "test_scenes.h"
 #include "texel_space.h"
 
 namespace sb {
@@ -101,6 +105,45 @@ INSTANTIATE_TEST_SUITE_P(Corpus, ShaftCulling,
                              if (ch == '/' || ch == '.') ch = '_';
                            return n;
                          });
+
+}  // namespace
+}  // namespace sb
+
+namespace sb {
+namespace {
+
+// The convolution method without its convolution (convolve = false): the shaft test's clear
+// pairs are V = 1 and every other pair takes the reference's own estimate, so the bake is the
+// reference's, texel for texel, on a scene with two lights and contact.
+TEST(ShaftCullingBake, WithoutConvolutionEqualsTheReference) {
+  Scene reference = test_scenes::load("showcase", 64, "reference");
+  reference.bake.samples = 16;
+  Scene shaft = reference;
+  shaft.bake.method = "convolution";
+  shaft.bake.trace = true;
+  shaft.bake.convolve = false;
+  auto a = bake(reference);
+  auto b = bake(shaft);
+  ASSERT_TRUE(a) << a.error().message;
+  ASSERT_TRUE(b) << b.error().message;
+  ASSERT_EQ(a->receivers.size(), b->receivers.size());
+  for (std::size_t r = 0; r < a->receivers.size(); ++r) {
+    const Image& x = a->receivers[r].image;
+    const Image& y = b->receivers[r].image;
+    ASSERT_EQ(x.pixels.size(), y.pixels.size());
+    double worst = 0;
+    for (std::size_t i = 0; i < x.pixels.size(); ++i)
+      worst = std::max(worst, double(std::abs(x.pixels[i] - y.pixels[i])));
+    EXPECT_LT(worst, 1e-5) << a->receivers[r].name;
+  }
+  EXPECT_LT(b->shadow_rays, a->shadow_rays);  // the clear pairs took none
+
+  shaft.bake.trace = false;
+  auto neither = bake(shaft);
+  ASSERT_FALSE(neither);
+  EXPECT_NE(neither.error().message.find("convolve = false needs trace = true"), std::string::npos)
+      << neither.error().message;
+}
 
 }  // namespace
 }  // namespace sb

@@ -41,7 +41,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct Variant {
-  std::string label, family;  // family: "reference" or "convolution"
+  std::string label, family;  // "reference", "convolution" (the curves), "alone", "shaft"
   std::string method;
   std::vector<std::pair<std::string, std::string>> cli;  // overrides, as the CLI takes them
   std::function<void(sb::BakeSettings&)> apply;
@@ -72,6 +72,17 @@ std::vector<Variant> variants() {
                    b.trace = true;
                  }});
   }
+  // What the convolution contributes to the whole method: the same method with the convolution
+  // skipped (the shaft test, then rays at every pair it keeps; the reference's values).
+  v.push_back({"shaft-rays-64",
+               "shaft",
+               "convolution",
+               {{"--samples", "64"}, {"--no-convolve", ""}},
+               [](sb::BakeSettings& b) {
+                 b.samples = 64;
+                 b.trace = true;
+                 b.convolve = false;
+               }});
   return v;
 }
 
