@@ -1,11 +1,11 @@
 // The corpus benchmark (issue "The convolution method on the scenes artists bring"): for every
 // scene of the corpus and every receiver, each variant's in-process bake time (median of
 // --repeat runs, side by side in one program), its RMSE against the reference at
-// --truth-samples (covered texels), the peak memory of a whole `shadowbake bake` process, and
-// the equal-error speed ratio: the time each family (the reference at 16/64/256 samples; the
-// convolution at its settings) needs to reach RMSE --target, interpolated on its error curve
-// (log RMSE against log time, between the two points around the target; beyond them, from the
-// last two, marked '~').
+// --truth-samples (covered texels), the peak memory of a whole `shadowbake bake` process (its
+// VmHWM), and the equal-error speed ratio: the time each family (the reference at 16/64/256
+// samples; the convolution at its settings) needs to reach RMSE --target, interpolated on its
+// error curve (log RMSE against log time, between the two points around the target; beyond
+// them, from the last two, marked '~').
 //
 // A receiver's time is its own texel space, method and dilation, plus a share of the scene's
 // load (meshes, rays, clusters) in proportion to its texels.
@@ -15,7 +15,6 @@
 // The references at --truth-samples are cached under out/corpus-truth/ (keyed by the scene
 // file's bytes, resolution and samples), so later runs only bake the variants.
 #include <fmt/core.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <nlohmann/json.hpp>
@@ -141,12 +140,21 @@ double process_peak_mib(const std::string& scene, const Variant& v, int resoluti
     ::execv(SB_CLI, argv.data());
     ::_exit(127);
   }
+  // The child's own high-water mark (VmHWM, of its address space after exec), read every 5 ms
+  // until it ends. Not wait4's ru_maxrss: Linux folds into it the resident size of the forked
+  // copy of this process before exec, so it would report this benchmark's own memory.
   int status = 0;
-  struct rusage usage = {};
-  ::wait4(pid, &status, 0, &usage);
+  double peak_kib = 0;
+  const std::string proc = "/proc/" + std::to_string(pid) + "/status";
+  while (::waitpid(pid, &status, WNOHANG) == 0) {
+    std::ifstream in(proc);
+    for (std::string line; std::getline(in, line);)
+      if (line.rfind("VmHWM:", 0) == 0) peak_kib = std::max(peak_kib, std::stod(line.substr(6)));
+    ::usleep(5000);
+  }
   fs::remove_all(out);
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) return NAN;
-  return double(usage.ru_maxrss) / 1024.0;
+  return peak_kib / 1024.0;
 }
 
 // Time at RMSE `target` on a family's curve of (time, rmse) points; `extrapolated` when the
