@@ -148,8 +148,12 @@ double process_peak_mib(const std::string& scene, const Variant& v, int resoluti
   const std::string proc = "/proc/" + std::to_string(pid) + "/status";
   while (::waitpid(pid, &status, WNOHANG) == 0) {
     std::ifstream in(proc);
-    for (std::string line; std::getline(in, line);)
-      if (line.rfind("VmHWM:", 0) == 0) peak_kib = std::max(peak_kib, std::stod(line.substr(6)));
+    bool execed = false;  // before exec the child is a copy of this benchmark
+    for (std::string line; std::getline(in, line);) {
+      if (line.rfind("Name:", 0) == 0) execed = line == "Name:\tshadowbake";
+      if (execed && line.rfind("VmHWM:", 0) == 0)
+        peak_kib = std::max(peak_kib, std::stod(line.substr(6)));
+    }
     ::usleep(5000);
   }
   fs::remove_all(out);
