@@ -11,11 +11,11 @@
 #include <optional>
 #include <string>
 
-#include "bake.h"
+#include "pipeline/bake.h"
 #include "commands.h"
-#include "memory_budget.h"
-#include "outputs.h"
-#include "scene.h"
+#include "pipeline/memory_budget.h"
+#include "pipeline/outputs.h"
+#include "scene/scene.h"
 
 namespace sbcli {
 

@@ -6,7 +6,7 @@
 
 #include <functional>
 
-#include "error.h"
+#include "core/error.h"
 
 namespace sbcli {
 

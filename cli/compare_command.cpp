@@ -14,9 +14,9 @@
 #include <vector>
 
 #include "commands.h"
-#include "image_io.h"
-#include "image_metrics.h"
-#include "output_folder.h"
+#include "core/image_io.h"
+#include "evaluation/image_metrics.h"
+#include "pipeline/output_folder.h"
 
 namespace sbcli {
 

@@ -5,7 +5,7 @@
 
 #include <optional>
 
-#include "bake.h"
+#include "pipeline/bake.h"
 #include "commands.h"
 
 namespace sbcli {

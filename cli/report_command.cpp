@@ -23,8 +23,8 @@
 #include <vector>
 
 #include "commands.h"
-#include "report.h"
-#include "scene.h"
+#include "evaluation/report.h"
+#include "scene/scene.h"
 
 extern char** environ;
 

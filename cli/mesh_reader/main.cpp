@@ -1,4 +1,4 @@
-// shadowbake_mesh_reader: the process in which Assimp reads one mesh file (src/mesh_reader.h).
+// shadowbake_mesh_reader: the process in which Assimp reads one mesh file (src/scene/mesh_reader.h).
 // Started by read_mesh_file with posix_spawn (never a bare fork of a process whose other threads
 // may hold locks), it reads the file named by argv[1] under a data limit of argv[2] bytes, packs
 // what the project uses (mesh_reader.h gives the layout) and writes it to file descriptor 3.
@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "mesh_reader.h"
+#include "scene/mesh_reader.h"
 
 namespace {
 

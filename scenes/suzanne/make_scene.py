@@ -1,7 +1,7 @@
 """Suzanne on a floor, as an artist hands it over: a smooth, subdivided Suzanne whose lightmap
 UVs (Blender's Lightmap Pack) are in UV channel 1, with seams unlike those of its texture UVs in
 channel 0, exported as Y-up glTF binary. The asset of the channel-1 import test
-(tests/mesh_import_test.cpp) and a scene of the corpus.
+(tests/scene/mesh_import_test.cpp) and a scene of the corpus.
 
     blender -b --factory-startup -P scenes/suzanne/make_scene.py
 """

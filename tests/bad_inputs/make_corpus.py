@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes the bad-input corpus under tests/bad_inputs/: one folder per case with its scene.toml and
-files, and cases.json, which tests/bad_inputs_test.cpp reads: per case the command, the exit code
+files, and cases.json, which tests/pipeline/bad_inputs_test.cpp reads: per case the command, the exit code
 (docs/cli.md) and a phrase the one-line error (or warning) must contain. Cases that need files git
 cannot hold (a FIFO, a symbolic-link loop, /dev/zero) are made by the test itself.
 

@@ -13,8 +13,8 @@
 #include <memory>
 #include <string>
 
-#include "bake.h"
-#include "outputs.h"
+#include "pipeline/bake.h"
+#include "pipeline/outputs.h"
 
 namespace sb {
 namespace {

@@ -1,4 +1,4 @@
-// Benchmarks of the FFT convolution (src/fft_convolution.cpp) against its floor: one bare FFTW
+// Benchmarks of the FFT convolution (src/methods/convolution/fft_convolution.cpp) against its floor: one bare FFTW
 // r2c + c2r round trip of the same size, planned with FFTW_ESTIMATE (what the convolver uses) and
 // with FFTW_MEASURE (what a long-running program could afford). Convolve adds the padding copy,
 // the spectrum product and the output copy to the round trip; the aim is to stay within 2× of
@@ -18,7 +18,7 @@
 #include <utility>
 #include <vector>
 
-#include "fft_convolution.h"
+#include "methods/convolution/fft_convolution.h"
 
 namespace sb {
 namespace {

@@ -1,4 +1,4 @@
-// How long measuring a lightmap against its reference takes (src/image_metrics.cpp): SSIM of one
+// How long measuring a lightmap against its reference takes (src/evaluation/image_metrics.cpp): SSIM of one
 // 2048² channel, and a whole three-channel comparison, on smooth deterministic patterns.
 //
 // Run: build/shadowbake_bench --benchmark_filter=Ssim\|Compare --benchmark_repetitions=5
@@ -7,7 +7,7 @@
 
 #include <cmath>
 
-#include "image_metrics.h"
+#include "evaluation/image_metrics.h"
 
 namespace sb {
 namespace {

@@ -6,12 +6,12 @@
 #include <string>
 #include <vector>
 
-#include "lights.h"
-#include "mesh.h"
-#include "ray_scene.h"
-#include "scene.h"
-#include "shaft_culling.h"
-#include "texel_space.h"
+#include "scene/lights.h"
+#include "scene/mesh.h"
+#include "occluders/ray_scene.h"
+#include "scene/scene.h"
+#include "occluders/shaft_culling.h"
+#include "texels/texel_space.h"
 
 namespace sb {
 namespace {

@@ -13,7 +13,7 @@
 #include <algorithm>
 #include <string>
 
-#include "bake.h"
+#include "pipeline/bake.h"
 
 namespace sb {
 namespace {

@@ -20,12 +20,12 @@
 #include <string>
 #include <string_view>
 
-#include "lights.h"
-#include "mesh.h"
-#include "mesh_file_checks.h"
-#include "scene.h"
-#include "texel_space.h"
-#include "uv_checks.h"
+#include "scene/lights.h"
+#include "scene/mesh.h"
+#include "scene/mesh_file_checks.h"
+#include "scene/scene.h"
+#include "texels/texel_space.h"
+#include "texels/uv_checks.h"
 
 namespace {
 

@@ -31,9 +31,9 @@
 #include <string>
 #include <vector>
 
-#include "bake.h"
-#include "image_io.h"
-#include "scene.h"
+#include "pipeline/bake.h"
+#include "core/image_io.h"
+#include "scene/scene.h"
 
 namespace {
 

@@ -1,0 +1,295 @@
+// The error-driven hierarchy of the convolution method (design-notes §4–5; Soler & Sillion's
+// blocker, receiver and source subdivision, ../shared/seeds/001_414ff95054935c53.txt): for one
+// receiver, the (light part, blocker cluster, receiver part) triples whose convolutions together
+// give its soft shadows, each with its virtual configuration, penumbra error ε and image size.
+// Built by plan_convolution (convolution_plan.cpp) without convolving anything, so that
+// `shadowbake plan` can print it; executed by bake_convolution (convolution_bake.cpp).
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "methods/convolution/blocker_image.h"
+#include "scene/lights.h"
+#include "scene/mesh.h"
+#include "texels/texel_space.h"
+#include "occluders/virtual_configuration.h"
+
+namespace sb {
+
+struct ClusterTree;
+
+// How the occluded fractions O_i of different blocker clusters over one texel combine
+// (design-notes §5): `product` takes V = ∏(1 − O_i), clusters hiding independent parts of the
+// light; `sum` takes V = 1 − Σ O_i, clusters hiding disjoint parts. docs/methods.md has the
+// measurement that chose the default.
+enum class BlockerCombine { product, sum };
+
+struct PlanInputs {
+  const std::vector<Light>* lights = nullptr;
+  const Mesh* receiver = nullptr;
+  // Every blocker mesh (the receiver's own too, when it is a blocker) and their cluster
+  // hierarchy, built over exactly these meshes in this order.
+  std::vector<const Mesh*> blockers;
+  const ClusterTree* clusters = nullptr;
+  double error_texels = 1.0;  // the target ε, in receiver texels
+  int max_image = 4096;       // largest image side, pixels
+  int max_triples = 512;      // leaves per light: the work budget
+  // Each untextured rectangular light whose plan cuts blockers into depth slabs is split into at
+  // least this many parts (1, 2 or 4), whatever ε says: the slabs' error in the shares and in
+  // Euler's count scales with the light's size and ε does not measure it (docs/methods.md).
+  int light_parts = 2;
+  // Per light (scene order) and receiver texel: 1 where a blocker may lie between them
+  // (ShaftCuller). Where given, only those texels are planned for that light: the others see all
+  // of it. Null: every texel a light reaches.
+  const std::vector<std::vector<std::uint8_t>>* maybe_blocked = nullptr;
+  // What tracing one texel of a footprint costs, in the FFT pixel-log units of Triple::cost
+  // (0: the bake traces nothing). A leaf dearer to convolve than its footprint is to trace is
+  // traced and not refined further: costs are compared before either is paid.
+  double ray_cost_per_texel = 0;
+  // Leaves whose ε stays above this are traced too (negative: never, for ε alone).
+  double trace_error_texels = -1;
+  // The convolution's work budget, in Triple::cost units per planned texel (0: none): the
+  // leaves of a light part cost at most this much in all (refinement stops there), and a leaf
+  // at most this much per texel of its footprint (its images are made coarser).
+  double cost_budget_per_texel = 0;
+};
+
+// A shadow ray's cost in Triple::cost units (FFT pixel-log): 80 ns per ray and core (the
+// showcase's reference at 64 samples, 72 M rays in 2.9 s on 2 cores) against 0.64 ns per unit
+// (a 512² r2c and c2r pair in 3 ms, 4.7 M units).
+inline constexpr double kRayCostUnits = 125;
+
+// One side of a receiver split: the part's texels have depth below (or above) `depth`, blended
+// linearly with the other side's over depth ± band so that no seam shows.
+struct ReceiverCut {
+  double depth = 0, band = 0;
+  bool below = true;
+  double weight(double r) const {
+    const double w =
+        band > 0 ? std::clamp((depth + band - r) / (2 * band), 0.0, 1.0) : (r <= depth ? 1.0 : 0.0);
+    return below ? w : 1.0 - w;
+  }
+};
+
+// The depth interval of a receiver part: where every cut's weight is positive.
+std::pair<double, double> part_interval(const std::vector<ReceiverCut>& cuts);
+
+// A node of the hierarchy: the root of a (light part, frame), a split, or a leaf to convolve.
+struct Triple {
+  int frame = -1;     // index into ConvolutionPlan::frames
+  int group = 0;      // index into the frame's texel groups
+  int parent = -1;    // index into ConvolutionPlan::triples; -1 for a root
+  std::string split;  // how the children were made: "", "blocker depth", "blocker space",
+                      // "receiver depth"
+  std::vector<int> children;
+  // The blocker cluster: faces, and the slab of depth along D they are clipped to.
+  std::vector<FaceRef> faces;
+  double slab_lo = 0, slab_hi = 0;
+  // The receiver part: the frame's texels whose weight under every cut is positive.
+  std::vector<ReceiverCut> cuts;
+  // Evaluated: the projected blockers, the footprint's receiver texels (indices into the
+  // frame's arrays), the configuration and the image it needs.
+  bool empty = true;           // no blocker or no receiver texel: nothing to convolve
+  ProjectedBlockers blockers;  // kept for leaves only
+  // The root's projection, shared by its whole tree: the layer whose nearest surfaces decide
+  // which cluster casts each part of the hard shadow (nearest_layer_coverage).
+  std::shared_ptr<const ProjectedBlockers> layer;
+  Bounds3 receiver_box;  // world bounds of the texels it may shadow (footprint, or the group)
+  DepthRange blocker_depths, receiver_depths;
+  VirtualConfiguration config;
+  // The kernel is exact for receiver points seen along `view`; a tilted light (its points spread
+  // over depths ±z across D) seen from elsewhere in the footprint is sheared by up to
+  // z·|t − view|·(ρ_hi − 1) on the receiver (source_image.cpp), metres.
+  double view_error = 0;
+  // (ε + view_error) in receiver texels while the narrowest penumbra is below kRelativeSpan
+  // texels, in kRelativeSpan-ths of that penumbra beyond (convolution_plan.cpp).
+  double penumbra_error_texels = 0;
+  double smallest_penumbra = 0;  // L·(ρ_lo − 1), metres on the receiver
+  TangentGrid grid;
+  Vec2 footprint_lo = Vec2::Zero(), footprint_hi = Vec2::Zero();  // tangent box
+  // The tangent direction the light is projected along for the kernel (source_kernel): the
+  // middle of the blockers' projection.
+  Vec2 view = Vec2::Zero();
+  int fft_width = 0, fft_height = 0;
+  bool blurred = false;  // the image budget forced pixels coarser than the shadow's detail
+  double cost = 0;       // estimated work, FFT pixel-log units
+  // Not convolved: its footprint's texels are traced instead, as tracing them costs less than
+  // convolving it (PlanInputs::ray_cost_per_texel), or, when set so by the bake, as its ε stays
+  // above what tracing is for.
+  bool traced = false;
+  std::int64_t footprint_texels = 0;
+  int polygons = 0;
+  double seconds = 0;  // measured by the bake (0 in a plan)
+  // A slab of a convex closed solid (add_sections): the triple's blockers are all of one such
+  // component's faces within its slab, so its whole image is capped by the component's section
+  // at slab_lo; every face of the component, for that section.
+  std::shared_ptr<const std::vector<FaceRef>> solid_faces;
+  // Slabs of one convex solid count the lines from a texel to the light that meet it by Euler's
+  // count (convolution_bake.cpp): `euler` is the triple heading their depth splits (-1: none);
+  // a `section` leaf is the solid's section at its slab (slab_lo = slab_hi) between two of them,
+  // subtracted.
+  int euler = -1;
+  bool section = false;
+};
+
+// A uniform grid over tangent coordinates holding texel indices, so a footprint's texels are
+// found without visiting the others.
+struct TexelIndex {
+  Vec2 lo = Vec2::Zero();
+  double cell = 1;
+  int nx = 0, ny = 0;
+  std::vector<int> start;  // nx·ny + 1 offsets into items
+  std::vector<int> items;  // frame texel indices, by cell
+
+  // Per cell: the bounds of its texels' tangents, depths and positions, and their count, so a
+  // footprint that holds a whole cell takes it at once (for_each_cell).
+  struct Cell {
+    Vec2 lo, hi;
+    DepthRange depth;
+    Bounds3 box;
+    int count = 0;
+  };
+  std::vector<Cell> cells;
+  // Blocks of kBlock × kBlock cells with the same aggregates, so that a footprint covering most
+  // of a large receiver takes it a block at a time (thousands of footprints are scanned while
+  // planning).
+  static constexpr int kBlock = 8;
+  int bx = 0, by = 0;
+  std::vector<Cell> blocks;
+
+  void build(const std::vector<int>& texels, const std::vector<Vec2>& tangent,
+             const std::vector<double>& depth, const std::vector<Vec3>& position);
+  // Like for_each, but a block or cell whose texels all lie in the box and pass `whole(cell)`
+  // goes to cell(cell) instead of texel by texel.
+  template <class W, class C, class F>
+  void for_each_cell(const Vec2& box_lo, const Vec2& box_hi, W&& whole, C&& cell, F&& f) const {
+    if (nx == 0) return;
+    const int x0 = std::max(0, int((box_lo.x() - lo.x()) / this->cell));
+    const int y0 = std::max(0, int((box_lo.y() - lo.y()) / this->cell));
+    const int x1 = std::min(nx - 1, int((box_hi.x() - lo.x()) / this->cell));
+    const int y1 = std::min(ny - 1, int((box_hi.y() - lo.y()) / this->cell));
+    if (x0 > x1 || y0 > y1) return;
+    auto inside = [&](const Cell& k) {
+      return (k.lo.array() >= box_lo.array()).all() && (k.hi.array() <= box_hi.array()).all() &&
+             whole(k);
+    };
+    for (int yb = y0 / kBlock; yb <= y1 / kBlock; ++yb) {
+      for (int xb = x0 / kBlock; xb <= x1 / kBlock; ++xb) {
+        const Cell& b = blocks[std::size_t(yb) * bx + xb];
+        if (b.count == 0) continue;
+        if (inside(b)) {
+          cell(b);
+          continue;
+        }
+        const int cy1 = std::min(y1, yb * kBlock + kBlock - 1);
+        const int cx1 = std::min(x1, xb * kBlock + kBlock - 1);
+        for (int y = std::max(y0, yb * kBlock); y <= cy1; ++y) {
+          for (int x = std::max(x0, xb * kBlock); x <= cx1; ++x) {
+            const std::size_t c = std::size_t(y) * nx + x;
+            const Cell& k = cells[c];
+            if (k.count == 0) continue;
+            if (inside(k)) {
+              cell(k);
+              continue;
+            }
+            for (int i = start[c]; i < start[c + 1]; ++i) f(items[std::size_t(i)]);
+          }
+        }
+      }
+    }
+  }
+  // Calls f(i) for every texel i whose cell meets the box [lo, hi] (callers test the box).
+  template <class F>
+  void for_each(const Vec2& box_lo, const Vec2& box_hi, F&& f) const {
+    if (nx == 0) return;
+    const int x0 = std::max(0, int((box_lo.x() - lo.x()) / cell));
+    const int y0 = std::max(0, int((box_lo.y() - lo.y()) / cell));
+    const int x1 = std::min(nx - 1, int((box_hi.x() - lo.x()) / cell));
+    const int y1 = std::min(ny - 1, int((box_hi.y() - lo.y()) / cell));
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x)
+        for (int k = start[std::size_t(y) * nx + x]; k < start[std::size_t(y) * nx + x + 1]; ++k)
+          f(items[std::size_t(k)]);
+  }
+};
+
+// One light part seen through one frustum from its centre: the texels it serves.
+struct PlanFrame {
+  int light = -1;       // index into the scene's lights
+  int light_part = -1;  // index into ConvolutionPlan::light_parts
+  std::string face;     // "" for one central frustum; "+x" ... "-z" for cube faces
+  ProjectionFrame frame;
+  std::vector<std::size_t> texels;  // indices into TexelSpace::texels
+  std::vector<double> depth;        // per texel of `texels`: depth along D
+  std::vector<Vec2> tangent;        // per texel: tangent coordinates
+  std::vector<Vec3> position;       // per texel: world position
+  double near = 0;                  // texels at or before this depth cannot be projected
+  std::int64_t outside_texels = 0;  // at or behind the light's plane: left unshadowed
+  // Texels that share their blockers: all of them, or, for a receiver that is its own blocker,
+  // those of one convex component, or of one plane of a non-convex one. Indices into the arrays
+  // above, the deepest last; one root triple each.
+  std::vector<std::vector<int>> groups;
+  std::vector<TexelIndex> index;  // per group
+  std::vector<int> roots;
+};
+
+struct LightPart {
+  int light = -1;
+  std::string name;     // "panel", or "panel[0]", "panel[1]" ... for parts
+  Light part;           // the part as a light of its own
+  double fraction = 1;  // its share of the light's power
+};
+
+struct ConvolutionPlan {
+  std::string receiver;
+  const TexelSpace* space = nullptr;
+  double texel = 0;   // receiver texel size, metres
+  double target = 0;  // ε allowed, metres
+  std::vector<LightPart> light_parts;
+  std::vector<PlanFrame> frames;
+  std::vector<Triple> triples;
+  std::vector<std::string> warnings;
+
+  std::vector<int> leaves() const;
+  double worst_error_texels() const;
+  double estimated_cost() const;
+};
+
+// Plans one receiver's convolutions: per light, the frusta from its centre (one towards the lit
+// texels, or cube faces when they spread wider than 60°), and per frustum the refinement of its
+// root triple: while the worst leaf's ε exceeds the target, split it where ε falls most per unit
+// of estimated work (blocker depth, blocker space, receiver depth); when the budget runs out
+// with ε still above it, a rectangular light is split in two and planned again, keeping
+// whichever plan has the smaller worst ε.
+ConvolutionPlan plan_convolution(const TexelSpace& space, const PlanInputs& in);
+
+// Appends to `plan` the frames, texel groups and evaluated root triples of its light part
+// `light_part` (plan_frames.cpp; used by plan_convolution).
+void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part);
+
+// A new child of `parent` made by `split`: the same frame, group, slab, cuts and layer, for the
+// caller to narrow and evaluate.
+Triple child_triple(const Triple& parent, const char* split);
+
+// Marks the triples of `plan` that are slabs of convex closed solids and adds, under every depth
+// split between two of a solid's slabs, the section leaf at the split's depth (used by
+// plan_convolution; plan_sections.cpp).
+void add_sections(ConvolutionPlan& plan, const PlanInputs& in);
+
+// Evaluates one triple in place (used by the planner; exposed for tests).
+void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& triple);
+
+// The hierarchy as indented text, one line per triple, with ε, image sizes, estimated cost and
+// (after a bake) measured seconds.
+std::string describe_plan(const ConvolutionPlan& plan);
+
+// World size of one texel of `mesh`'s lightmap at width × height, metres: the square root of
+// world area per covered texel area.
+double texel_size(const Mesh& mesh, int width, int height);
+
+}  // namespace sb

@@ -1,0 +1,313 @@
+// Frames, texel groups and root triples of a convolution plan (design-notes §3): which frustum
+// from a light part's centre serves which receiver texels, which texels share their blockers,
+// and which blocker faces lie in the shaft between the light and each group. Split from
+// convolution_plan.cpp, which refines the roots made here.
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+
+#include "occluders/clusters.h"
+#include "methods/convolution/convolution_plan.h"
+
+namespace sb {
+
+namespace {
+
+// The widest angle, from the light's centre, between a receiver's texels and its frustum's axis
+// that one projection serves; beyond it the tangent plane stretches without bound (tan 60° = 1.7;
+// each leaf sizes its own pixels, so the stretch costs image size, not accuracy).
+constexpr double kMaxFrustumHalfAngleDeg = 60.0;
+
+// Points whose convex hull holds the light: the shaft's light end.
+std::vector<Vec3> light_outline(const Light& light) {
+  std::vector<Vec3> pts;
+  const Vec3 c = light.centre();
+  if (light.shape() == LightShape::rectangle) {
+    const Vec3 a = 0.5 * light.desc().width * light.right(),
+               b = 0.5 * light.desc().height * light.up();
+    for (const Vec3& p : {Vec3(c + a + b), Vec3(c + a - b), Vec3(c - a + b), Vec3(c - a - b)})
+      pts.push_back(p);
+  } else if (light.shape() == LightShape::disk) {
+    const int n = 16;  // circumscribed 16-gon
+    const double r = light.desc().radius / std::cos(std::numbers::pi / n);
+    for (int i = 0; i < n; ++i) {
+      const double phi = 2 * std::numbers::pi * i / n;
+      pts.push_back(c + r * (std::cos(phi) * light.right() + std::sin(phi) * light.up()));
+    }
+  } else {
+    const double r = light.desc().radius;
+    for (int i = 0; i < 8; ++i)
+      pts.push_back(c + r * Vec3(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1));
+  }
+  return pts;
+}
+
+// The receiver's index among the blockers, or -1.
+int own_index(const PlanInputs& in) {
+  for (std::size_t i = 0; i < in.blockers.size(); ++i)
+    if (in.blockers[i] == in.receiver) return int(i);
+  return -1;
+}
+
+// Lit texels that share their blockers: all of them, or, for a receiver that is its own blocker,
+// those of one convex component, or of one plane of a non-convex one.
+struct TexelGroup {
+  std::vector<std::size_t> texels;  // indices into TexelSpace::texels
+  int convex_component = -1;        // the receiver's own convex component, left out of blockers
+  // All texels on one plane, with the light's centre in front of it at `height`: the group gets
+  // its own frame along the plane's normal (add_frames).
+  bool planar = false;
+  Vec3 normal = Vec3::Zero();
+  double height = 0;
+};
+
+std::vector<TexelGroup> group_texels(const TexelSpace& space, const PlanInputs& in,
+                                     const std::vector<std::size_t>& lit, const Light& light) {
+  const int own = own_index(in);
+  std::map<std::pair<int, long long>, std::vector<std::size_t>> groups;
+  // Neighbouring texels mostly share their group: the last one found saves a map search.
+  std::pair<int, long long> last_key{-2, 0};
+  std::vector<std::size_t>* last = nullptr;
+  for (std::size_t t : lit) {
+    std::pair<int, long long> key{-1, 0};
+    if (own >= 0 && in.clusters) {
+      const TriMesh& mesh = in.receiver->mesh;
+      const int face = space.texels[t].face;
+      const int comp = in.clusters->face_component[own][face];
+      key.first = comp;
+      if (!in.clusters->component_convex[own][comp]) {
+        // The plane of the texel's face, quantised: normal to ~0.3°, offset to 1 mm.
+        const auto fh = mesh.face_handle(face);
+        const auto n = mesh.normal(fh);
+        const auto p = mesh.point(*mesh.cfv_begin(fh));
+        long long h = 0;
+        for (int k = 0; k < 3; ++k) h = h * 1001 + std::llround(n[k] * 200) + 500;
+        h = h * 1000003 + std::llround((n | p) * 1000);
+        key.second = h;
+      }
+    }
+    if (!last || key != last_key) {
+      last_key = key;
+      last = &groups[key];
+    }
+    last->push_back(t);
+  }
+  // A curved non-convex component has a plane per face: then fall back to one group per
+  // component (its nearby faces may then shadow it a little: docs/methods.md).
+  std::map<int, int> planes_per_component;
+  for (const auto& [key, members] : groups)
+    if (key.first >= 0 && key.second != 0) ++planes_per_component[key.first];
+  std::map<std::pair<int, long long>, std::vector<std::size_t>> merged;
+  for (auto& [key, members] : groups) {
+    auto k = key;
+    if (k.first >= 0 && planes_per_component[k.first] > 64) k.second = 1;
+    auto& dst = merged[k];
+    dst.insert(dst.end(), members.begin(), members.end());
+  }
+  std::vector<TexelGroup> out;
+  for (auto& [key, members] : merged) {
+    TexelGroup g;
+    g.convex_component = key.first >= 0 && key.second == 0 ? key.first : -1;
+    // Planar: every texel's face normal within ~0.1° of the first's and every texel within
+    // 0.1 mm of its plane.
+    const Texel& first = space.texels[members.front()];
+    const Vec3 n = first.geometric_normal.cast<double>().normalized();
+    const double offset = n.dot(first.position.cast<double>());
+    g.planar = std::all_of(members.begin(), members.end(), [&](std::size_t t) {
+      const Texel& x = space.texels[t];
+      return x.geometric_normal.cast<double>().dot(n) > 1 - 2e-6 &&
+             std::abs(n.dot(x.position.cast<double>()) - offset) < 1e-4;
+    });
+    g.height = n.dot(light.centre()) - offset;
+    g.planar = g.planar && g.height > 0;
+    g.normal = n;
+    g.texels = std::move(members);
+    out.push_back(std::move(g));
+  }
+  return out;
+}
+
+// The candidate blocker faces of a group: those of the clusters in the shaft between the light
+// and the group's texels, less the group's own convex component.
+std::vector<FaceRef> group_faces(const ConvolutionPlan& plan, const PlanInputs& in,
+                                 const PlanFrame& fr, const std::vector<int>& group,
+                                 const Light& light, int convex_component) {
+  const int own = own_index(in);
+  std::vector<FaceRef> faces;
+  auto keep = [&](int mesh, int face) {
+    return !(mesh == own && convex_component >= 0 &&
+             in.clusters->face_component[mesh][face] == convex_component);
+  };
+  if (!in.clusters) {
+    for (std::size_t m = 0; m < in.blockers.size(); ++m)
+      for (auto f : in.blockers[m]->mesh.faces())
+        if (keep(int(m), f.idx())) faces.push_back({in.blockers[m], f.idx()});
+    return faces;
+  }
+  Bounds3 bounds;
+  for (int i : group) bounds.extend(fr.position[std::size_t(i)]);
+  const Shaft shaft(light_outline(light), bounds);
+  for (int node : clusters_in_shaft(*in.clusters, shaft)) {
+    const Cluster& c = in.clusters->nodes[node];
+    for (int f : c.faces)
+      if (keep(c.mesh, f)) faces.push_back({in.blockers[c.mesh], f});
+  }
+  return faces;
+}
+
+}  // namespace
+
+// Frames, groups and root triples for one light part, appended to `plan`. A planar group (a
+// floor, one face plane of a bracket) is seen along its plane's normal: every texel then lies at
+// the same depth, the receiver plane of design-notes §2 is the group's own plane, and blockers
+// clipped to depth <= that plane are exactly those on the light's side of it. The other groups
+// share one frustum from the light's centre towards the middle of their texels (design-notes §3)
+// when it holds them all within kMaxFrustumHalfAngleDeg; otherwise (a light beside or among its
+// receiver) the six faces of a cube around the light, each its own frustum.
+void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part) {
+  const TexelSpace& space = *plan.space;
+  const LightPart& lp = plan.light_parts[light_part];
+  const Light& light = lp.part;
+  std::vector<std::size_t> lit;
+  const std::vector<std::uint8_t>* maybe =
+      in.maybe_blocked ? &(*in.maybe_blocked)[std::size_t(lp.light)] : nullptr;
+  for (std::size_t t = 0; t < space.texels.size(); ++t) {
+    if (maybe && !(*maybe)[t]) continue;  // nothing between it and the light
+    if (light.reaches(space.texels[t].position.cast<double>(),
+                      space.texels[t].normal.cast<double>()))
+      lit.push_back(t);
+  }
+  if (lit.empty()) return;
+  auto position = [&](std::size_t t) { return Vec3(space.texels[t].position.cast<double>()); };
+  const std::vector<TexelGroup> groups = group_texels(space, in, lit, light);
+  // Each frame with the groups it serves: (index into `groups`, texels of that group in it).
+  struct FrameGroups {
+    PlanFrame frame;
+    std::vector<std::pair<int, std::vector<std::size_t>>> members;
+  };
+  std::vector<FrameGroups> frames;
+  Bounds3 rest_bounds;
+  std::vector<int> rest;
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    if (groups[g].planar) {
+      FrameGroups f;
+      f.frame.frame = frame_towards(light.centre(), light.centre() - groups[g].normal);
+      f.frame.face = "plane";
+      f.members.emplace_back(int(g), groups[g].texels);
+      frames.push_back(std::move(f));
+    } else {
+      rest.push_back(int(g));
+      for (std::size_t t : groups[g].texels) rest_bounds.extend(position(t));
+    }
+  }
+  if (!rest.empty()) {
+    const ProjectionFrame central = frame_towards(light.centre(), rest_bounds.centre());
+    double widest = 1.0;
+    for (int g : rest) {
+      for (std::size_t t : groups[std::size_t(g)].texels) {
+        const Vec3 d = position(t) - light.centre();
+        const double len = d.norm();
+        widest = std::min(widest, len > 0 ? d.dot(central.axis) / len : 1.0);
+      }
+    }
+    if (widest >= std::cos(kMaxFrustumHalfAngleDeg * std::numbers::pi / 180.0)) {
+      FrameGroups f;
+      f.frame.frame = central;
+      for (int g : rest) f.members.emplace_back(g, groups[std::size_t(g)].texels);
+      frames.push_back(std::move(f));
+    } else {
+      static const char* kFaces[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
+      const std::size_t first = frames.size();
+      for (int face = 0; face < 6; ++face) {
+        Vec3 axis = Vec3::Zero();
+        axis[face / 2] = face % 2 ? -1.0 : 1.0;
+        FrameGroups f;
+        f.frame.frame = frame_towards(light.centre(), light.centre() + axis);
+        f.frame.face = kFaces[face];
+        for (int g : rest) f.members.emplace_back(g, std::vector<std::size_t>{});
+        frames.push_back(std::move(f));
+      }
+      for (std::size_t r = 0; r < rest.size(); ++r) {
+        for (std::size_t t : groups[std::size_t(rest[r])].texels) {
+          const Vec3 d = position(t) - light.centre();
+          int axis;
+          d.cwiseAbs().maxCoeff(&axis);
+          frames[first + 2 * std::size_t(axis) + (d[axis] < 0 ? 1 : 0)].members[r].second.push_back(
+              t);
+        }
+      }
+    }
+  }
+  for (FrameGroups& fg : frames) {
+    PlanFrame& f = fg.frame;
+    f.light = lp.light;
+    f.light_part = light_part;
+    std::vector<int> convex_component;
+    double deepest = 0;
+    std::size_t members = 0;
+    for (const auto& m : fg.members) members += m.second.size();
+    f.texels.reserve(members);
+    f.depth.reserve(members);
+    f.position.reserve(members);
+    f.tangent.reserve(members);
+    for (auto& [g, texels] : fg.members) {
+      if (texels.empty()) continue;
+      std::vector<int> members;
+      for (std::size_t t : texels) {
+        members.push_back(int(f.texels.size()));
+        f.texels.push_back(t);
+        f.depth.push_back(f.frame.depth(position(t)));
+        deepest = std::max(deepest, f.depth.back());
+      }
+      f.groups.push_back(std::move(members));
+      convex_component.push_back(groups[std::size_t(g)].convex_component);
+    }
+    if (f.texels.empty()) continue;
+    // Texels this close to the light's plane across D (or behind it) cannot be projected; they
+    // keep V = 1 and are counted. The choice of frusta keeps them rare.
+    f.near = std::max(1e-4, 1e-3 * deepest);
+    for (std::size_t i = 0; i < f.texels.size(); ++i) {
+      f.position.push_back(position(f.texels[i]));
+      f.tangent.push_back(f.depth[i] > f.near ? f.frame.tangent(f.position.back()) : Vec2::Zero());
+      if (f.depth[i] <= f.near) ++f.outside_texels;
+    }
+    std::vector<std::vector<int>> kept;
+    std::vector<int> kept_component;
+    for (std::size_t k = 0; k < f.groups.size(); ++k) {
+      auto& g = f.groups[k];
+      std::erase_if(g, [&](int i) { return f.depth[std::size_t(i)] <= f.near; });
+      if (g.empty()) continue;
+      // The deepest texel last (evaluate_triple reads the group's depth there); a full sort by
+      // depth cost a tenth of the planning of a 2048² floor.
+      std::iter_swap(std::max_element(g.begin(), g.end(),
+                                      [&](int a, int b) { return f.depth[a] < f.depth[b]; }),
+                     g.end() - 1);
+      kept.push_back(std::move(g));
+      kept_component.push_back(convex_component[k]);
+    }
+    f.groups = std::move(kept);
+    convex_component = std::move(kept_component);
+    for (const auto& g : f.groups) {
+      f.index.emplace_back();
+      f.index.back().build(g, f.tangent, f.depth, f.position);
+    }
+    const int index = int(plan.frames.size());
+    plan.frames.push_back(std::move(f));
+    PlanFrame& added = plan.frames.back();
+    for (std::size_t g = 0; g < added.groups.size(); ++g) {
+      Triple root;
+      root.frame = index;
+      root.group = int(g);
+      root.slab_lo = 0;
+      root.slab_hi = std::numeric_limits<double>::infinity();
+      root.faces = group_faces(plan, in, added, added.groups[g], light, convex_component[g]);
+      for (int i : added.groups[g]) root.receiver_box.extend(added.position[std::size_t(i)]);
+      evaluate_triple(plan, in, root);
+      added.roots.push_back(int(plan.triples.size()));
+      plan.triples.push_back(std::move(root));
+    }
+  }
+}
+
+}  // namespace sb

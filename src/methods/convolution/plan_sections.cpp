@@ -1,0 +1,151 @@
+// Convex closed solids in a plan (add_sections, convolution_plan.h): which triples are slabs
+// of such solids, and the section leaves between their slabs, so that the bake can count the
+// light each solid hides by Euler's formula (convolution_bake.cpp, docs/methods.md). Split from
+// convolution_plan.cpp, whose planner makes the trees this walks.
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <memory>
+#include <vector>
+
+#include "occluders/clusters.h"
+#include "methods/convolution/convolution_plan.h"
+#include "methods/convolution/source_image.h"
+
+namespace sb {
+
+void add_sections(ConvolutionPlan& plan, const PlanInputs& in) {
+  if (!in.clusters) return;
+  const ClusterTree& tree = *in.clusters;
+  std::map<const Mesh*, int> mesh_index;
+  for (std::size_t m = 0; m < in.blockers.size(); ++m) mesh_index.emplace(in.blockers[m], int(m));
+  using Component = std::pair<int, int>;  // (mesh, connected component)
+  std::map<Component, int> root_of;       // its cluster tree's root node
+  for (int r : tree.roots) root_of.emplace(Component(tree.nodes[r].mesh, tree.nodes[r].component), r);
+  auto component_of = [&](const FaceRef& f) {
+    const int m = mesh_index.at(f.mesh);
+    return Component(m, tree.face_component[std::size_t(m)][std::size_t(f.face)]);
+  };
+  // Every face of a set of solids, by their cluster roots.
+  std::map<std::vector<int>, std::shared_ptr<const std::vector<FaceRef>>> solid_faces;
+
+  // A triple is complete when it holds every face of each component it touches that meets its
+  // slab: a root holding whole components, and its descendants, except where a blocker-space
+  // split shares a component between its two sides. Parents come before children in `triples`.
+  const std::size_t n = plan.triples.size();
+  std::vector<std::uint8_t> complete(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    Triple& t = plan.triples[i];
+    std::map<Component, std::size_t> count;
+    for (const FaceRef& f : t.faces) ++count[component_of(f)];
+    if (t.parent < 0) {
+      complete[i] = std::all_of(count.begin(), count.end(), [&](const auto& c) {
+        return c.second == tree.nodes[std::size_t(root_of.at(c.first))].faces.size();
+      });
+    } else {
+      const Triple& parent = plan.triples[std::size_t(t.parent)];
+      complete[i] = complete[std::size_t(t.parent)];
+      if (complete[i] && parent.split == "blocker space") {
+        for (int sibling : parent.children) {
+          if (sibling == int(i)) continue;
+          for (const FaceRef& f : plan.triples[std::size_t(sibling)].faces)
+            if (count.count(component_of(f))) complete[i] = 0;
+        }
+      }
+    }
+    if (!complete[i] || t.empty) continue;
+    const PlanFrame& fr = plan.frames[std::size_t(t.frame)];
+    std::vector<int> roots;
+    bool solid = true;
+    for (const auto& [component, faces] : count) {
+      const auto [m, c] = component;
+      // Convex only: a non-convex solid's capped slabs cost convolutions and measured no gain
+      // (the bracket), and Euler's count needs a line to meet the solid in one interval.
+      if (!tree.component_closed[std::size_t(m)][std::size_t(c)] ||
+          !tree.component_convex[std::size_t(m)][std::size_t(c)]) {
+        solid = false;
+        break;
+      }
+      const int root = root_of.at(component);
+      double lo = 0, hi = 0;
+      tree.nodes[std::size_t(root)].depth_range(fr.frame.origin, fr.frame.axis, &lo, &hi);
+      // A section counts crossings from the light's side: the solid must lie wholly before it.
+      if (!(lo > fr.near)) {
+        solid = false;
+        break;
+      }
+      roots.push_back(root);
+    }
+    if (!solid || roots.empty()) continue;
+    // Several solids count together only when no line from a receiver texel to the light can
+    // meet two of them within the slab: such a line's projection from the light's centre moves
+    // by at most the light's projected half extents times (1/d_lo − 1/d_hi) across the slab's
+    // depths, so solids whose projections lie further apart than that are never both met.
+    if (roots.size() > 1) {
+      const Light& light = plan.light_parts[std::size_t(fr.light_part)].part;
+      const Vec2 reach = projected_half_extents(light, fr.frame, t.view, t.receiver_depths.hi) *
+                         (1.0 / t.blocker_depths.lo - 1.0 / t.blocker_depths.hi);
+      std::vector<std::pair<Vec2, Vec2>> boxes;
+      for (int root : roots) {
+        Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+        for (const Vec3& p : tree.nodes[std::size_t(root)].hull) {
+          lo = lo.cwiseMin(fr.frame.tangent(p));
+          hi = hi.cwiseMax(fr.frame.tangent(p));
+        }
+        boxes.emplace_back(lo - reach, hi + reach);
+      }
+      for (std::size_t a = 0; a < boxes.size() && solid; ++a)
+        for (std::size_t b = a + 1; b < boxes.size() && solid; ++b)
+          solid = (boxes[a].second.array() < boxes[b].first.array()).any() ||
+                  (boxes[b].second.array() < boxes[a].first.array()).any();
+      if (!solid) continue;
+    }
+    std::sort(roots.begin(), roots.end());
+    auto& faces = solid_faces[roots];
+    if (!faces) {
+      auto all = std::make_shared<std::vector<FaceRef>>();
+      for (int root : roots) {
+        const Cluster& node = tree.nodes[std::size_t(root)];
+        for (int f : node.faces) all->push_back({in.blockers[std::size_t(node.mesh)], f});
+      }
+      faces = std::move(all);
+    }
+    t.solid_faces = faces;
+  }
+
+  // Euler's count for a convex solid: a line meets it in one interval, which touches k
+  // consecutive slabs and crosses the k − 1 sections between them inside the solid, so
+  // Σ slabs − Σ sections is 1 for a line that meets the solid and 0 for one that misses it.
+  for (std::size_t top = 0; top < n; ++top) {
+    const Triple& t = plan.triples[top];
+    if (!t.solid_faces || t.children.empty()) continue;
+    if (t.parent >= 0 && plan.triples[std::size_t(t.parent)].solid_faces) continue;
+    std::vector<int> subtree = {int(top)};
+    bool whole = true;
+    for (std::size_t k = 0; k < subtree.size() && whole; ++k) {
+      const Triple& s = plan.triples[std::size_t(subtree[k])];
+      if (!s.empty && !s.solid_faces) whole = false;
+      for (int child : s.children) subtree.push_back(child);
+    }
+    if (!whole) continue;
+    for (int s : subtree) plan.triples[std::size_t(s)].euler = int(top);
+    for (int s : subtree) {
+      if (plan.triples[std::size_t(s)].split != "blocker depth") continue;
+      const Triple& split = plan.triples[std::size_t(s)];
+      Triple section = child_triple(split, "");
+      section.parent = s;
+      section.slab_lo = section.slab_hi = plan.triples[std::size_t(split.children[0])].slab_hi;
+      section.faces = split.faces;
+      section.solid_faces = split.solid_faces;
+      section.euler = int(top);
+      section.section = true;
+      evaluate_triple(plan, in, section);
+      if (section.empty) continue;
+      plan.triples[std::size_t(s)].children.push_back(int(plan.triples.size()));
+      plan.triples.push_back(std::move(section));
+    }
+  }
+}
+
+}  // namespace sb

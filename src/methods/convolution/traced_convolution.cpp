@@ -1,0 +1,189 @@
+// The convolution method with exact shaft culling and traced fallbacks (traced_convolution.h).
+//
+// Why this shape. Soler & Sillion's convolution is exact for parallel planes and approximate
+// elsewhere by a penumbra error ε that its plan knows per leaf. On scenes as artists make them
+// most of what a light reaches has nothing in its way (a floor is in shadow only around its
+// furniture): there the answer is exactly 1 and costs a shaft test (shaft_culling.cpp), not a
+// convolution. What remains splits by what the plan can promise: where its leaves' ε is within
+// `trace_error_texels`, the convolution's value stands; where it is not (walls crossing the
+// light's depth, curved blockers near the light, lights among geometry), or where a blocker may
+// cross a texel's shaft that no leaf accounted for, the texel takes the reference's own estimate
+// (estimate_visibility, same stream), so it costs what the reference costs there and is as good.
+#include "methods/convolution/traced_convolution.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+
+#include "occluders/shadow_rays.h"
+
+namespace sb {
+
+namespace {
+
+// How close to 0 or 1 the convolution's V must be to count as wholly hidden or wholly seen.
+constexpr float kCertain = 2e-3f;
+// Texels around a traced one that are traced too (either axis), against a penumbra the
+// convolution placed up to its ε (1 texel at the default target) off.
+constexpr int kTraceMargin = 2;
+
+// Whether some of the light lies below the horizon of (p, n): a corner of a rectangle, the rim of
+// a disk, the far side of a sphere.
+bool partly_below_horizon(const Light& light, const Vec3& p, const Vec3& n) {
+  const Vec3 c = light.centre() - p;
+  const LightDesc& d = light.desc();
+  switch (light.shape()) {
+    case LightShape::rectangle:
+      return n.dot(c) - 0.5 * d.width * std::abs(n.dot(light.right())) -
+                 0.5 * d.height * std::abs(n.dot(light.up())) <
+             0;
+    case LightShape::disk:
+      return n.dot(c) - d.radius * (n - n.dot(light.normal()) * light.normal()).norm() < 0;
+    case LightShape::sphere:
+      return n.dot(c) - d.radius < 0;
+  }
+  return true;
+}
+
+}  // namespace
+
+Expected<Image> bake_traced_convolution(const TexelSpace& space, const TracedConvolutionInputs& in,
+                                        std::vector<PairReport>* reports, ConvolutionPlan* plan,
+                                        TracedConvolutionStats* stats) {
+  const std::vector<Light>& lights = *in.convolution.lights;
+  const std::size_t n = space.texels.size();
+  ConvolutionInputs conv = in.convolution;
+  // The convolution may cost at most half what the reference at 64 samples would per texel
+  // (the method must never be slower than the rays it replaces), or half what tracing the texel
+  // at `samples` would, where it traces.
+  conv.cost_budget_per_texel = 0.5 * 64 * kRayCostUnits;
+  if (in.rays) {
+    conv.ray_cost_per_texel = in.samples * kRayCostUnits;
+    conv.trace_error_texels = in.trace_error_texels;
+    conv.cost_budget_per_texel =
+        std::min(conv.cost_budget_per_texel, 0.5 * conv.ray_cost_per_texel);
+  }
+  std::vector<std::vector<std::uint8_t>> maybe;
+  if (in.culler) {
+    const double offset = in.rays ? in.rays->surface_offset() : 0.0;
+    for (const Light& light : lights)
+      maybe.push_back(in.culler->maybe_blocked(space, light, offset));
+    conv.maybe_blocked = &maybe;
+  }
+  ConvolutionVisibility per_light;
+  if (in.convolve || !in.rays) {
+    auto convolved = bake_convolution(space, conv, reports, plan, &per_light);
+    if (!convolved) return convolved.error();
+  } else {  // no leaf: every pair the shaft test keeps is traced
+    per_light.visible.resize(lights.size());
+    per_light.reached.resize(lights.size());
+    per_light.error_texels.resize(lights.size());
+  }
+
+  // Which (light, texel) pairs are traced. The convolution's penumbra values are approximate
+  // beyond what ε measures (the slabs' shares, the first-order weighting), so a texel it finds
+  // partly lit is traced, as is one whose leaves' ε is above trace_error_texels or which no leaf
+  // accounted for; its own answer stands only where it finds the light wholly seen or wholly
+  // hidden, and not within kTraceMargin texels of a traced one (where a penumbra it placed up
+  // to ε off may begin).
+  std::vector<std::vector<std::uint8_t>> trace(lights.size());
+  if (in.rays) {
+    std::vector<std::int32_t> texel_at(std::size_t(space.width) * space.height, -1);
+    for (std::size_t t = 0; t < n; ++t)
+      texel_at[std::size_t(space.texels[t].y) * space.width + std::size_t(space.texels[t].x)] =
+          std::int32_t(t);
+    for (std::size_t l = 0; l < lights.size(); ++l) {
+      std::vector<std::uint8_t> seed(n, 0);
+      for (std::size_t t = 0; t < n; ++t) {
+        if (!maybe.empty() && !maybe[l][t]) continue;
+        const bool planned = !per_light.visible[l].empty() && per_light.reached[l][t];
+        const float e = planned ? per_light.error_texels[l][t] : -1.0f;
+        bool partial = false;
+        if (planned)
+          for (int c = 0; c < 3; ++c) {
+            const float v = per_light.visible[l][t][c];
+            partial = partial || (v > kCertain && v < 1 - kCertain);
+          }
+        seed[t] = e < 0 || e > in.trace_error_texels || partial;
+      }
+      trace[l].assign(n, 0);
+      for (std::size_t t = 0; t < n; ++t) {
+        if (!seed[t]) continue;
+        const int x = space.texels[t].x, y = space.texels[t].y;
+        for (int dy = -kTraceMargin; dy <= kTraceMargin; ++dy)
+          for (int dx = -kTraceMargin; dx <= kTraceMargin; ++dx) {
+            const int xx = x + dx, yy = y + dy;
+            if (xx < 0 || yy < 0 || xx >= space.width || yy >= space.height) continue;
+            const std::int32_t u = texel_at[std::size_t(yy) * space.width + std::size_t(xx)];
+            if (u >= 0 && (maybe.empty() || maybe[l][std::size_t(u)])) trace[l][std::size_t(u)] = 1;
+          }
+      }
+    }
+  }
+
+  const bool weights_needed = lights.size() > 1 || conv.quantity == Quantity::irradiance;
+  Image out(space.width, space.height, 3, 0.0f);
+  std::atomic<std::int64_t> pairs{0}, clear{0}, traced{0}, rays_traced{0};
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
+    ShadowRays batch(in.samples);
+    std::vector<Vec2> strata;
+    std::int64_t local_pairs = 0, local_clear = 0, local_traced = 0, local_rays = 0;
+    for (std::size_t t = r.begin(); t != r.end(); ++t) {
+      const Texel& tx = space.texels[t];
+      const Vec3 p = tx.position.cast<double>(), normal = tx.normal.cast<double>();
+      Vec3 sum = Vec3::Zero(), weight = Vec3::Zero();
+      const bool buried = !per_light.buried.empty() && per_light.buried[t];
+      for (std::size_t l = 0; l < lights.size() && !buried; ++l) {
+        if (!lights[l].reaches(p, normal)) continue;
+        ++local_pairs;
+        const bool planned = !per_light.visible[l].empty() && per_light.reached[l][t];
+        Vec3 v = planned ? Vec3(per_light.visible[l][t].cast<double>()) : Vec3::Ones();
+        if (!maybe.empty() && !maybe[l][t]) {
+          ++local_clear;
+          // Nothing blocks the light, but where most of it is below the horizon the reference's
+          // samples may all fall there, and it then leaves the light out: so does this method,
+          // so that the two agree to the texel (no ray is traced for it).
+          if (in.rays && partly_below_horizon(lights[l], p, normal) &&
+              !any_sample_contributes(tx, l, lights[l], *in.rays, in.samples, in.seed, in.stream,
+                                      space.width, batch, strata))
+            continue;
+        } else if (in.rays && trace[l][t]) {
+          Vec3 traced_v;
+          ++local_traced;
+          // As the reference does: a light none of whose samples contributes is left out.
+          if (!estimate_visibility(tx, l, lights[l], *in.rays, in.samples, in.seed, in.stream,
+                                   space.width, batch, strata, &traced_v))
+            continue;
+          v = traced_v;
+          local_rays += batch.size();
+        }
+        const Vec3 w =
+            weights_needed ? lights[l].unoccluded_irradiance(p, normal) : lights[l].exitance();
+        sum += w.cwiseProduct(v);
+        weight += w;
+      }
+      float* px = out.at(tx.x, tx.y);
+      for (int c = 0; c < 3; ++c) {
+        px[c] = float(conv.quantity == Quantity::irradiance
+                          ? sum[c]
+                          : (weight[c] > 0 ? sum[c] / weight[c] : 0.0));
+      }
+    }
+    pairs += local_pairs;
+    clear += local_clear;
+    traced += local_traced;
+    rays_traced += local_rays;
+  });
+  if (stats) {
+    stats->pairs += pairs;
+    stats->clear += clear;
+    stats->traced += traced;
+    stats->convolved += pairs - clear - traced;
+    stats->rays += rays_traced;
+  }
+  return out;
+}
+
+}  // namespace sb

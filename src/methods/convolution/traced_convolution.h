@@ -1,0 +1,40 @@
+// The `convolution` method as a bake runs it on real scenes (traced_convolution.cpp): the shaft
+// test decides exactly which (light, texel) pairs nothing stands between; the convolution shades
+// the rest; and where the convolution cannot vouch for its value (a leaf's penumbra error above
+// `trace_error_texels`, or a texel whose shaft a blocker may cross that no leaf accounted for),
+// shadow rays take over, so hard cases cost what the reference costs there and no more.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "methods/convolution/convolution_bake.h"
+#include "occluders/ray_scene.h"
+#include "occluders/shaft_culling.h"
+
+namespace sb {
+
+struct TracedConvolutionInputs {
+  ConvolutionInputs convolution;
+  const ShaftCuller* culler = nullptr;  // null: no shaft test, the convolution shades every pair
+  const RayScene* rays = nullptr;       // null: no rays, the convolution's values stand
+  bool convolve = true;                 // false: no convolution, every pair not clear is traced
+  int samples = 64;                     // rays per light per traced texel
+  double trace_error_texels = 1.0;      // leaves' ε above this are traced
+  std::uint64_t seed = 0, stream = 0;   // as the reference's, so a traced texel matches it
+};
+
+// What the method did with the receiver's (light, texel) pairs the lights reach.
+struct TracedConvolutionStats {
+  std::int64_t pairs = 0, clear = 0, convolved = 0, traced = 0;
+  std::int64_t rays = 0;
+};
+
+// Bakes one receiver; lights combined as V = Σ H0_l·V_l / Σ H0_l (or H = Σ H0_l·V_l).
+Expected<Image> bake_traced_convolution(const TexelSpace& space, const TracedConvolutionInputs& in,
+                                        std::vector<PairReport>* reports, ConvolutionPlan* plan,
+                                        TracedConvolutionStats* stats);
+
+}  // namespace sb

@@ -1,0 +1,58 @@
+// Shadow-ray queries against the scene's blockers, with Embree 3. Embree's types stay in
+// ray_scene.cpp; the methods see only this class.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "core/error.h"
+#include "core/geometry.h"
+#include "scene/mesh.h"
+
+namespace sb {
+
+class RayScene {
+ public:
+  // Builds the acceleration structure over the given meshes (world space). Safe to query from
+  // many threads at once.
+  static Expected<RayScene> build(const std::vector<const Mesh*>& blockers);
+
+  RayScene(RayScene&&) noexcept;
+  RayScene& operator=(RayScene&&) noexcept;
+  ~RayScene();
+
+  // True when a blocker triangle (either side) lies on the segment origin + t·direction,
+  // t ∈ [surface_offset() / |direction|, length]. direction need not be unit; length is in
+  // units of |direction|.
+  bool occluded(const Vec3& origin, const Vec3& direction, double length) const;
+
+  // Answers `count` segments at once (faster than one at a time). Writes 1 for an occluded
+  // segment into hit[i], 0 otherwise.
+  void occluded(int count, const Vec3* origins, const Vec3* directions, const double* lengths,
+                std::uint8_t* hit) const;
+
+  // Where the segment origin + t·direction, t ∈ [surface_offset() / |direction|, length], first
+  // meets a blocker triangle (either side): that t, in units of |direction|, or a negative value
+  // when it meets none. The closest-hit counterpart of occluded(), for methods that need the
+  // distance to the blocker (erosion's penumbra width) and not only whether there is one.
+  double first_hit(const Vec3& origin, const Vec3& direction, double length) const;
+
+  // Answers `count` segments at once, writing each first hit's t (or a negative value) into t_hit.
+  void first_hit(int count, const Vec3* origins, const Vec3* directions, const double* lengths,
+                 double* t_hit) const;
+
+  // The blockers' bounding box (empty when there are none).
+  const Bounds3& bounds() const;
+
+  // How far a shadow ray's origin is pushed off its surface, in metres: enough to step over
+  // the single-precision error of a triangle position anywhere in the scene, small against any
+  // gap that should cast a shadow (see ray_scene.cpp).
+  double surface_offset() const;
+
+ private:
+  struct Impl;
+  explicit RayScene(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace sb

@@ -1,0 +1,109 @@
+// One texel's shadow rays towards one light's sample points, traced together: what the
+// reference and accumulation methods share (each picks its points differently: stratified per
+// texel, or one constellation for every texel).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "scene/lights.h"
+#include "occluders/ray_scene.h"
+#include "core/sampling.h"
+#include "texels/texel_space.h"
+
+namespace sb {
+
+class ShadowRays {
+ public:
+  explicit ShadowRays(int capacity)
+      : origins_(std::size_t(capacity)),
+        directions_(std::size_t(capacity)),
+        lengths_(std::size_t(capacity)),
+        weights_(std::size_t(capacity)),
+        hit_(std::size_t(capacity)) {}
+
+  void clear() {
+    n_ = 0;
+    weight_sum_ = Vec3::Zero();
+  }
+  // Adds the segment from `origin` to a sample point, unless the point cannot contribute or
+  // lies within the surface offset. The segment stops that offset short of the light's own
+  // surface, which may lie on a blocker (a panel on a ceiling).
+  void add(const Vec3& origin, const LightSample& ls, double offset) {
+    if (ls.weight <= 0) return;
+    const Vec3 d = ls.point - origin;
+    const double len = d.norm();
+    if (len <= 2 * offset) return;
+    const std::size_t i = std::size_t(n_++);
+    origins_[i] = origin;
+    directions_[i] = d;
+    lengths_[i] = 1.0 - offset / len;
+    weights_[i] = ls.weight * ls.tint;  // per channel
+    weight_sum_ += weights_[i];
+  }
+  int size() const { return n_; }
+  // Traces the segments; per channel, the weighted fraction that reaches the light. False, and
+  // nothing traced, when no point contributes.
+  bool visible_fraction(const RayScene& rays, Vec3* v) {
+    if (n_ == 0 || weight_sum_.maxCoeff() <= 0) return false;
+    rays.occluded(n_, origins_.data(), directions_.data(), lengths_.data(), hit_.data());
+    Vec3 visible = Vec3::Zero();
+    for (std::size_t s = 0; s < std::size_t(n_); ++s)
+      if (!hit_[s]) visible += weights_[s];
+    *v = Vec3::Zero();
+    for (int c = 0; c < 3; ++c)
+      if (weight_sum_[c] > 0) (*v)[c] = visible[c] / weight_sum_[c];
+    return true;
+  }
+
+ private:
+  std::vector<Vec3> origins_, directions_;
+  std::vector<double> lengths_;
+  std::vector<Vec3> weights_;
+  std::vector<std::uint8_t> hit_;
+  int n_ = 0;
+  Vec3 weight_sum_ = Vec3::Zero();
+};
+
+// The reference's samples of light `l` at one texel (reference_bake.cpp), into `batch`: `samples`
+// stratified points, from the texel's own random stream (seed, receiver stream, light, pixel),
+// one shadow ray each from the lifted shadow origin; points below the texel's horizon or on the
+// light's back add none.
+inline void add_reference_samples(const Texel& texel, std::size_t l, const Light& light,
+                                  const RayScene& rays, int samples, std::uint64_t seed,
+                                  std::uint64_t stream, int width, ShadowRays& batch,
+                                  std::vector<Vec2>& strata) {
+  const double offset = rays.surface_offset();
+  const Vec3 position = texel.position.cast<double>();
+  const Vec3 normal = texel.normal.cast<double>();
+  const Vec3 origin =
+      texel.shadow_origin.cast<double>() + offset * texel.geometric_normal.cast<double>();
+  Rng rng(stream_seed(seed, (stream << 32) ^ l, std::uint64_t(texel.y) * width + texel.x));
+  stratified_samples(samples, rng, strata);
+  batch.clear();
+  for (int s = 0; s < samples; ++s)
+    batch.add(origin, light.sample(position, normal, strata[s]), offset);
+}
+
+// The reference's estimate of light `l`'s visibility at one texel, traced from those samples.
+// False when no point contributes. Any method that traces a texel this way gets the reference's
+// value at that many samples, bit for bit.
+inline bool estimate_visibility(const Texel& texel, std::size_t l, const Light& light,
+                                const RayScene& rays, int samples, std::uint64_t seed,
+                                std::uint64_t stream, int width, ShadowRays& batch,
+                                std::vector<Vec2>& strata, Vec3* v) {
+  add_reference_samples(texel, l, light, rays, samples, seed, stream, width, batch, strata);
+  return batch.visible_fraction(rays, v);
+}
+
+// Whether estimate_visibility would find a contributing point among the same samples, without
+// tracing: false where every sample lies below the texel's horizon or on the light's back.
+inline bool any_sample_contributes(const Texel& texel, std::size_t l, const Light& light,
+                                   const RayScene& rays, int samples, std::uint64_t seed,
+                                   std::uint64_t stream, int width, ShadowRays& batch,
+                                   std::vector<Vec2>& strata) {
+  add_reference_samples(texel, l, light, rays, samples, seed, stream, width, batch, strata);
+  return batch.size() > 0;
+}
+
+}  // namespace sb

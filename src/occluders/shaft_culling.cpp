@@ -1,0 +1,412 @@
+// Exact shaft culling per texel (shaft_culling.h): Haines & Wallace, "Shaft Culling for Efficient
+// Ray-Cast Radiosity" (Eurographics Rendering Workshop 1991) bound the volume between a patch and
+// a light by planes and test a hierarchy of boxes against them; here the patch is a single point
+// (the texel's shadow origin), so the shaft is a pyramid:
+//
+// - its apex is the origin p; its base is the light's outline: a rectangle's corners, a disk's
+//   circumscribed octagon, or for a sphere the octagon circumscribing its silhouette disk as seen
+//   from p (every visible point of a sphere lies between p and the silhouette's plane);
+// - its planes are the sides through p and each edge of the base, the base's plane (nothing
+//   beyond the light blocks it) and the texel's tangent plane (a ray to a point of the light that
+//   contributes leaves the surface upwards).
+//
+// A box of the hierarchy outside one plane holds nothing of the shaft. A triangle whose plane has
+// p and the whole light on one side cannot cut a segment between them (this drops the texel's own
+// face and, on a convex surface, its neighbours); otherwise it is clipped by the pyramid's planes
+// (Sutherland–Hodgman) and lies in the shaft when something remains. Both tests only ever keep
+// too much, never too little: a texel called clear has no blocker in any of its rays.
+//
+// Written by hand: Embree answers rays, not volumes, and a cone or pyramid query is a few planes
+// over a small hierarchy.
+#include "occluders/shaft_culling.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+
+namespace sb {
+
+namespace {
+
+struct Plane {
+  Vec3 n;  // inside: n·x <= d
+  double d = 0;
+  double eval(const Vec3& x) const { return n.dot(x) - d; }
+};
+
+struct Box {
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+  Vec3 hi = Vec3::Constant(-std::numeric_limits<double>::infinity());
+  void extend(const Vec3& p) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  void extend(const Box& b) {
+    lo = lo.cwiseMin(b.lo);
+    hi = hi.cwiseMax(b.hi);
+  }
+};
+
+struct Node {
+  Box box;
+  int first = 0, count = 0;  // leaf: triangles [first, first + count)
+  int left = -1, right = -1;
+};
+
+struct Tri {
+  Vec3 v[3];
+  Vec3 normal;  // unit (zero for a degenerate triangle, which blocks nothing)
+  Vec3 lo, hi;  // bounding box
+};
+
+constexpr int kLeafSize = 4;
+// Points within this distance (metres) of a triangle's plane count as on it.
+constexpr double kPlaneTolerance = 1e-9;
+
+// Sutherland–Hodgman: the part of a convex polygon inside one plane.
+void clip(std::vector<Vec3>& poly, std::vector<Vec3>& scratch, const Plane& plane) {
+  scratch.clear();
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    const Vec3& a = poly[i];
+    const Vec3& b = poly[(i + 1) % poly.size()];
+    const double da = plane.eval(a), db = plane.eval(b);
+    if (da <= 0) scratch.push_back(a);
+    if ((da < 0 && db > 0) || (da > 0 && db < 0)) scratch.push_back(a + (b - a) * (da / (da - db)));
+  }
+  poly.swap(scratch);
+}
+
+}  // namespace
+
+struct ShaftCuller::Impl {
+  std::vector<Tri> tris;
+  std::vector<Node> nodes;
+
+  int build(int first, int count) {
+    Node node;
+    Box centroids;
+    for (int i = first; i < first + count; ++i) {
+      for (const Vec3& v : tris[std::size_t(i)].v) node.box.extend(v);
+      centroids.extend(
+          (tris[std::size_t(i)].v[0] + tris[std::size_t(i)].v[1] + tris[std::size_t(i)].v[2]) /
+          3.0);
+    }
+    node.first = first;
+    node.count = count;
+    const int index = int(nodes.size());
+    nodes.push_back(node);
+    if (count <= kLeafSize) return index;
+    // Median split along the widest axis of the centroids.
+    int axis = 0;
+    const Vec3 extent = centroids.hi - centroids.lo;
+    if (extent.y() > extent[axis]) axis = 1;
+    if (extent.z() > extent[axis]) axis = 2;
+    const int half = count / 2;
+    std::nth_element(tris.begin() + first, tris.begin() + first + half,
+                     tris.begin() + first + count, [axis](const Tri& a, const Tri& b) {
+                       return a.v[0][axis] + a.v[1][axis] + a.v[2][axis] <
+                              b.v[0][axis] + b.v[1][axis] + b.v[2][axis];
+                     });
+    const int left = build(first, half);
+    const int right = build(first + half, count - half);
+    nodes[std::size_t(index)].left = left;
+    nodes[std::size_t(index)].right = right;
+    nodes[std::size_t(index)].count = 0;
+    return index;
+  }
+
+  // The shaft between the apex and the light, as planes; false when the light cannot reach the
+  // apex. The apex is a point (one texel's ray origin; with its surface point and normal, whose
+  // horizon bounds the shaft too) or a box of several (a tile of texels, no horizon): for a box
+  // the planes are those of its centre, each pushed out by the box's reach along its normal,
+  // which holds every segment from a point of the box to the light (a point s·q + (1 − s)·b of
+  // one, q in the box and b on the light, is at most s times that reach outside the plane).
+  static bool shaft(const Box& apex, const Vec3* surface, const Vec3* n, const Light& light,
+                    std::vector<Plane>& planes, std::array<Vec3, 8>& base, int& corners) {
+    const Vec3 p = 0.5 * (apex.lo + apex.hi);
+    const Vec3 half = 0.5 * (apex.hi - apex.lo);
+    const bool point = half.isZero();
+    const auto reach = [&](const Vec3& normal) { return half.dot(normal.cwiseAbs()); };
+    const Vec3 c = light.centre();
+    Vec3 e1 = Vec3::Zero(), e2 = Vec3::Zero(), base_normal = Vec3::UnitZ();  // base axes, normal
+    Vec3 centre = c;
+    double r = 0;
+    switch (light.shape()) {
+      case LightShape::rectangle: {
+        if ((p - c).dot(light.normal()) - reach(light.normal()) <= 0) return false;
+        const double hw = 0.5 * light.desc().width, hh = 0.5 * light.desc().height;
+        const Vec3& right = light.right();
+        const Vec3& up = light.up();
+        base = {c - hw * right - hh * up, c + hw * right - hh * up, c + hw * right + hh * up,
+                c - hw * right + hh * up};
+        corners = 4;
+        base_normal = light.normal();
+        break;
+      }
+      case LightShape::disk:
+      case LightShape::sphere: {
+        if (light.shape() == LightShape::disk) {
+          if ((p - c).dot(light.normal()) - reach(light.normal()) <= 0) return false;
+          e1 = light.right();
+          e2 = light.up();
+          base_normal = light.normal();
+          r = light.desc().radius;
+        } else {
+          const Vec3 to = c - p;
+          const double dist = to.norm(), R = light.desc().radius;
+          if (dist - half.norm() <= R * (1 + 1e-9)) return false;
+          const Vec3 axis = to / dist;
+          if (point) {
+            // The silhouette: a circle of radius R·sqrt(L² − R²)/L at R²/L before the centre.
+            centre = c - axis * (R * R / dist);
+            r = R * std::sqrt(std::max(0.0, dist * dist - R * R)) / dist;
+          } else {
+            // From a box no one silhouette holds: the tangent cone from the box's centre,
+            // which holds the whole sphere, cut beyond it.
+            centre = c + axis * R;
+            r = R * (dist + R) / std::sqrt(std::max(1e-300, dist * dist - R * R));
+          }
+          base_normal = -axis;
+          e1 = std::abs(axis.x()) < 0.9 ? axis.cross(Vec3::UnitX()).normalized()
+                                        : axis.cross(Vec3::UnitY()).normalized();
+          e2 = axis.cross(e1);
+        }
+        // The octagon circumscribing the circle.
+        const double radius_scale = 1.0 / std::cos(std::numbers::pi / 8);
+        for (int k = 0; k < 8; ++k) {
+          const double a = (k + 0.5) * std::numbers::pi / 4;
+          base[std::size_t(k)] = centre + r * radius_scale * (std::cos(a) * e1 + std::sin(a) * e2);
+        }
+        corners = 8;
+        break;
+      }
+    }
+    if (surface) {
+      // The light must rise above the texel's horizon somewhere.
+      double highest = -std::numeric_limits<double>::infinity();
+      for (int k = 0; k < corners; ++k)
+        highest = std::max(highest, n->dot(base[std::size_t(k)] - *surface));
+      if (light.shape() == LightShape::sphere)
+        highest = std::max(highest, n->dot(c - *surface) + light.desc().radius);
+      if (highest <= 0) return false;
+    }
+
+    planes.clear();
+    Vec3 mid = Vec3::Zero();
+    for (int k = 0; k < corners; ++k) mid += base[std::size_t(k)];
+    mid /= corners;
+    for (int k = 0; k < corners; ++k) {
+      const Vec3& a = base[std::size_t(k)];
+      const Vec3& b = base[std::size_t((k + 1) % corners)];
+      Vec3 normal = (a - p).cross(b - p);
+      const double len = normal.norm();
+      if (!(len > 0)) continue;
+      normal /= len;
+      if (normal.dot(mid - p) > 0) normal = -normal;
+      planes.push_back({normal, normal.dot(p) + reach(normal)});
+    }
+    // Beyond the light's (or silhouette's) plane, and, for one texel, below the horizon of its
+    // surface point (its rays start a little above it and end above it).
+    planes.push_back({-base_normal, -base_normal.dot(base[0])});
+    // Through the lower of the surface point and the ray origin along the normal: the origin is
+    // lifted onto the smooth surface (uv_rasterizer.cpp), which may lie below the flat face's
+    // horizon, and the segment starts there.
+    if (surface) planes.push_back({-*n, -std::min(n->dot(*surface), n->dot(p))});
+    return true;
+  }
+
+  // Whether the light lies wholly on one side of a triangle's plane as the whole apex does (or a
+  // point apex lies on the plane): then the triangle cannot cut a segment from it to the light.
+  static bool same_side(const Tri& t, const Box& apex, const std::array<Vec3, 8>& base, int corners,
+                        const Light& light) {
+    const Vec3 p = 0.5 * (apex.lo + apex.hi);
+    const double spread = (0.5 * (apex.hi - apex.lo)).dot(t.normal.cwiseAbs());
+    const double sp = t.normal.dot(p - t.v[0]);
+    if (spread == 0 && std::abs(sp) <= kPlaneTolerance) return true;
+    // The light's extent along the normal: its base polygon, and for a sphere the sphere itself.
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (int k = 0; k < corners; ++k) {
+      const double s = t.normal.dot(base[std::size_t(k)] - t.v[0]);
+      lo = std::min(lo, s);
+      hi = std::max(hi, s);
+    }
+    if (light.shape() == LightShape::sphere) {
+      const double s = t.normal.dot(light.centre() - t.v[0]);
+      lo = std::min(lo, s - light.desc().radius);
+      hi = std::max(hi, s + light.desc().radius);
+    }
+    if (sp - spread > -kPlaneTolerance && sp - spread >= 0) return lo >= 0;
+    if (sp + spread < 0) return hi <= 0;
+    return false;
+  }
+
+  // Whether a triangle may lie in the shaft (planes, base) from `apex`.
+  static bool in_shaft(const Tri& t, const Box& apex, const std::vector<Plane>& planes,
+                       const std::array<Vec3, 8>& base, int corners, const Light& light,
+                       std::vector<Vec3>& poly, std::vector<Vec3>& scratch) {
+    if (t.normal.isZero()) return false;
+    // The triangle's box wholly outside one plane: nothing of it is in the shaft.
+    for (const Plane& pl : planes) {
+      const Vec3 near(pl.n.x() >= 0 ? t.lo.x() : t.hi.x(), pl.n.y() >= 0 ? t.lo.y() : t.hi.y(),
+                      pl.n.z() >= 0 ? t.lo.z() : t.hi.z());
+      if (pl.eval(near) > 0) return false;
+    }
+    if (same_side(t, apex, base, corners, light)) return false;
+    poly.assign(std::begin(t.v), std::end(t.v));
+    for (const Plane& pl : planes) {
+      clip(poly, scratch, pl);
+      if (poly.empty()) return false;
+    }
+    return true;
+  }
+
+  // Whether a blocker may lie in the apex's shaft. With `candidates`, every triangle that may
+  // (by index) is collected instead of stopping at the first; `among`, when given, restricts
+  // the search to those triangles (a tile's candidates, for its texels).
+  bool query(const Box& apex, const Vec3* surface, const Vec3* n, const Light& light,
+             std::vector<std::uint32_t>* candidates = nullptr,
+             const std::vector<std::uint32_t>* among = nullptr) const {
+    if (nodes.empty()) return false;
+    std::vector<Plane> planes;
+    std::array<Vec3, 8> base;
+    int corners = 0;
+    // A point the light cannot reach has nothing to block; a box of which some point it cannot
+    // reach is not decided here (its texels are tested one by one, among every triangle).
+    if (!shaft(apex, surface, n, light, planes, base, corners)) {
+      if (apex.lo == apex.hi) return false;
+      if (candidates) candidates->push_back(kAll);
+      return true;
+    }
+    std::vector<Vec3> poly, scratch;
+    if (among) {
+      for (std::uint32_t i : *among)
+        if (in_shaft(tris[i], apex, planes, base, corners, light, poly, scratch)) return true;
+      return false;
+    }
+    bool found = false;
+    int stack[64];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+      const Node& node = nodes[std::size_t(stack[--top])];
+      bool outside = false;
+      for (const Plane& pl : planes) {
+        // The box's corner least far along the plane's normal.
+        const Vec3 near(pl.n.x() >= 0 ? node.box.lo.x() : node.box.hi.x(),
+                        pl.n.y() >= 0 ? node.box.lo.y() : node.box.hi.y(),
+                        pl.n.z() >= 0 ? node.box.lo.z() : node.box.hi.z());
+        if (pl.eval(near) > 0) {
+          outside = true;
+          break;
+        }
+      }
+      if (outside) continue;
+      if (node.count == 0) {
+        if (top + 2 > 64) {  // deeper than any balanced tree: keep, to be safe
+          if (candidates) candidates->assign(1, kAll);
+          return true;
+        }
+        stack[top++] = node.left;
+        stack[top++] = node.right;
+        continue;
+      }
+      for (int i = node.first; i < node.first + node.count; ++i) {
+        if (!in_shaft(tris[std::size_t(i)], apex, planes, base, corners, light, poly, scratch))
+          continue;
+        if (!candidates) return true;
+        found = true;
+        candidates->push_back(std::uint32_t(i));
+        if (candidates->size() > kMaxCandidates) {  // a busy tile: search each texel afresh
+          candidates->assign(1, kAll);
+          return true;
+        }
+      }
+    }
+    return found;
+  }
+
+  // In a candidate list: "search every triangle".
+  static constexpr std::uint32_t kAll = 0xffffffffu;
+  static constexpr std::size_t kMaxCandidates = 32;
+};
+
+ShaftCuller::ShaftCuller(const std::vector<const Mesh*>& blockers)
+    : impl_(std::make_unique<Impl>()) {
+  for (const Mesh* m : blockers) {
+    for (const auto f : m->mesh.faces()) {
+      const Triangle tri = triangle(m->mesh, f);
+      Tri t;
+      for (int k = 0; k < 3; ++k) t.v[k] = tri.p[k];
+      const Vec3 cross = (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]);
+      const double len = cross.norm();
+      t.normal = len > 0 ? Vec3(cross / len) : Vec3::Zero();
+      t.lo = t.v[0].cwiseMin(t.v[1]).cwiseMin(t.v[2]);
+      t.hi = t.v[0].cwiseMax(t.v[1]).cwiseMax(t.v[2]);
+      impl_->tris.push_back(t);
+    }
+  }
+  if (!impl_->tris.empty()) {
+    impl_->nodes.reserve(2 * impl_->tris.size() / kLeafSize + 2);
+    impl_->build(0, int(impl_->tris.size()));
+  }
+}
+
+ShaftCuller::ShaftCuller(ShaftCuller&&) noexcept = default;
+ShaftCuller& ShaftCuller::operator=(ShaftCuller&&) noexcept = default;
+ShaftCuller::~ShaftCuller() = default;
+
+bool ShaftCuller::maybe_blocked(const Vec3& origin, const Vec3& surface, const Vec3& normal,
+                                const Light& light) const {
+  Box apex;
+  apex.extend(origin);
+  return impl_->query(apex, &surface, &normal, light);
+}
+
+std::vector<std::uint8_t> ShaftCuller::maybe_blocked(const TexelSpace& space, const Light& light,
+                                                     double offset) const {
+  // Tiles of kTile² texels (of the lightmap, so neighbours on the surface too, mostly) are
+  // tested as one box first: most of a floor is clear of every blocker, and one query says so
+  // for a whole tile. Only a tile that may be blocked is tested texel by texel.
+  constexpr int kTile = 8;
+  const int tiles_x = (space.width + kTile - 1) / kTile;
+  const int tiles_y = (space.height + kTile - 1) / kTile;
+  std::vector<std::vector<std::uint32_t>> tile_texels(std::size_t(tiles_x) * tiles_y);
+  std::vector<Vec3> origin(space.texels.size());
+  for (std::size_t i = 0; i < space.texels.size(); ++i) {
+    const Texel& t = space.texels[i];
+    origin[i] = t.shadow_origin.cast<double>() + offset * t.geometric_normal.cast<double>();
+    tile_texels[std::size_t(t.y / kTile) * tiles_x + std::size_t(t.x / kTile)].push_back(
+        std::uint32_t(i));
+  }
+  std::vector<std::uint8_t> out(space.texels.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tile_texels.size(), 16), [&](const auto& r) {
+    std::vector<std::uint32_t> candidates;
+    for (std::size_t k = r.begin(); k != r.end(); ++k) {
+      const std::vector<std::uint32_t>& members = tile_texels[k];
+      if (members.empty()) continue;
+      // The tile's own shaft first: clear, or the triangles its texels need to look at.
+      candidates.clear();
+      const bool tile = members.size() > 1;
+      if (tile) {
+        Box box;
+        for (std::uint32_t i : members) box.extend(origin[i]);
+        if (!impl_->query(box, nullptr, nullptr, light, &candidates)) continue;
+      }
+      const bool all = !tile || (!candidates.empty() && candidates[0] == Impl::kAll);
+      for (std::uint32_t i : members) {
+        const Texel& t = space.texels[i];
+        Box apex;
+        apex.extend(origin[i]);
+        const Vec3 surface = t.position.cast<double>(), normal = t.normal.cast<double>();
+        out[i] = impl_->query(apex, &surface, &normal, light, nullptr, all ? nullptr : &candidates);
+      }
+    }
+  });
+  return out;
+}
+
+}  // namespace sb

@@ -1,0 +1,341 @@
+// Area lights: closed-form unoccluded irradiance and sampling.
+//
+// H0 (design-notes §1): for a Lambertian emitter of exitance E, H0(y) = E · F(y) with F the
+// point-to-surface form factor, F = (1/π) ∫ cosθ_y dω over the part of the light above y's
+// horizon. For a polygon, Lambert's formula gives F exactly as a sum over edges:
+//   F = (1/2π) Σ_i  acos(â_i · â_{i+1}) · n · normalize(a_i × a_{i+1}).
+// For a disk wholly above the horizon the vector form factor has an elementary closed form
+// (the classic parallel and perpendicular disk form factors are its two components, and F is
+// linear in n); a disk cut by the horizon falls back to an equal-area polygon. A sphere seen from
+// y shows exactly the solid angle of its silhouette disk, so it reuses the disk.
+//
+// Sampling (the reference, design-notes §7): area sampling for rectangles and disks,
+// cone sampling for spheres. The reference estimates V with the ratio Σ w·v / Σ w over the same
+// samples rather than Σ w·v / (N · H0): both converge to H/H0, but the ratio is always in [0, 1]
+// and its noise is only that of v, not of the weight's variation over the light.
+#include "scene/lights.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "core/image_io.h"
+
+namespace sb {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr int kDiskPolygonSides = 128;
+
+// Clips a polygon to the half-space n·x >= 0 (Sutherland–Hodgman, one plane).
+std::vector<Vec3> clip_to_horizon(const std::vector<Vec3>& poly, const Vec3& n) {
+  std::vector<Vec3> out;
+  out.reserve(poly.size() + 2);
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    const Vec3& a = poly[i];
+    const Vec3& b = poly[(i + 1) % poly.size()];
+    const double da = n.dot(a), db = n.dot(b);
+    if (da >= 0) out.push_back(a);
+    if ((da >= 0) != (db >= 0)) out.push_back(a + (b - a) * (da / (da - db)));
+  }
+  return out;
+}
+
+// Disk of centre c (relative to the receiving point), unit axis m pointing at the emitting side,
+// radius R: form factor from a point at the origin with unit normal n.
+double disk_form_factor(const Vec3& c, const Vec3& m, const Vec3& right, const Vec3& up, double R,
+                        const Vec3& n) {
+  const Vec3 to_point = -c;          // from the disk centre to the point
+  const double h = to_point.dot(m);  // height above the disk's plane
+  if (h <= 0) return 0.0;            // behind the emitting side
+  const Vec3 radial = to_point - h * m;
+  const double rho = radial.norm();
+  const Vec3 n_in_plane = n - n.dot(m) * m;
+  // Lowest value of n·(x − y) over the disk's points x: the disk is wholly above the horizon
+  // when it is positive.
+  const double lowest = n.dot(c) - R * n_in_plane.norm();
+  if (n.dot(c) + R * n_in_plane.norm() <= 0) return 0.0;  // wholly below the horizon
+  if (lowest >= 0) {
+    const double A = h * h + rho * rho + R * R;
+    const double S = std::sqrt((h * h + (rho - R) * (rho - R)) * (h * h + (rho + R) * (rho + R)));
+    const double f_axial = 0.5 * (1.0 - (h * h + rho * rho - R * R) / S);  // normal = -m
+    // Perpendicular component, normal pointing from the point towards the axis; written as
+    // 2hR²ρ / (S (A + S)) rather than (h / 2ρ)(A / S − 1) so it stays exact as ρ → 0.
+    const double f_radial = 2.0 * h * R * R * rho / (S * (A + S));
+    double f = f_axial * n.dot(-m);
+    if (rho > 0) f += f_radial * n.dot(-radial / rho);
+    return std::max(0.0, f);
+  }
+  // Cut by the horizon: a regular polygon with the disk's area.
+  const double sides = kDiskPolygonSides;
+  const double r_poly = R * std::sqrt(2.0 * kPi / (sides * std::sin(2.0 * kPi / sides)));
+  std::vector<Vec3> poly(kDiskPolygonSides);
+  for (int i = 0; i < kDiskPolygonSides; ++i) {
+    const double t = 2.0 * kPi * i / sides;
+    poly[i] = c + r_poly * (std::cos(t) * right + std::sin(t) * up);
+  }
+  return polygon_form_factor(std::move(poly), n);
+}
+
+// RGB of pixel (x, y): grey images repeat their one channel; alpha is ignored.
+Vec3 pixel_rgb(const Image& image, int x, int y) {
+  const float* p = image.at(x, y);
+  return image.channels >= 3 ? Vec3(p[0], p[1], p[2]) : Vec3::Constant(p[0]);
+}
+
+Vec3 texture_mean(const Image& image) {
+  Vec3 sum = Vec3::Zero();
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) sum += pixel_rgb(image, x, y);
+  return sum / (double(image.width) * image.height);
+}
+
+// Bilinear lookup at (u, v) ∈ [0, 1]², v up (row 0 is v = 1), clamped at the border.
+Vec3 bilinear_rgb(const Image& image, double u, double v) {
+  const double fx = std::clamp(u, 0.0, 1.0) * image.width - 0.5;
+  const double fy = (1.0 - std::clamp(v, 0.0, 1.0)) * image.height - 0.5;
+  const int x0 = std::clamp(int(std::floor(fx)), 0, image.width - 1);
+  const int y0 = std::clamp(int(std::floor(fy)), 0, image.height - 1);
+  const int x1 = std::min(x0 + 1, image.width - 1), y1 = std::min(y0 + 1, image.height - 1);
+  const double tx = std::clamp(fx - x0, 0.0, 1.0), ty = std::clamp(fy - y0, 0.0, 1.0);
+  return (1 - ty) * ((1 - tx) * pixel_rgb(image, x0, y0) + tx * pixel_rgb(image, x1, y0)) +
+         ty * ((1 - tx) * pixel_rgb(image, x0, y1) + tx * pixel_rgb(image, x1, y1));
+}
+
+// Any unit vector orthogonal to m.
+Vec3 orthogonal(const Vec3& m) {
+  const Vec3 a = std::abs(m.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+  return (a - a.dot(m) * m).normalized();
+}
+
+}  // namespace
+
+double polygon_form_factor(std::vector<Vec3> polygon, const Vec3& n) {
+  polygon = clip_to_horizon(polygon, n);
+  if (polygon.size() < 3) return 0.0;
+  double sum = 0;
+  for (std::size_t i = 0; i < polygon.size(); ++i) {
+    const Vec3 a = polygon[i].normalized();
+    const Vec3 b = polygon[(i + 1) % polygon.size()].normalized();
+    const Vec3 cross = a.cross(b);
+    const double len = cross.norm();
+    if (len < 1e-300) continue;
+    const double angle = std::atan2(len, a.dot(b));
+    sum += angle * n.dot(cross / len);
+  }
+  return std::abs(sum) / (2.0 * kPi);
+}
+
+Light::Light(const LightDesc& desc, std::shared_ptr<const Image> texture)
+    : desc_(desc), texture_(std::move(texture)) {
+  if (desc_.shape == LightShape::sphere) {
+    up_ = Vec3::UnitZ();
+    right_ = Vec3::UnitX();
+  } else {
+    // In the light's plane whatever the description holds (the scene reader makes `up`
+    // perpendicular to the normal; a description built by hand may not).
+    up_ = (desc_.up - desc_.up.dot(desc_.normal) * desc_.normal).normalized();
+    right_ = up_.cross(desc_.normal).normalized();
+  }
+  exitance_ = desc_.color * (desc_.power / area());
+  if (texture_) exitance_ = exitance_.cwiseProduct(texture_mean(*texture_));
+}
+
+Vec3 Light::tint(const Vec2& local) const {
+  if (!texture_) return Vec3::Ones();
+  // Texture coordinates over the light's bounding rectangle: u along right, v along up.
+  const double w = desc_.shape == LightShape::rectangle ? desc_.width : 2 * desc_.radius;
+  const double h = desc_.shape == LightShape::rectangle ? desc_.height : 2 * desc_.radius;
+  return bilinear_rgb(*texture_, local.x() / w + 0.5, local.y() / h + 0.5);
+}
+
+double Light::extent_across(const Vec3& axis) const {
+  switch (desc_.shape) {
+    case LightShape::rectangle: {
+      // The longer diagonal of the parallelogram the rectangle projects to.
+      const Vec3 a = 0.5 * desc_.width * right_, b = 0.5 * desc_.height * up_;
+      auto across = [&](const Vec3& v) { return (v - v.dot(axis) * axis).norm(); };
+      return 2 * std::max(across(a + b), across(a - b));
+    }
+    case LightShape::disk:
+    case LightShape::sphere:
+      return 2 * desc_.radius;  // an ellipse's major axis, or the sphere's outline
+  }
+  return 0;
+}
+
+Vec2 Light::half_extents(const Vec3& e1, const Vec3& e2) const {
+  auto along = [&](const Vec3& e) {
+    switch (desc_.shape) {
+      case LightShape::rectangle:
+        return 0.5 * (desc_.width * std::abs(right_.dot(e)) + desc_.height * std::abs(up_.dot(e)));
+      case LightShape::disk:
+        return desc_.radius * std::sqrt(std::max(0.0, 1.0 - std::pow(desc_.normal.dot(e), 2)));
+      case LightShape::sphere:
+        return desc_.radius;
+    }
+    return 0.0;
+  };
+  return Vec2(along(e1), along(e2));
+}
+
+Vec3 Light::source_image(const Vec3& offset, const Vec3& axis) const {
+  if (desc_.shape == LightShape::sphere) {
+    return (offset - offset.dot(axis) * axis).norm() <= desc_.radius ? Vec3::Ones() : Vec3::Zero();
+  }
+  // Slide along the axis onto the light's plane.
+  const double facing = axis.dot(desc_.normal);
+  if (std::abs(facing) < 1e-9) return Vec3::Zero();  // seen edge-on: no area
+  const Vec3 on_light = offset - axis * (offset.dot(desc_.normal) / facing);
+  const Vec2 local(on_light.dot(right_), on_light.dot(up_));
+  const bool inside =
+      desc_.shape == LightShape::rectangle
+          ? std::abs(local.x()) <= 0.5 * desc_.width && std::abs(local.y()) <= 0.5 * desc_.height
+          : local.squaredNorm() <= desc_.radius * desc_.radius;
+  return inside ? tint(local) : Vec3::Zero();
+}
+
+double Light::area() const {
+  switch (desc_.shape) {
+    case LightShape::rectangle:
+      return desc_.width * desc_.height;
+    case LightShape::disk:
+      return kPi * desc_.radius * desc_.radius;
+    case LightShape::sphere:
+      return 4.0 * kPi * desc_.radius * desc_.radius;
+  }
+  return 0;
+}
+
+double Light::form_factor(const Vec3& y, const Vec3& n) const {
+  const Vec3 c = desc_.position - y;
+  switch (desc_.shape) {
+    case LightShape::rectangle: {
+      if (c.dot(desc_.normal) >= 0) return 0.0;  // the point is behind the emitting side
+      const Vec3 hw = 0.5 * desc_.width * right_, hh = 0.5 * desc_.height * up_;
+      return polygon_form_factor({c - hw - hh, c + hw - hh, c + hw + hh, c - hw + hh}, n);
+    }
+    case LightShape::disk:
+      return disk_form_factor(c, desc_.normal, right_, up_, desc_.radius, n);
+    case LightShape::sphere: {
+      const double d = c.norm(), r = desc_.radius;
+      if (d <= r) return 0.0;
+      // The silhouette: a disk facing the point, at distance (d² − r²)/d, of radius r·√(d²−r²)/d.
+      const Vec3 axis = -c / d;
+      const Vec3 sil_centre = c * (1.0 - r * r / (d * d));
+      const double sil_radius = r * std::sqrt(d * d - r * r) / d;
+      const Vec3 a = orthogonal(axis);
+      return disk_form_factor(sil_centre, axis, a, axis.cross(a), sil_radius, n);
+    }
+  }
+  return 0.0;
+}
+
+bool Light::reaches(const Vec3& y, const Vec3& n) const {
+  const Vec3 c = desc_.position - y;
+  switch (desc_.shape) {
+    case LightShape::rectangle: {
+      if (c.dot(desc_.normal) >= 0) return false;
+      // The horizon clips a positive area off the rectangle as soon as one corner is above it.
+      const double hw = 0.5 * desc_.width * std::abs(n.dot(right_));
+      const double hh = 0.5 * desc_.height * std::abs(n.dot(up_));
+      return n.dot(c) + hw + hh > 0;
+    }
+    case LightShape::disk:
+      return c.dot(desc_.normal) < 0 &&
+             n.dot(c) + desc_.radius * (n - n.dot(desc_.normal) * desc_.normal).norm() > 0;
+    case LightShape::sphere: {
+      const double d = c.norm(), r = desc_.radius;
+      if (d <= r) return false;
+      // The silhouette disk, as in form_factor.
+      const Vec3 axis = -c / d;
+      const Vec3 sil_centre = c * (1.0 - r * r / (d * d));
+      const double sil_radius = r * std::sqrt(d * d - r * r) / d;
+      return n.dot(sil_centre) + sil_radius * (n - n.dot(axis) * axis).norm() > 0;
+    }
+  }
+  return false;
+}
+
+Vec3 Light::unoccluded_irradiance(const Vec3& y, const Vec3& n) const {
+  return exitance_ * form_factor(y, n);
+}
+
+LightSample Light::sample(const Vec3& y, const Vec3& n, const Vec2& u) const {
+  LightSample s;
+  switch (desc_.shape) {
+    case LightShape::rectangle:
+    case LightShape::disk: {
+      Vec2 local;  // metres in the light's (right, up) frame
+      if (desc_.shape == LightShape::rectangle) {
+        local = Vec2((u.x() - 0.5) * desc_.width, (u.y() - 0.5) * desc_.height);
+      } else {
+        // Shirley–Chiu concentric map: keeps the strata's shapes compact on the disk.
+        const double a = 2 * u.x() - 1, b = 2 * u.y() - 1;
+        double r, phi;
+        if (a == 0 && b == 0) {
+          r = 0, phi = 0;
+        } else if (std::abs(a) > std::abs(b)) {
+          r = a, phi = (kPi / 4) * (b / a);
+        } else {
+          r = b, phi = kPi / 2 - (kPi / 4) * (a / b);
+        }
+        local = desc_.radius * r * Vec2(std::cos(phi), std::sin(phi));
+      }
+      s.point = desc_.position + local.x() * right_ + local.y() * up_;
+      s.tint = tint(local);
+      const Vec3 d = s.point - y;
+      const double dist2 = d.squaredNorm();
+      if (dist2 <= 0) return s;
+      const double inv = 1.0 / std::sqrt(dist2);
+      const double cos_light = -d.dot(desc_.normal) * inv;
+      const double cos_receiver = d.dot(n) * inv;
+      if (cos_light > 0 && cos_receiver > 0) s.weight = cos_light * cos_receiver / dist2;
+      return s;
+    }
+    case LightShape::sphere: {
+      const Vec3 c = desc_.position - y;
+      const double d = c.norm(), r = desc_.radius;
+      if (d <= r) return s;
+      const Vec3 axis = c / d;
+      const double cos_max = std::sqrt(std::max(0.0, 1.0 - r * r / (d * d)));
+      const double cos_t = 1.0 - u.x() * (1.0 - cos_max);
+      const double sin_t = std::sqrt(std::max(0.0, 1.0 - cos_t * cos_t));
+      const double phi = 2 * kPi * u.y();
+      const Vec3 a = orthogonal(axis), b = axis.cross(a);
+      const Vec3 dir = cos_t * axis + sin_t * (std::cos(phi) * a + std::sin(phi) * b);
+      // Nearest intersection of the ray y + t·dir with the sphere.
+      const double proj = dir.dot(c);
+      const double t = proj - std::sqrt(std::max(0.0, r * r - (d * d - proj * proj)));
+      s.point = y + t * dir;
+      const double cos_receiver = dir.dot(n);
+      if (cos_receiver > 0) s.weight = cos_receiver;
+      return s;
+    }
+  }
+  return s;
+}
+
+Expected<std::vector<Light>> make_lights(const std::vector<LightDesc>& descs,
+                                         const std::filesystem::path& scene_file) {
+  std::vector<Light> lights;
+  lights.reserve(descs.size());
+  for (const auto& d : descs) {
+    std::shared_ptr<const Image> texture;
+    if (!d.texture.empty()) {
+      auto image = read_image(d.texture, /*linearise=*/true);
+      const std::string where = scene_file.string() + ":" + std::to_string(d.line) + ": light '" +
+                                d.name + "': texture: ";
+      if (!image) return scene_error(where + image.error().message);
+      if (image->width < 1 || image->height < 1 || texture_mean(*image).maxCoeff() <= 0) {
+        return scene_error(where + d.texture.string() + ": the image is empty or black");
+      }
+      texture = std::make_shared<const Image>(std::move(*image));
+    }
+    lights.emplace_back(d, std::move(texture));
+  }
+  return lights;
+}
+
+}  // namespace sb

@@ -1,0 +1,94 @@
+// Area lights as the bake methods see them: emission, closed-form unoccluded irradiance H0
+// (design-notes §1) and stratified sampling for the ray-traced reference.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <vector>
+
+#include "core/error.h"
+#include "core/geometry.h"
+#include "core/image.h"
+#include "scene/scene.h"
+
+namespace sb {
+
+// A point on a light chosen for one shadow ray, with its weight in the ratio estimator
+// V = Σ w·v / Σ w (lights.cpp says why that estimator).
+struct LightSample {
+  Vec3 point;
+  double weight = 0;  // 0: the sample cannot contribute (behind the light or below the horizon)
+  Vec3 tint = Vec3::Ones();  // the emission texture at the point (ones for an untextured light)
+};
+
+class Light {
+ public:
+  // `texture`, if given, is the emission image mapped over a rectangle or disk (linear RGB or
+  // grey; row 0 is the top, along `up`).
+  explicit Light(const LightDesc& desc, std::shared_ptr<const Image> texture = nullptr);
+
+  const LightDesc& desc() const { return desc_; }
+  LightShape shape() const { return desc_.shape; }
+  Vec3 centre() const { return desc_.position; }
+  // Emitting surface area in m² (a sphere's whole surface; a rectangle or disk's one side).
+  double area() const;
+  // Radiant exitance per channel, W/m², averaged over the light: color · power / area, times the
+  // texture's mean for a textured light.
+  Vec3 exitance() const { return exitance_; }
+  bool textured() const { return texture_ != nullptr; }
+  // The texture's value (bilinear) at a point given in metres in the light's (right, up) frame;
+  // ones for an untextured light.
+  Vec3 tint(const Vec2& local) const;
+  // Largest distance across the light seen along `axis`: the length that the penumbra error
+  // metric multiplies (design-notes §4), metres.
+  double extent_across(const Vec3& axis) const;
+  // Half the light's extent along each of two unit directions e1, e2 across the axis of
+  // projection (the bounding box of its outline seen along that axis), metres.
+  Vec2 half_extents(const Vec3& e1, const Vec3& e2) const;
+  // What the source image of design-notes §2 holds at a point of the plane through the centre
+  // perpendicular to `axis` (given as an offset from the centre): the light's relative emission
+  // (per channel, tint times 1) where the line through the point along `axis` meets the light,
+  // 0 where it misses. A sphere is a uniform disk of its radius.
+  Vec3 source_image(const Vec3& offset, const Vec3& axis) const;
+  // Unit axes of a rectangle or disk: right = up × normal; the normal is the emitting side.
+  const Vec3& right() const { return right_; }
+  const Vec3& up() const { return up_; }
+  const Vec3& normal() const { return desc_.normal; }
+
+  // Unoccluded irradiance H0 at point y with unit normal n, per channel, W/m², in closed form:
+  // H0 = E · F where F is the form factor from the point to the light, clipped to the point's
+  // horizon. Rectangle: Lambert's polygon formula (exact). Disk, and a sphere through the disk of
+  // its silhouette: the elementary closed form when the disk is wholly above the horizon, and a
+  // 128-gon of equal area, clipped, otherwise (relative error < 1e-4, tested). A textured light
+  // uses its mean exitance: exact for a uniform texture, the far-field value otherwise.
+  Vec3 unoccluded_irradiance(const Vec3& y, const Vec3& n) const;
+  // Whether any of the light lies above the horizon of (y, n) and faces y, i.e. F > 0; much
+  // cheaper than F itself.
+  bool reaches(const Vec3& y, const Vec3& n) const;
+  // The form factor F alone (dimensionless, H0 = E · F).
+  double form_factor(const Vec3& y, const Vec3& n) const;
+
+  // Maps a stratified point u ∈ [0,1)² to a light sample as seen from y with normal n.
+  // Rectangle and disk: uniform in area, weight cosθ_light · cosθ_receiver / r².
+  // Sphere: uniform in the solid angle of the cone it subtends, weight cosθ_receiver.
+  // Either way Σ w·v / Σ w converges to V = H / H0.
+  LightSample sample(const Vec3& y, const Vec3& n, const Vec2& u) const;
+
+ private:
+  LightDesc desc_;
+  Vec3 right_, up_;
+  Vec3 exitance_;
+  std::shared_ptr<const Image> texture_;
+};
+
+// The scene's lights, with their textures read (through OpenImageIO, sRGB decoded to linear).
+// An unreadable texture is an error naming scene_file, the light and the image.
+Expected<std::vector<Light>> make_lights(const std::vector<LightDesc>& descs,
+                                         const std::filesystem::path& scene_file);
+
+// Lambert's formula for the form factor of a planar polygon (vertices relative to the point,
+// either winding) seen from a point with unit normal n, after clipping the polygon to the
+// half-space n·x >= 0. Exposed for tests.
+double polygon_form_factor(std::vector<Vec3> polygon, const Vec3& n);
+
+}  // namespace sb

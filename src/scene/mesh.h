@@ -1,0 +1,57 @@
+// The project's working mesh: an OpenMesh triangle mesh in world space (object transform
+// applied) with per-vertex normals and the object's lightmap UVs. Imported with Assimp by
+// import_mesh (mesh_import.cpp); every later stage reads geometry from here.
+#pragma once
+
+#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "core/geometry.h"
+#include "scene/scene.h"
+
+namespace sb {
+
+struct MeshTraits : public OpenMesh::DefaultTraits {
+  using Point = OpenMesh::Vec3d;
+  using Normal = OpenMesh::Vec3d;
+  using TexCoord2D = OpenMesh::Vec2d;
+  VertexAttributes(OpenMesh::Attributes::Normal | OpenMesh::Attributes::TexCoord2D);
+  FaceAttributes(OpenMesh::Attributes::Normal);
+};
+
+using TriMesh = OpenMesh::TriMesh_ArrayKernelT<MeshTraits>;
+
+struct Mesh {
+  std::string name;            // the object's name
+  TriMesh mesh;                // world space; vertex texcoords are the lightmap UVs
+  bool has_uv = false;         // false when the mesh has no UV set at the object's uv channel
+  int skipped_degenerate = 0;  // zero-area triangles dropped on import
+};
+
+// Loads every mesh of every node of obj.mesh (one object = the whole file), applies node
+// transforms and then obj.transform, takes UVs from obj.uv_channel, drops zero-area triangles
+// (counted in skipped_degenerate). Errors name scene_file, the object and the problem: an
+// unreadable file, no triangles, NaN/infinite vertices, or a receiver without the UV channel.
+// What a mesh file may cost: its size, and the memory and time its reader may take
+// (mesh_reader.h).
+struct ImportLimits {
+  std::uint64_t max_file_bytes = std::uint64_t(1) << 32;  // refused before it is read
+  std::uint64_t max_memory = std::uint64_t(4) << 30;      // Assimp's allocations
+  double max_seconds = 0;  // Assimp's time; 0: 60 s plus 10 s per MB of file
+};
+Expected<Mesh> import_mesh(const ObjectDesc& obj, const std::filesystem::path& scene_file,
+                           const ImportLimits& limits = {});
+
+// World-space triangle of face f, as three points.
+struct Triangle {
+  Vec3 p[3];
+  Vec3 n[3];   // vertex normals (unit)
+  Vec2 uv[3];  // lightmap UVs
+};
+Triangle triangle(const TriMesh& mesh, TriMesh::FaceHandle f);
+
+}  // namespace sb

@@ -1,0 +1,359 @@
+// Mesh import: reads one object's mesh file with Assimp (any format it knows: OBJ, PLY, glTF,
+// FBX, ...) and builds the project's working mesh (mesh.h) in world space.
+//
+// Why each choice:
+// - Assimp post-processing triangulates, pre-transforms vertices (node transforms applied; all
+//   meshes of the file become one object) and generates smooth normals only where the file has
+//   none. It is not asked to remove degenerate triangles (we count them, so the user is told) nor
+//   to convert axes (world coordinates are the file's own; the scene's transform places the
+//   object).
+// - Vertices are welded here, not by Assimp's JoinIdenticalVertices: in Assimp 5.2.5 that step
+//   compares only the first UV channel, so on a mesh whose lightmap UVs (channel 1) have seams
+//   where its texture UVs (channel 0) have none, vertices on either side of a lightmap seam are
+//   merged and triangles stretch across the atlas. Two vertices are one when their position,
+//   normal and every UV channel are bitwise equal (weld_vertices), so OpenMesh sees the shared
+//   vertices and connectivity of each chart and no seam of any channel is lost.
+// - Before Assimp reads a file, check_mesh_file (mesh_file_checks.h) refuses files it would
+//   misread or exhaust memory on; Assimp then reads it in a helper process (mesh_reader.h), so a
+//   crash, a hang or a runaway allocation inside Assimp is an error too; Assimp's own warnings
+//   that it dropped faces are errors here.
+// - obj.transform is applied here, in double precision: points by the affine map, normals by the
+//   inverse transpose of its linear part. A mirroring transform (negative determinant) reverses
+//   every triangle's winding so that the winding-derived face normals keep agreeing with the
+//   transformed vertex normals (both stay on the file's outward side). Assimp's pre-transform
+//   does not do the same for a mirroring node transform inside the file, so any triangle whose
+//   winding disagrees with its vertex normals is reversed too: the normals say which side is out.
+// - OpenMesh refuses non-manifold faces; such a face is added on fresh copies of its vertices so
+//   no triangle, hence no blocker or receiver surface, is ever lost.
+// - Bad input (unreadable file, no triangles, non-finite positions, only degenerate triangles, a
+//   receiver without its UV channel) is an Error, never a crash or an exception.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <system_error>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "scene/mesh.h"
+#include "scene/mesh_file_checks.h"
+#include "scene/mesh_reader.h"
+
+namespace sb {
+namespace {
+
+// A triangle smaller than this fraction of the squared bounding-box diagonal has no area worth
+// shading or tracing; it is skipped and counted.
+constexpr double kDegenerateAreaFraction = 1e-12;
+
+// One vertex of the file after Assimp's post-processing, in world space.
+struct ImportedVertex {
+  Vec3 position;
+  Vec3 normal;  // unit, or zero when the file's normal is unusable (fixed after face normals)
+  Vec2 uv = Vec2::Zero();
+};
+
+class ErrorPrefix {
+ public:
+  ErrorPrefix(const ObjectDesc& obj, const std::filesystem::path& scene_file)
+      : prefix_(scene_file.string() + ":" + std::to_string(obj.line) + ": object '" + obj.name +
+                "': ") {}
+  Error operator()(const std::string& problem) const { return scene_error(prefix_ + problem); }
+
+ private:
+  std::string prefix_;
+};
+
+// Assimp reports what it dropped from a broken file only as a log warning ("Some faces had
+// out-of-range indices. Those faces were dropped." in its glTF 2 reader): the first such message
+// of the reader's, or "".
+std::string dropped_data_message(const std::vector<std::string>& messages) {
+  for (const std::string& m : messages) {
+    if (m.find("dropped") != std::string::npos || m.find("out-of-range") != std::string::npos ||
+        m.find("out of range") != std::string::npos)
+      return m;
+  }
+  return "";
+}
+
+// Assimp's messages may span lines and quote bytes of a broken file; errors are one line.
+std::string one_line(std::string text) {
+  for (char& c : text) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = ' ';
+  }
+  while (!text.empty() && text.back() == ' ') text.pop_back();
+  return text;
+}
+
+// obj.mesh is resolved against the scene file's folder by the scene reader; a path still
+// relative to that folder (an ObjectDesc built by hand) is accepted too.
+std::filesystem::path mesh_path(const ObjectDesc& obj, const std::filesystem::path& scene_file) {
+  std::error_code ec;
+  if (obj.mesh.is_absolute() || std::filesystem::exists(obj.mesh, ec)) return obj.mesh;
+  const std::filesystem::path beside_scene = scene_file.parent_path() / obj.mesh;
+  if (std::filesystem::exists(beside_scene, ec)) return beside_scene;
+  return obj.mesh;
+}
+
+// A captured Assimp message without its "Warn,  T0: " prefix, on one line.
+std::string assimp_message(const std::string& message) {
+  const auto colon = message.find(": ");
+  return one_line(colon != std::string::npos && colon < 16 ? message.substr(colon + 2) : message);
+}
+
+std::string format_vec(const Vec3& v) {
+  std::ostringstream out;
+  out << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
+  return out.str();
+}
+
+// Adds triangle (a, b, c) to mesh. OpenMesh's add_face refuses a face that would make a vertex or
+// an edge non-manifold (and prints why); the checks below are its own, done first to keep it
+// quiet. A refused face is added on three fresh copies of its vertices.
+void add_triangle(TriMesh& mesh, TriMesh::VertexHandle a, TriMesh::VertexHandle b,
+                  TriMesh::VertexHandle c) {
+  const TriMesh::VertexHandle corners[3] = {a, b, c};
+  bool manifold = true;
+  for (int i = 0; i < 3 && manifold; ++i) {
+    const auto from = corners[i];
+    const auto to = corners[(i + 1) % 3];
+    if (!mesh.is_boundary(from)) manifold = false;
+    const auto he = mesh.find_halfedge(from, to);
+    if (he.is_valid() && !mesh.is_boundary(he)) manifold = false;
+  }
+  if (manifold && mesh.add_face(a, b, c).is_valid()) return;
+
+  TriMesh::VertexHandle copies[3];
+  for (int i = 0; i < 3; ++i) {
+    // Copies first: point(), normal() and texcoord2D() return references into the vertex
+    // arrays that add_vertex may reallocate.
+    const TriMesh::Point point = mesh.point(corners[i]);
+    const TriMesh::Normal normal = mesh.normal(corners[i]);
+    const TriMesh::TexCoord2D uv = mesh.texcoord2D(corners[i]);
+    copies[i] = mesh.add_vertex(point);
+    mesh.set_normal(copies[i], normal);
+    mesh.set_texcoord2D(copies[i], uv);
+  }
+  mesh.add_face(copies[0], copies[1], copies[2]);
+}
+
+// For every vertex of the file (all meshes concatenated, in order), the index of the first vertex
+// that has the same position, normal and UVs in every channel, bit for bit: the welded vertex it
+// becomes. Bitwise, because "identical" is what a weld may merge without changing any attribute;
+// +0 and -0 stay apart, which only keeps a seam.
+std::vector<std::size_t> weld_vertices(const RawMeshFile& file) {
+  // Up to 3 + 3 + 3 * kMaxUvChannels floats, and which of them are present.
+  struct Key {
+    std::uint32_t present = 0;
+    std::uint32_t bits[6 + 3 * kMaxUvChannels] = {};
+    bool operator==(const Key& o) const {
+      return present == o.present && std::memcmp(bits, o.bits, sizeof bits) == 0;
+    }
+  };
+  struct KeyHash {
+    std::size_t operator()(const Key& k) const {
+      std::uint64_t h = 1469598103934665603ull ^ k.present;  // FNV-1a over the words
+      for (std::uint32_t w : k.bits) h = (h ^ w) * 1099511628211ull;
+      return std::size_t(h);
+    }
+  };
+  std::size_t total = 0;
+  for (const RawMeshPart& part : file.parts) total += part.vertex_count();
+  std::vector<std::size_t> representative(total);
+  std::unordered_map<Key, std::size_t, KeyHash> first;
+  first.reserve(total);
+  std::size_t index = 0;
+  for (const RawMeshPart& part : file.parts) {
+    for (std::size_t i = 0; i < part.vertex_count(); ++i, ++index) {
+      Key key;
+      std::memcpy(key.bits, &part.positions[3 * i], 12);
+      if (!part.normals.empty()) {
+        key.present |= 1;
+        std::memcpy(key.bits + 3, &part.normals[3 * i], 12);
+      }
+      for (int c = 0; c < kMaxUvChannels; ++c) {
+        if (part.uvs[std::size_t(c)].empty()) continue;
+        key.present |= 2u << c;
+        std::memcpy(key.bits + 6 + 3 * c, &part.uvs[std::size_t(c)][3 * i], 12);
+      }
+      representative[index] = first.try_emplace(key, index).first->second;
+    }
+  }
+  return representative;
+}
+
+Expected<Mesh> build_mesh(const RawMeshFile& file, const ObjectDesc& obj, const std::string& path,
+                          const ErrorPrefix& error) {
+  Mesh result;
+  result.name = obj.name;
+
+  std::size_t triangle_count = 0;
+  for (const RawMeshPart& part : file.parts) triangle_count += part.triangles.size() / 3;
+  if (triangle_count == 0) {
+    return error("'" + path + "' has no triangles (an object needs a surface)");
+  }
+
+  // UV channel: every part must carry it for the object to have lightmap UVs.
+  const bool channel_in_range = obj.uv_channel >= 0 && obj.uv_channel < kMaxUvChannels;
+  result.has_uv = channel_in_range;
+  const RawMeshPart* part_without_uv = nullptr;
+  for (const RawMeshPart& part : file.parts) {
+    if (!channel_in_range || part.uvs[std::size_t(obj.uv_channel)].empty()) {
+      result.has_uv = false;
+      if (!part_without_uv) part_without_uv = &part;
+    }
+  }
+
+  // Vertices in world space, all parts concatenated. UVs are copied only when every part has
+  // the channel, so has_uv says what the texcoords hold.
+  const Mat3 linear = obj.transform.linear();
+  const Mat3 normal_matrix = linear.inverse().transpose();
+  const bool mirrors = linear.determinant() < 0;
+  std::vector<ImportedVertex> vertices;
+  std::vector<std::size_t> first_vertex(file.parts.size());
+  bool uvs_finite = true;
+  for (std::size_t m = 0; m < file.parts.size(); ++m) {
+    const RawMeshPart& part = file.parts[m];
+    first_vertex[m] = vertices.size();
+    for (std::size_t i = 0; i < part.vertex_count(); ++i) {
+      ImportedVertex v;
+      const float* p = &part.positions[3 * i];
+      const Vec3 file_position(p[0], p[1], p[2]);
+      if (!file_position.allFinite()) {
+        return error("'" + path + "': vertex " + std::to_string(vertices.size()) +
+                     " (as Assimp numbers them) has a non-finite position " +
+                     format_vec(file_position) + "; fix the mesh file");
+      }
+      v.position = obj.transform * file_position;
+      v.normal = Vec3::Zero();
+      if (!part.normals.empty()) {
+        const float* n = &part.normals[3 * i];
+        const Vec3 world_normal = normal_matrix * Vec3(n[0], n[1], n[2]);
+        const double length = world_normal.norm();
+        if (std::isfinite(length) && length > 0) v.normal = world_normal / length;
+      }
+      if (result.has_uv) {
+        const float* t = &part.uvs[std::size_t(obj.uv_channel)][3 * i];
+        v.uv = Vec2(t[0], t[1]);
+        if (!v.uv.allFinite()) {
+          if (obj.receiver) {
+            return error("'" + path + "': vertex " + std::to_string(vertices.size()) +
+                         " (as Assimp numbers them) has a non-finite UV in channel " +
+                         std::to_string(obj.uv_channel) + "; fix the mesh file");
+          }
+          uvs_finite = false;
+        }
+      }
+      vertices.push_back(v);
+    }
+  }
+  if (!uvs_finite) {  // a blocker's unusable UVs are dropped: it needs none
+    result.has_uv = false;
+    for (ImportedVertex& v : vertices) v.uv = Vec2::Zero();
+  }
+  if (obj.receiver && !result.has_uv) {
+    const int channels = part_without_uv ? part_without_uv->uv_channel_count() : 0;
+    const std::string channel = std::to_string(obj.uv_channel);
+    return error("a receiver needs lightmap UVs in channel " + channel + " (uv = " + channel +
+                 ") but '" + path + "' has " +
+                 (channels == 0 ? std::string("no UVs")
+                                : "only " + std::to_string(channels) + " UV channel(s)") +
+                 "; add a lightmap UV set or set 'uv' to an existing channel");
+  }
+
+  // Degenerate threshold relative to the object's size, from the vertices faces use.
+  Bounds3 bounds;
+  for (std::size_t m = 0; m < file.parts.size(); ++m)
+    for (const std::uint32_t index : file.parts[m].triangles)
+      bounds.extend(vertices[first_vertex[m] + index].position);
+  const double diagonal = bounds.diagonal();
+  const double min_area = kDegenerateAreaFraction * diagonal * diagonal;
+
+  TriMesh& mesh = result.mesh;
+  const std::vector<std::size_t> welded = weld_vertices(file);
+  std::vector<TriMesh::VertexHandle> handle(vertices.size());  // made on first use
+  auto vertex = [&](std::size_t index) {
+    if (!handle[index].is_valid()) {
+      const ImportedVertex& v = vertices[index];
+      handle[index] =
+          mesh.add_vertex(TriMesh::Point(v.position.x(), v.position.y(), v.position.z()));
+      mesh.set_normal(handle[index], TriMesh::Normal(v.normal.x(), v.normal.y(), v.normal.z()));
+      mesh.set_texcoord2D(handle[index], TriMesh::TexCoord2D(v.uv.x(), v.uv.y()));
+    }
+    return handle[index];
+  };
+  for (std::size_t m = 0; m < file.parts.size(); ++m) {
+    const std::vector<std::uint32_t>& triangles = file.parts[m].triangles;
+    for (std::size_t f = 0; f + 2 < triangles.size(); f += 3) {
+      std::size_t index[3];
+      for (int k = 0; k < 3; ++k)
+        index[k] = welded[first_vertex[m] + triangles[f + std::size_t(k)]];
+      if (mirrors) std::swap(index[1], index[2]);
+      const Vec3& a = vertices[index[0]].position;
+      const Vec3& b = vertices[index[1]].position;
+      const Vec3& c = vertices[index[2]].position;
+      const Vec3 winding_normal = (b - a).cross(c - a);
+      const double area = 0.5 * winding_normal.norm();
+      const Vec3 normal_sum =
+          vertices[index[0]].normal + vertices[index[1]].normal + vertices[index[2]].normal;
+      if (winding_normal.dot(normal_sum) < 0) std::swap(index[1], index[2]);
+      if (!(area > min_area) || area == 0 || index[0] == index[1] || index[1] == index[2] ||
+          index[0] == index[2]) {
+        ++result.skipped_degenerate;
+        continue;
+      }
+      add_triangle(mesh, vertex(index[0]), vertex(index[1]), vertex(index[2]));
+    }
+  }
+  if (mesh.n_faces() == 0) {
+    return error("every one of the " + std::to_string(triangle_count) + " triangles of '" + path +
+                 "' has zero area; fix the mesh file or its scale");
+  }
+  mesh.update_face_normals();
+
+  // A vertex whose file normal was missing or unusable takes the area-weighted mean of its faces'.
+  for (auto v : mesh.vertices()) {
+    if (mesh.normal(v).sqrnorm() > 0) continue;
+    TriMesh::Normal sum(0, 0, 0);
+    for (auto f : mesh.vf_range(v)) sum += mesh.calc_face_normal(f) * mesh.calc_face_area(f);
+    const double length = sum.norm();
+    mesh.set_normal(v, length > 0 ? sum / length : TriMesh::Normal(0, 0, 1));
+  }
+  return result;
+}
+
+}  // namespace
+
+Expected<Mesh> import_mesh(const ObjectDesc& obj, const std::filesystem::path& scene_file,
+                           const ImportLimits& import_limits) {
+  const ErrorPrefix error(obj, scene_file);
+  const std::filesystem::path file = mesh_path(obj, scene_file);
+  const std::string path = file.string();
+  try {
+    if (Status checked = check_mesh_file(file, import_limits.max_file_bytes); !checked) {
+      return error("cannot read mesh '" + path + "': " + checked.error().message);
+    }
+    MeshReadLimits limits;
+    limits.max_memory = import_limits.max_memory;
+    std::error_code ec;
+    limits.max_seconds = import_limits.max_seconds > 0
+                             ? import_limits.max_seconds
+                             : 60 + 10 * double(std::filesystem::file_size(file, ec)) / 1e6;
+    auto raw = read_mesh_file(file, limits);
+    if (!raw) return error("cannot read mesh '" + path + "': " + raw.error().message);
+    if (const std::string dropped = dropped_data_message(raw->warnings); !dropped.empty()) {
+      return error("'" + path + "' is broken: Assimp says \"" + assimp_message(dropped) +
+                   "\"; fix or re-export the mesh file");
+    }
+    return build_mesh(*raw, obj, path, error);
+  } catch (const std::exception& e) {
+    return error("cannot import mesh '" + path + "': " + one_line(e.what()));
+  }
+}
+
+}  // namespace sb

@@ -1,0 +1,105 @@
+// The scene as the user describes it: bake settings, objects (meshes with flags and transforms)
+// and area lights. Read from a TOML file by load_scene (scene_file.cpp); docs/scene-format.md is
+// the user's reference for every key.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "core/geometry.h"
+
+namespace sb {
+
+enum class Quantity { visibility, irradiance };
+
+// Names of the methods this build knows, in the order docs/methods.md lists them.
+const std::vector<std::string>& known_methods();
+
+struct BakeSettings {
+  int resolution = 512;  // texels per side of each receiver's lightmap
+  std::string method = "convolution";
+  Quantity quantity = Quantity::visibility;
+  int samples = 256;       // light samples per texel, for sampling methods
+  int margin = 4;          // texels of dilation around UV charts
+  std::uint64_t seed = 0;  // sampling seed; same seed, same bytes
+  // Bytes the bake may use (memory_budget.h); 0: the default, 3/4 of the physical memory.
+  std::uint64_t max_memory = 0;
+  // convolution: the penumbra error ε allowed per (light part, blocker cluster, receiver part)
+  // triple, in receiver texels, and the largest convolution image side, pixels
+  double error_texels = 1.0;
+  int max_image = 4096;
+  int max_triples = 128;  // leaf triples per light: the convolution's work budget
+  int light_parts = 2;    // convolution: each rectangular light split into at least this many
+  // convolution: trace `samples` shadow rays per light at the (light, texel) pairs whose leaves'
+  // penumbra error exceeds trace_error_texels, or which a blocker may shadow unaccounted for
+  // (traced_convolution.h); false: the convolution's values stand everywhere
+  bool trace = true;
+  // convolution: false skips the convolution, so that the shaft test's clear pairs are V = 1 and
+  // every other pair is traced (needs trace): what the convolution contributes is measured
+  // against this (docs/performance.md)
+  bool convolve = true;
+  double trace_error_texels = 1.0;
+  std::string blocker_combine = "sum";  // how blocker clusters combine: "product" or "sum"
+  // What the convolution's V averages the light's points by: "irradiance" (cos·cos/r², to first
+  // order across the light, as the reference) or "emission" (V_u, exact for parallel planes)
+  std::string weighting = "irradiance";
+  // shadow-map baselines (pcf, pcss, adaptive-pcf, chun-oh, erosion): the shadow map's side in
+  // pixels, PCF's fixed filter radius in shadow-map pixels, and how erosion turns the distance
+  // to a hard-shadow edge into a shadow factor ("pcf" or "distance")
+  int shadow_map = 2048;
+  double pcf_radius = 2.0;
+  std::string erosion_factor = "pcf";
+};
+
+struct ObjectDesc {
+  std::string name;            // unique; the output file stem
+  std::filesystem::path mesh;  // resolved against the scene file's folder
+  bool receiver = true;
+  bool blocker = true;
+  int uv_channel = 0;
+  // A receiver whose lightmap UVs cover no texel is an error unless this is set (its lightmap is
+  // then written black, with a warning).
+  bool allow_uncovered = false;
+  Affine3 transform = Affine3::Identity();  // scale, then rotate (X, Y, Z), then translate
+  int line = 0;  // line of the [[object]] table in the scene file, for errors
+};
+
+enum class LightShape { rectangle, disk, sphere };
+
+struct LightDesc {
+  std::string name;
+  LightShape shape = LightShape::rectangle;
+  Vec3 position = Vec3::Zero();   // centre, metres
+  Vec3 normal = Vec3(0, 0, -1);   // unit; the side it emits into (rectangle, disk)
+  Vec3 up = Vec3(0, 1, 0);        // unit, made orthogonal to normal by the reader; height axis
+  double width = 0;               // rectangle only, across up; metres
+  double height = 0;              // rectangle only; metres
+  double radius = 0;              // disk and sphere; metres
+  Vec3 color = Vec3(1, 1, 1);     // per-channel scale of the emitted power
+  double power = 0;               // watts (for colour (1,1,1) and a white texture)
+  std::filesystem::path texture;  // optional emission image over a rectangle or disk; resolved
+  int line = 0;
+};
+
+struct Scene {
+  std::filesystem::path file;  // the scene file, as given
+  BakeSettings bake;
+  std::vector<ObjectDesc> objects;
+  std::vector<LightDesc> lights;
+};
+
+// Reads and validates a scene file. Every problem is an Error naming the file, the line, the item
+// and what is wrong; unknown keys are errors, not ignored.
+Expected<Scene> load_scene(const std::filesystem::path& file);
+
+// Builds an object's transform from the optional keys: scale, then rotation about X, then Y,
+// then Z (degrees; Blender's "XYZ Euler"), then translation.
+Affine3 object_transform(const Vec3& translate, const Vec3& rotate_deg, const Vec3& scale);
+
+const char* to_string(Quantity q);
+const char* to_string(LightShape s);
+
+}  // namespace sb

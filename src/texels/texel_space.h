@@ -1,0 +1,49 @@
+// Lightmap texel space: which texels of a receiver's UV layout are covered by its triangles, and
+// for each covered texel the world position and normals that the bake methods shade. Built by
+// rasterise_texels (uv_rasterizer.cpp); grown into the margin by dilate (dilation.cpp).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/geometry.h"
+#include "core/image.h"
+#include "scene/mesh.h"
+
+namespace sb {
+
+// Single precision: a 2048² lightmap has 4 M texels, and their memory traffic, not arithmetic,
+// bounds the fast methods; the methods compute in double from these.
+struct Texel {
+  int x = 0, y = 0;        // pixel; row 0 is v = 1
+  Vec3f position;          // world space, on the triangle
+  Vec3f normal;            // interpolated shading normal, unit
+  Vec3f geometric_normal;  // the triangle's face normal, unit, on the side of `normal`
+  // Where shadow rays leave from: `position` lifted onto the smooth surface the vertex normals
+  // describe (uv_rasterizer.cpp), so a coarsely tessellated curved object does not shadow
+  // itself along its terminator. Equal to `position` on flat faces.
+  Vec3f shadow_origin;
+  int face = -1;  // index of the covering triangle
+};
+
+struct TexelSpace {
+  int width = 0, height = 0;
+  std::vector<Texel> texels;          // covered texels, in row-major order
+  std::vector<std::uint8_t> covered;  // width * height; 1 where a texel of `texels` lies
+  // Texels whose centre two UV triangles claim (inside one, inside or on the other): charts that
+  // overlap in the lightmap, so one surface point stands for two (check_uv_layout reports it).
+  std::int64_t overlapping_texels = 0;
+};
+
+// Rasterises mesh's triangles in UV space at width × height. A texel whose centre lies inside a
+// triangle takes that point; a texel that a triangle touches but whose centre no triangle covers
+// (thin triangles, chart borders) takes the triangle's point nearest its centre (conservative
+// coverage), so thin geometry is never lost. UVs outside [0, 1] are clipped.
+TexelSpace rasterise_texels(const Mesh& mesh, int width, int height);
+
+// Grows image values outward from covered texels by `margin` texels: each ring of uncovered
+// texels takes the mean of its already-filled 8-neighbours, so bilinear filtering and mip-mapping
+// near chart borders do not pull in black. Texels further than `margin` stay as they are.
+void dilate(Image& image, const std::vector<std::uint8_t>& covered, int margin);
+
+}  // namespace sb

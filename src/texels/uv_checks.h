@@ -1,0 +1,32 @@
+// Checks of a receiver's lightmap UV layout, reported per receiver in the manifest and as
+// warnings (uv_checks.cpp): how many texels it covers, how much of its UV area lies outside the
+// lightmap, texels two charts claim, and texels so close to another chart that bilinear
+// filtering and the margin's dilation mix the two.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "scene/mesh.h"
+#include "texels/texel_space.h"
+
+namespace sb {
+
+struct UvLayoutReport {
+  std::int64_t covered_texels = 0;
+  double uv_area = 0;                   // Σ of the UV triangles' areas (the unit square is 1)
+  double uv_area_outside = 0;           // the part of it outside [0, 1]², which gets no texels
+  std::int64_t overlapping_texels = 0;  // TexelSpace::overlapping_texels
+  int charts = 0;  // UV charts: triangles joined by edges with the same UVs at both ends
+  int margin = 0;  // texels, [bake] margin
+  // Covered texels with a texel of another chart within `margin` texels (either axis).
+  std::int64_t texels_near_other_charts = 0;
+};
+
+UvLayoutReport check_uv_layout(const Mesh& mesh, const TexelSpace& space, int margin);
+
+// One message per problem the report shows, without the object's name (the caller adds it).
+std::vector<std::string> uv_layout_warnings(const UvLayoutReport& report);
+
+}  // namespace sb

@@ -1,0 +1,410 @@
+// Rasterises a receiver's triangles in lightmap UV space: for each texel of a width × height
+// lightmap, whether the UV layout covers it and, if so, the surface point it stands for (world
+// position, interpolated shading normal, face normal, face, shadow-ray origin). The bake methods
+// shade exactly these points, so every later image is only as complete as this coverage.
+//
+// Two passes per row of texels:
+//  1. Centre sampling. A texel whose centre lies inside a triangle or on its edge takes the point
+//     at its centre, by barycentric interpolation; the first face in face order wins. Edge
+//     functions are evaluated with the edge's endpoints in a canonical order, so two triangles
+//     sharing an edge get exactly opposite values and a centre on it is never lost to rounding.
+//  2. Conservative coverage (Hasselgren, Akenine-Möller & Ohlsson, "Conservative Rasterization",
+//     GPU Gems 2, ch. 42, 2005). A texel that no centre test claimed but whose square a triangle
+//     overlaps with positive area takes that triangle's point nearest its centre in UV space
+//     (Ericson, "Real-Time Collision Detection", 2005, §5.1.5); of several such triangles the one
+//     with the nearest point wins, then the lowest face index. The overlap test is the separating
+//     axis test of Akenine-Möller ("Fast 3D Triangle-Box Overlap Testing", JGT 2001) reduced to
+//     2D: the square's two axes and the triangle's three edge normals.
+//
+// Why pass 2 matters: a triangle thinner than a texel, or the border of a UV chart, often contains
+// no texel centre at all. With centre sampling alone such geometry gets no texels, its part of the
+// lightmap stays black, and bilinear filtering pulls that black in as seams along chart borders
+// and across thin geometry. The nearest-point rule keeps every conservative texel's position on
+// its triangle, so shading it never samples a point off the surface.
+//
+// Rows are independent (a texel's coverage depends only on the triangles crossing its row), so
+// rows run in parallel with oneTBB; the result does not depend on the thread count.
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cassert>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "texels/texel_space.h"
+
+namespace sb {
+namespace {
+
+// One edge of a footprint as a function of texel-space point (X, Y), >= 0 on the triangle's side:
+// value = a (X - x0) + b (Y - y0). The edge's endpoints are taken in lexicographic order, so two
+// triangles sharing an edge hold the same (x0, y0) and opposite (a, b), and get bitwise opposite
+// values at every point: a texel centre on a shared edge is inside both, never lost to rounding.
+struct EdgeFunction {
+  double a = 0.0, b = 0.0, x0 = 0.0, y0 = 0.0;
+
+  EdgeFunction() = default;
+  // The edge p → q of a triangle whose texel-space signed area has sign `orientation` (±1).
+  EdgeFunction(const Vec2& p, const Vec2& q, double orientation) {
+    const bool ordered = p.x() < q.x() || (p.x() == q.x() && p.y() <= q.y());
+    const Vec2& from = ordered ? p : q;
+    const Vec2& to = ordered ? q : p;
+    const double sign = ordered ? orientation : -orientation;
+    a = -(to.y() - from.y()) * sign;
+    b = (to.x() - from.x()) * sign;
+    x0 = from.x();
+    y0 = from.y();
+  }
+  double row_term(double y) const { return b * (y - y0); }
+  double operator()(double x, double row_term_y) const { return a * (x - x0) + row_term_y; }
+};
+
+// A triangle's UV footprint in texel coordinates, X = u * width and Y = (1 - v) * height, so that
+// texel (x, y) is the unit square [x, x + 1] × [y, y + 1] with its centre at (x + 0.5, y + 0.5).
+struct FaceFootprint {
+  int face = -1;
+  Vec2 texel_uv[3];      // vertices in texel coordinates
+  Vec2 uv[3];            // vertices in UV coordinates, for the nearest-point rule
+  EdgeFunction edge[3];  // edge[i] is the edge opposite vertex i; its value weighs vertex i
+  Vec2 lo, hi;           // texel-space bounding box
+};
+
+// Everything needed to turn barycentrics on face f into a Texel.
+struct FaceSurface {
+  Vec3 position[3];
+  Vec3 normal[3];
+  Vec3 face_normal;  // unit, from the world positions
+};
+
+// Twice the signed area of (a, b, p); positive when p lies to the left of a → b.
+double orient(const Vec2& a, const Vec2& b, const Vec2& p) {
+  return (b.x() - a.x()) * (p.y() - a.y()) - (b.y() - a.y()) * (p.x() - a.x());
+}
+
+// The three edge values of centre (x, y) scaled to barycentrics; false when it is outside.
+bool centre_barycentrics(const FaceFootprint& fp, double x, double y, double bary[3]) {
+  double sum = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    bary[i] = fp.edge[i](x, fp.edge[i].row_term(y));
+    if (bary[i] < 0.0) return false;
+    sum += bary[i];
+  }
+  if (!(sum > 0.0)) return false;
+  const double inverse_sum = 1.0 / sum;
+  for (int i = 0; i < 3; ++i) bary[i] *= inverse_sum;
+  return true;
+}
+
+// The point of triangle (a, b, c) nearest to p, as barycentrics; returns its squared distance to p.
+// Ericson, "Real-Time Collision Detection", §5.1.5, by Voronoi regions of the vertices and edges.
+double nearest_point(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& p, double bary[3]) {
+  const Vec2 ab = b - a, ac = c - a, ap = p - a;
+  const auto result = [&](double wa, double wb, double wc) {
+    bary[0] = wa;
+    bary[1] = wb;
+    bary[2] = wc;
+    return (wa * a + wb * b + wc * c - p).squaredNorm();
+  };
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0.0 && d2 <= 0.0) return result(1, 0, 0);
+  const Vec2 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0.0 && d4 <= d3) return result(0, 1, 0);
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+    const double t = d1 / (d1 - d3);
+    return result(1 - t, t, 0);
+  }
+  const Vec2 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0.0 && d5 <= d6) return result(0, 0, 1);
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+    const double t = d2 / (d2 - d6);
+    return result(1 - t, 0, t);
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+    const double t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return result(0, 1 - t, t);
+  }
+  const double denom = va + vb + vc;
+  return result(va / denom, vb / denom, vc / denom);
+}
+
+// Overlaps shorter than this (in texels, along any separating axis) count as touching, not
+// overlapping: a triangle whose edge lies on a texel border does not claim the texel beyond it.
+constexpr double kOverlapTolerance = 1e-9;
+
+// True when the footprint and texel square [x, x + 1] × [y, y + 1] overlap with positive area.
+bool overlaps_texel(const FaceFootprint& fp, int x, int y) {
+  const double sx0 = x, sx1 = x + 1.0, sy0 = y, sy1 = y + 1.0;
+  if (fp.hi.x() <= sx0 + kOverlapTolerance || fp.lo.x() >= sx1 - kOverlapTolerance) return false;
+  if (fp.hi.y() <= sy0 + kOverlapTolerance || fp.lo.y() >= sy1 - kOverlapTolerance) return false;
+  const Vec2 centre(x + 0.5, y + 0.5);
+  for (int i = 0; i < 3; ++i) {
+    const Vec2& a = fp.texel_uv[i];
+    const Vec2& b = fp.texel_uv[(i + 1) % 3];
+    const Vec2& opposite = fp.texel_uv[(i + 2) % 3];
+    // Axis: the edge's normal (unnormalised). The triangle projects onto [edge, opposite vertex].
+    const Vec2 axis(-(b.y() - a.y()), b.x() - a.x());
+    const double length = axis.norm();
+    const double edge_value = axis.dot(a);
+    const double opposite_value = axis.dot(opposite);
+    const double tri_lo = std::min(edge_value, opposite_value);
+    const double tri_hi = std::max(edge_value, opposite_value);
+    const double radius = 0.5 * (std::abs(axis.x()) + std::abs(axis.y()));
+    const double square_value = axis.dot(centre);
+    const double tolerance = kOverlapTolerance * length;
+    if (tri_hi <= square_value - radius + tolerance || tri_lo >= square_value + radius - tolerance)
+      return false;
+  }
+  return true;
+}
+
+// The x extent of the footprint within the row strip Y in [y0, y1], or false if it misses it.
+bool row_extent(const FaceFootprint& fp, double y0, double y1, double& x_lo, double& x_hi) {
+  x_lo = std::numeric_limits<double>::infinity();
+  x_hi = -x_lo;
+  const auto include = [&](double x) {
+    x_lo = std::min(x_lo, x);
+    x_hi = std::max(x_hi, x);
+  };
+  for (int i = 0; i < 3; ++i) {
+    const Vec2& a = fp.texel_uv[i];
+    const Vec2& b = fp.texel_uv[(i + 1) % 3];
+    if (a.y() >= y0 && a.y() <= y1) include(a.x());
+    for (const double y : {y0, y1}) {
+      if ((a.y() < y && b.y() > y) || (a.y() > y && b.y() < y)) {
+        const double t = (y - a.y()) / (b.y() - a.y());
+        include(a.x() + t * (b.x() - a.x()));
+      }
+    }
+  }
+  return x_lo <= x_hi;
+}
+
+// Texels in a row that the footprint may touch: [first, last], clamped to the image.
+bool row_span(const FaceFootprint& fp, int y, int width, int& first, int& last) {
+  double x_lo, x_hi;
+  if (!row_extent(fp, y, y + 1.0, x_lo, x_hi)) return false;
+  // A little slack: the exact decision is made per texel, this only bounds the loop.
+  x_lo = std::clamp(std::floor(x_lo - 1e-6), 0.0, double(width));
+  x_hi = std::clamp(std::ceil(x_hi + 1e-6), 0.0, double(width));
+  first = int(x_lo);
+  last = std::min(int(x_hi), width - 1);
+  return first <= last;
+}
+
+Vec3 unit_or(const Vec3& v, const Vec3& fallback) {
+  const double length = v.norm();
+  return length > 1e-12 ? Vec3(v * (1.0 / length)) : fallback;
+}
+
+Texel make_texel(const FaceSurface& s, int face, int x, int y, const double bary[3]) {
+  Texel t;
+  t.x = x;
+  t.y = y;
+  t.face = face;
+  const Vec3 position = bary[0] * s.position[0] + bary[1] * s.position[1] + bary[2] * s.position[2];
+  const Vec3 normal =
+      unit_or(bary[0] * s.normal[0] + bary[1] * s.normal[1] + bary[2] * s.normal[2], s.face_normal);
+  t.position = position.cast<float>();
+  t.normal = normal.cast<float>();
+  t.geometric_normal =
+      (normal.dot(s.face_normal) < 0.0 ? Vec3(-s.face_normal) : s.face_normal).cast<float>();
+  // Shadow-terminator offset (Hanika, "Hacking the Shadow Terminator", Ray Tracing Gems II,
+  // ch. 4, 2021): a flat triangle of a curved mesh lies inside the smooth surface its vertex
+  // normals describe, so rays towards a grazing light hit the neighbouring triangles. Lift the
+  // point by the barycentric mean of its heights below each vertex's tangent plane.
+  Vec3 shadow_origin = position;
+  for (int i = 0; i < 3; ++i) {
+    const double below = (s.position[i] - position).dot(s.normal[i]);
+    if (below > 0) shadow_origin += bary[i] * below * s.normal[i];
+  }
+  t.shadow_origin = shadow_origin.cast<float>();
+  return t;
+}
+
+// Per-texel owner codes: no face, face f by centre (pass 1) as f, by overlap (pass 2) as -2 - f.
+constexpr std::int32_t kUncovered = -1;
+std::int32_t conservative_code(int face) { return -2 - face; }
+bool is_centre_code(std::int32_t code) { return code >= 0; }
+int face_of(std::int32_t code) { return code >= 0 ? code : -2 - code; }
+
+}  // namespace
+
+TexelSpace rasterise_texels(const Mesh& mesh, int width, int height) {
+  assert(width > 0 && height > 0);
+  TexelSpace space;
+  if (width <= 0 || height <= 0) return space;
+  space.width = width;
+  space.height = height;
+  const std::size_t texel_count = std::size_t(width) * std::size_t(height);
+  space.covered.assign(texel_count, 0);
+  if (!mesh.has_uv) return space;  // no lightmap UVs: nothing is covered
+
+  // Footprints of the usable faces, in face order; surfaces indexed by face.
+  const TriMesh& tri_mesh = mesh.mesh;
+  std::vector<FaceFootprint> footprints;
+  std::vector<FaceSurface> surfaces(tri_mesh.n_faces());
+  footprints.reserve(tri_mesh.n_faces());
+  for (const auto f : tri_mesh.faces()) {
+    const Triangle tri = triangle(tri_mesh, f);
+    FaceFootprint fp;
+    fp.face = f.idx();
+    bool finite = true;
+    for (int i = 0; i < 3; ++i) {
+      fp.uv[i] = tri.uv[i];
+      fp.texel_uv[i] = Vec2(tri.uv[i].x() * width, (1.0 - tri.uv[i].y()) * height);
+      finite = finite && fp.texel_uv[i].allFinite();
+    }
+    if (!finite) continue;
+    const double area2 = orient(fp.texel_uv[0], fp.texel_uv[1], fp.texel_uv[2]);
+    // Zero UV area (collapsed UVs) has no interior to shade. 1e-10 texel² is far below any sliver
+    // worth a texel; a nearly collinear triangle above it is still safe, as every texel it gets is
+    // a convex combination of its vertices.
+    if (std::abs(area2) <= 1e-10) continue;
+    const double orientation = area2 > 0.0 ? 1.0 : -1.0;
+    for (int i = 0; i < 3; ++i)
+      fp.edge[i] = EdgeFunction(fp.texel_uv[(i + 1) % 3], fp.texel_uv[(i + 2) % 3], orientation);
+    fp.lo = fp.texel_uv[0].cwiseMin(fp.texel_uv[1]).cwiseMin(fp.texel_uv[2]);
+    fp.hi = fp.texel_uv[0].cwiseMax(fp.texel_uv[1]).cwiseMax(fp.texel_uv[2]);
+    if (fp.hi.x() <= 0.0 || fp.hi.y() <= 0.0 || fp.lo.x() >= width || fp.lo.y() >= height)
+      continue;  // entirely outside the lightmap
+
+    FaceSurface& s = surfaces[f.idx()];
+    for (int i = 0; i < 3; ++i) {
+      s.position[i] = tri.p[i];
+      s.normal[i] = tri.n[i];
+    }
+    const Vec3 average_normal = tri.n[0] + tri.n[1] + tri.n[2];
+    s.face_normal = unit_or((tri.p[1] - tri.p[0]).cross(tri.p[2] - tri.p[0]),
+                            unit_or(average_normal, Vec3::UnitZ()));
+    footprints.push_back(fp);
+  }
+
+  // Rows → footprints whose bounding box crosses them, in face order (compressed rows).
+  std::vector<std::size_t> row_begin(std::size_t(height) + 1, 0);
+  const auto row_range = [&](const FaceFootprint& fp, int& y0, int& y1) {
+    y0 = int(std::clamp(std::floor(fp.lo.y()), 0.0, double(height - 1)));
+    y1 = int(std::clamp(std::ceil(fp.hi.y()) - 1.0, 0.0, double(height - 1)));
+  };
+  for (const FaceFootprint& fp : footprints) {
+    int y0, y1;
+    row_range(fp, y0, y1);
+    for (int y = y0; y <= y1; ++y) ++row_begin[std::size_t(y) + 1];
+  }
+  for (int y = 0; y < height; ++y) row_begin[std::size_t(y) + 1] += row_begin[std::size_t(y)];
+  std::vector<std::int32_t> row_faces(row_begin[std::size_t(height)]);
+  {
+    std::vector<std::size_t> next(row_begin.begin(), row_begin.end() - 1);
+    for (std::size_t i = 0; i < footprints.size(); ++i) {
+      int y0, y1;
+      row_range(footprints[i], y0, y1);
+      for (int y = y0; y <= y1; ++y) row_faces[next[std::size_t(y)]++] = std::int32_t(i);
+    }
+  }
+
+  // Passes 1 and 2, row by row: the owner code of every texel, and covered texels per row.
+  std::vector<std::int32_t> owner(texel_count, kUncovered);
+  std::vector<std::size_t> row_count(std::size_t(height) + 1, 0);
+  std::atomic<std::int64_t> overlapping{0};
+  tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
+    std::vector<double> best_distance(static_cast<std::size_t>(width));
+    std::vector<std::uint8_t> row_strict(static_cast<std::size_t>(width));
+    std::vector<std::uint8_t> row_overlap(static_cast<std::size_t>(width));
+    for (int y = rows.begin(); y != rows.end(); ++y) {
+      std::fill(row_overlap.begin(), row_overlap.end(), 0);
+      std::int32_t* row_owner = &owner[std::size_t(y) * std::size_t(width)];
+      const auto faces_begin = row_faces.begin() + std::ptrdiff_t(row_begin[std::size_t(y)]);
+      const auto faces_end = row_faces.begin() + std::ptrdiff_t(row_begin[std::size_t(y) + 1]);
+      const double centre_y = y + 0.5;
+      for (auto it = faces_begin; it != faces_end; ++it) {
+        const FaceFootprint& fp = footprints[std::size_t(*it)];
+        int first, last;
+        if (!row_span(fp, y, width, first, last)) continue;
+        const double row_term[3] = {fp.edge[0].row_term(centre_y), fp.edge[1].row_term(centre_y),
+                                    fp.edge[2].row_term(centre_y)};
+        for (int x = first; x <= last; ++x) {
+          const double centre_x = x + 0.5;
+          const double e0 = fp.edge[0](centre_x, row_term[0]);
+          const double e1 = fp.edge[1](centre_x, row_term[1]);
+          const double e2 = fp.edge[2](centre_x, row_term[2]);
+          if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) continue;
+          const bool strictly = e0 > 0.0 && e1 > 0.0 && e2 > 0.0;
+          if (row_owner[x] == kUncovered) {
+            row_owner[x] = fp.face;
+            row_strict[std::size_t(x)] = strictly;
+          } else if (strictly || row_strict[std::size_t(x)]) {
+            // Two triangles share a centre on a common edge or vertex (inside neither strictly);
+            // one strictly inside means their interiors overlap.
+            row_overlap[std::size_t(x)] = 1;
+          }
+        }
+      }
+      const double centre_v = 1.0 - centre_y / height;
+      for (auto it = faces_begin; it != faces_end; ++it) {
+        const FaceFootprint& fp = footprints[std::size_t(*it)];
+        int first, last;
+        if (!row_span(fp, y, width, first, last)) continue;
+        for (int x = first; x <= last; ++x) {
+          const std::int32_t code = row_owner[x];
+          if (is_centre_code(code) || !overlaps_texel(fp, x, y)) continue;
+          double bary[3];
+          const Vec2 centre_uv((x + 0.5) / width, centre_v);
+          const double d = nearest_point(fp.uv[0], fp.uv[1], fp.uv[2], centre_uv, bary);
+          // Faces come in increasing order, so strict < keeps the lowest face index on ties.
+          if (code == kUncovered || d < best_distance[std::size_t(x)]) {
+            row_owner[x] = conservative_code(fp.face);
+            best_distance[std::size_t(x)] = d;
+          }
+        }
+      }
+      std::size_t count = 0;
+      for (int x = 0; x < width; ++x) count += row_owner[x] != kUncovered;
+      row_count[std::size_t(y) + 1] = count;
+      std::int64_t overlaps = 0;
+      for (const std::uint8_t o : row_overlap) overlaps += o;
+      overlapping += overlaps;
+    }
+  });
+
+  space.overlapping_texels = overlapping.load();
+
+  // Offsets of each row's texels in the row-major output, then the texels themselves.
+  for (int y = 0; y < height; ++y) row_count[std::size_t(y) + 1] += row_count[std::size_t(y)];
+  space.texels.resize(row_count[std::size_t(height)]);
+  std::vector<int> footprint_of_face(tri_mesh.n_faces(), -1);
+  for (std::size_t i = 0; i < footprints.size(); ++i)
+    footprint_of_face[std::size_t(footprints[i].face)] = int(i);
+  tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y != rows.end(); ++y) {
+      Texel* out = space.texels.data() + row_count[std::size_t(y)];
+      const std::size_t row_offset = std::size_t(y) * std::size_t(width);
+      const double centre_y = y + 0.5;
+      const double centre_v = 1.0 - centre_y / height;
+      for (int x = 0; x < width; ++x) {
+        const std::int32_t code = owner[row_offset + std::size_t(x)];
+        if (code == kUncovered) continue;
+        const int face = face_of(code);
+        const FaceFootprint& fp = footprints[std::size_t(footprint_of_face[std::size_t(face)])];
+        double bary[3] = {};
+        // Pass 1 found the centre inside, so centre_barycentrics succeeds; the nearest point is
+        // the same point should it not.
+        if (!is_centre_code(code) || !centre_barycentrics(fp, x + 0.5, centre_y, bary))
+          nearest_point(fp.uv[0], fp.uv[1], fp.uv[2], Vec2((x + 0.5) / width, centre_v), bary);
+        *out++ = make_texel(surfaces[std::size_t(face)], face, x, y, bary);
+        space.covered[row_offset + std::size_t(x)] = 1;
+      }
+    }
+  });
+  return space;
+}
+
+}  // namespace sb

@@ -1,0 +1,266 @@
+// End to end: runs the shadowbake executable on small scenes written by the test, and checks the
+// files, the manifest, byte-identical re-runs, and the errors and exit codes for bad input,
+// with no partial output left behind.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include "core/image_io.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CliRun {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("shadowbake_cli_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    // A 2 m floor with UVs, and a blocker quad 0.5 m above it.
+    write("floor.obj",
+          "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n"
+          "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n"
+          "f 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n");
+    write("blocker.obj",
+          "v -0.3 -0.3 0.5\nv 0.3 -0.3 0.5\nv 0.3 0.3 0.5\nv -0.3 0.3 0.5\n"
+          "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n"
+          "f 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n");
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  void write(const std::string& name, const std::string& text) {
+    std::ofstream(dir_ / name, std::ios::binary) << text;
+  }
+
+  std::string scene(const std::string& bake_extra = "", const std::string& object_extra = "",
+                    const std::string& light_extra = "") {
+    return "[bake]\nresolution = 32\nsamples = 16\n" + bake_extra +
+           "\n[[object]]\nname = \"floor\"\nmesh = \"floor.obj\"\n" + object_extra +
+           "\n[[object]]\nname = \"blocker\"\nmesh = \"blocker.obj\"\nreceiver = false\n"
+           "\n[[light]]\nname = \"panel\"\nshape = \"rectangle\"\nposition = [0, 0, 1.5]\n"
+           "normal = [0, 0, -1]\nsize = [0.5, 0.5]\npower = 100.0\n" +
+           light_extra;
+  }
+
+  CliRun run(const std::string& args) {
+    CliRun r;
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string cmd = std::string(SB_CLI) + " " + args + " >" + out.string() + " 2>" +
+                            err.string() + " </dev/null";
+    const int status = std::system(cmd.c_str());
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+  }
+
+  // Files in `folder`, temporary ones included.
+  static std::vector<std::string> listing(const fs::path& folder) {
+    std::vector<std::string> names;
+    if (!fs::exists(folder)) return names;
+    for (const auto& e : fs::directory_iterator(folder)) names.push_back(e.path().filename());
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(Cli, BakesFilesAndManifest) {
+  write("scene.toml", scene());
+  const CliRun r = run("bake " + (dir_ / "scene.toml").string() + " -o " + (dir_ / "out").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(listing(dir_ / "out"), (std::vector<std::string>{"floor.coverage.png", "floor.exr",
+                                                             "floor.png", "manifest.json"}));
+  const auto manifest = nlohmann::json::parse(slurp(dir_ / "out" / "manifest.json"));
+  ASSERT_EQ(manifest["receivers"].size(), 1u);
+  const auto& floor = manifest["receivers"][0];
+  EXPECT_EQ(floor["name"], "floor");
+  EXPECT_EQ(floor["files"]["exr"], "floor.exr");
+  EXPECT_EQ(floor["files"]["png"], "floor.png");
+  EXPECT_EQ(floor["files"]["coverage"], "floor.coverage.png");
+  EXPECT_EQ(floor["uv_channel"], 0);
+  EXPECT_EQ(floor["resolution"], nlohmann::json::array({32, 32}));
+  EXPECT_EQ(floor["method"], "convolution");  // the default
+  EXPECT_EQ(floor["quantity"], "visibility");
+  EXPECT_EQ(floor["samples"], 16);
+  EXPECT_GE(floor["seconds"].get<double>(), 0.0);
+
+  auto exr = sb::read_image(dir_ / "out" / "floor.exr");
+  ASSERT_TRUE(exr);
+  EXPECT_EQ(exr->width, 32);
+  EXPECT_EQ(exr->channels, 3);
+  // The centre is in the blocker's umbra, the corners in full light.
+  EXPECT_LT(exr->at(16, 16)[0], 0.01f);
+  EXPECT_GT(exr->at(1, 1)[0], 0.99f);
+  auto png = sb::read_image(dir_ / "out" / "floor.png");
+  ASSERT_TRUE(png);
+  EXPECT_NEAR(png->at(1, 1)[0], exr->at(1, 1)[0], 1.0 / 255 + 1e-6);
+}
+
+TEST_F(Cli, SameSceneSameSeedSameBytes) {
+  write("scene.toml", scene("method = \"reference\"\n"));
+  const std::string s = (dir_ / "scene.toml").string();
+  ASSERT_EQ(run("bake " + s + " -o " + (dir_ / "a").string() + " --threads 1").code, 0);
+  // A second apart, so a timestamp written into a file would show.
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));
+  ASSERT_EQ(run("bake " + s + " -o " + (dir_ / "b").string() + " --threads 2").code, 0);
+  for (const char* f : {"floor.exr", "floor.png"}) {
+    EXPECT_EQ(slurp(dir_ / "a" / f), slurp(dir_ / "b" / f)) << f;
+  }
+  ASSERT_EQ(run("bake " + s + " -o " + (dir_ / "c").string() + " --seed 9").code, 0);
+  EXPECT_NE(slurp(dir_ / "a" / "floor.exr"), slurp(dir_ / "c" / "floor.exr"));
+  // The convolution method, which draws no random numbers, likewise.
+  ASSERT_EQ(
+      run("bake " + s + " -o " + (dir_ / "d").string() + " --method convolution --threads 1").code,
+      0);
+  ASSERT_EQ(
+      run("bake " + s + " -o " + (dir_ / "e").string() + " --method convolution --threads 2").code,
+      0);
+  for (const char* f : {"floor.exr", "floor.png"}) {
+    EXPECT_EQ(slurp(dir_ / "d" / f), slurp(dir_ / "e" / f)) << f;
+  }
+}
+
+TEST_F(Cli, OverridesReachTheManifest) {
+  write("scene.toml", scene());
+  const CliRun r = run("bake " + (dir_ / "scene.toml").string() + " -o " + (dir_ / "out").string() +
+                       " --quantity irradiance --resolution 16 --samples 4 --quiet");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(r.out.empty());
+  const auto manifest = nlohmann::json::parse(slurp(dir_ / "out" / "manifest.json"));
+  EXPECT_EQ(manifest["quantity"], "irradiance");
+  EXPECT_EQ(manifest["receivers"][0]["resolution"], nlohmann::json::array({16, 16}));
+  EXPECT_EQ(manifest["receivers"][0]["samples"], 4);
+  auto exr = sb::read_image(dir_ / "out" / "floor.exr");
+  ASSERT_TRUE(exr);
+  // A corner texel in full light: irradiance of the order of P/(π d²) ≈ 14 W/m².
+  EXPECT_GT(exr->at(0, 0)[0], 1.0f);
+}
+
+TEST_F(Cli, WarnsAboutDegenerateTriangles) {
+  // The blocker gains a zero-area triangle (three collinear points): skipped, with a warning.
+  write("blocker.obj",
+        "v -0.3 -0.3 0.5\nv 0.3 -0.3 0.5\nv 0.3 0.3 0.5\nv -0.3 0.3 0.5\nv 0 0 0.5\n"
+        "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n"
+        "f 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\nf 1/1/1 5/1/1 3/3/1\n");
+  write("scene.toml", scene());
+  const CliRun r = run("bake " + (dir_ / "scene.toml").string() + " -o " + (dir_ / "out").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("warning"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("blocker"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("degenerate"), std::string::npos) << r.err;
+}
+
+// A bad scene: exit code 3, one line on stderr naming the file and the item, and no output.
+void expect_scene_error(const CliRun& r, const std::vector<std::string>& words) {
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  for (const auto& w : words) EXPECT_NE(r.err.find(w), std::string::npos) << w << " in " << r.err;
+}
+
+TEST_F(Cli, RejectsUnknownKeyWithoutOutput) {
+  write("scene.toml", scene("", "recever = true\n"));
+  const CliRun r = run("bake " + (dir_ / "scene.toml").string() + " -o " + (dir_ / "out").string());
+  expect_scene_error(r, {"scene.toml", "floor", "recever"});
+  EXPECT_TRUE(listing(dir_ / "out").empty());
+}
+
+TEST_F(Cli, RejectsMissingSceneFile) {
+  const CliRun r = run("bake " + (dir_ / "nope.toml").string() + " -o " + (dir_ / "out").string());
+  expect_scene_error(r, {"nope.toml"});
+}
+
+TEST_F(Cli, RejectsMissingMesh) {
+  write("scene.toml", scene());
+  fs::remove(dir_ / "blocker.obj");
+  const CliRun r = run("bake " + (dir_ / "scene.toml").string() + " -o " + (dir_ / "out").string());
+  expect_scene_error(r, {"scene.toml", "blocker", "blocker.obj"});
+}
+
+TEST_F(Cli, RejectsUnreadableMesh) {
+  write("scene.toml", scene());
+  write("blocker.obj", "this is not a mesh\n\x01\x02\x03");
+  const CliRun r = run("bake " + (dir_ / "scene.toml").string() + " -o " + (dir_ / "out").string());
+  expect_scene_error(r, {"scene.toml", "blocker"});
+  EXPECT_TRUE(listing(dir_ / "out").empty());
+}
+
+TEST_F(Cli, RejectsMissingUvChannel) {
+  write("scene.toml", scene("", "uv = 1\n"));
+  const CliRun r = run("bake " + (dir_ / "scene.toml").string() + " -o " + (dir_ / "out").string());
+  expect_scene_error(r, {"scene.toml", "floor", "1"});
+}
+
+TEST_F(Cli, RejectsImpossibleLight) {
+  write("scene.toml", scene() +
+                          "\n[[light]]\nname = \"bad\"\nshape = \"disk\"\n"
+                          "position = [0, 0, 1]\nnormal = [0, 0, 0]\nradius = [0.1]\n"
+                          "power = 10.0\n");
+  const CliRun r = run("bake " + (dir_ / "scene.toml").string() + " -o " + (dir_ / "out").string());
+  expect_scene_error(r, {"scene.toml", "bad", "normal"});
+}
+
+TEST_F(Cli, UnwritableOutputLeavesNothing) {
+  write("scene.toml", scene());
+  write("a_file", "x");
+  const CliRun r =
+      run("bake " + (dir_ / "scene.toml").string() + " -o " + (dir_ / "a_file" / "out").string());
+  EXPECT_EQ(r.code, 4) << r.err;
+  EXPECT_NE(r.err.find("a_file"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+
+  // A folder in the way of one output: nothing else is published either.
+  fs::create_directories(dir_ / "out" / "floor.png");
+  const CliRun blocked =
+      run("bake " + (dir_ / "scene.toml").string() + " -o " + (dir_ / "out").string());
+  EXPECT_EQ(blocked.code, 4) << blocked.err;
+  EXPECT_NE(blocked.err.find("floor.png"), std::string::npos) << blocked.err;
+  EXPECT_EQ(listing(dir_ / "out"), std::vector<std::string>{"floor.png"});
+
+  // A read-only folder: nothing, not even a temporary file, is left in it.
+  if (::geteuid() != 0) {  // root ignores permissions
+    fs::create_directories(dir_ / "ro");
+    fs::permissions(dir_ / "ro", fs::perms::owner_read | fs::perms::owner_exec);
+    const CliRun ro =
+        run("bake " + (dir_ / "scene.toml").string() + " -o " + (dir_ / "ro").string());
+    EXPECT_EQ(ro.code, 4);
+    EXPECT_TRUE(listing(dir_ / "ro").empty());
+    fs::permissions(dir_ / "ro", fs::perms::owner_all);
+  }
+}
+
+TEST_F(Cli, UsageErrorsAndHelp) {
+  EXPECT_EQ(run("--help").code, 0);
+  const CliRun v = run("--version");
+  EXPECT_EQ(v.code, 0);
+  EXPECT_NE(v.out.find("shadowbake"), std::string::npos);
+  EXPECT_EQ(run("bake").code, 2);
+  EXPECT_EQ(run("bake x.toml -o out --method nonsense").code, 2);
+  EXPECT_EQ(run("bake x.toml -o out --resolution 0").code, 2);
+  EXPECT_EQ(run("frobnicate").code, 2);
+}
+
+}  // namespace

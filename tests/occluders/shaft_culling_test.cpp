@@ -1,0 +1,149 @@
+// Tests of ShaftCuller (shaft_culling.cpp): a texel it calls clear of a light has no blocker in
+// any shadow ray towards that light, on the realistic corpus scenes (Blender exports: walls that
+// cross the light's plane, lights flush with a ceiling or among columns, curved and non-convex
+// receivers, a dense blocker) and on the closed-form parallel scene; and it calls clear most of
+// what is lit, so that methods may skip it.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+
+#include "pipeline/bake.h"
+#include "scene/lights.h"
+#include "scene/mesh.h"
+#include "occluders/ray_scene.h"
+#include "core/sampling.h"
+#include "scene/scene.h"
+#include "occluders/shadow_rays.h"
+#include "occluders/shaft_culling.h"
+#include "support/test_scenes.h"
+#include "texels/texel_space.h"
+
+namespace sb {
+namespace {
+
+struct Counts {
+  std::int64_t lit = 0, clear = 0, wrong = 0;
+};
+
+// Per light and receiver texel the light reaches: how many are clear, and how many of those a
+// shadow ray (of `samples` stratified ones) finds blocked.
+Counts check_scene(const std::string& name, int resolution, int samples) {
+  auto scene = load_scene(std::string(SB_SOURCE_DIR) + "/scenes/" + name);
+  EXPECT_TRUE(scene) << scene.error().message;
+  std::vector<Mesh> meshes;
+  std::vector<const Mesh*> blockers;
+  for (const auto& obj : scene->objects) {
+    auto m = import_mesh(obj, scene->file);
+    EXPECT_TRUE(m) << m.error().message;
+    meshes.push_back(std::move(*m));
+  }
+  for (std::size_t i = 0; i < meshes.size(); ++i)
+    if (scene->objects[i].blocker) blockers.push_back(&meshes[i]);
+  auto rays = RayScene::build(blockers);
+  auto lights = make_lights(scene->lights, scene->file);
+  const ShaftCuller culler(blockers);
+  const double offset = rays->surface_offset();
+  Counts counts;
+  for (std::size_t r = 0; r < meshes.size(); ++r) {
+    if (!scene->objects[r].receiver) continue;
+    const TexelSpace space = rasterise_texels(meshes[r], resolution, resolution);
+    for (std::size_t l = 0; l < lights->size(); ++l) {
+      const Light& light = (*lights)[l];
+      const std::vector<std::uint8_t> maybe = culler.maybe_blocked(space, light, offset);
+      std::atomic<std::int64_t> lit{0}, clear{0}, wrong{0};
+      tbb::parallel_for(std::size_t(0), space.texels.size(), [&](std::size_t i) {
+        const Texel& t = space.texels[i];
+        const Vec3 p = t.position.cast<double>(), n = t.normal.cast<double>();
+        if (light.unoccluded_irradiance(p, n).maxCoeff() <= 0) return;
+        ++lit;
+        if (maybe[i]) return;
+        ++clear;
+        Rng rng(stream_seed(7, l, i));
+        std::vector<Vec2> strata;
+        stratified_samples(samples, rng, strata);
+        ShadowRays batch(samples);
+        const Vec3 origin =
+            t.shadow_origin.cast<double>() + offset * t.geometric_normal.cast<double>();
+        for (const Vec2& u : strata) batch.add(origin, light.sample(p, n, u), offset);
+        Vec3 v;
+        if (batch.visible_fraction(*rays, &v) && v.minCoeff() < 1) ++wrong;
+      });
+      counts.lit += lit;
+      counts.clear += clear;
+      counts.wrong += wrong;
+    }
+  }
+  return counts;
+}
+
+class ShaftCulling : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(ShaftCulling, ClearTexelsHaveNoBlockedRay) {
+  const Counts c = check_scene(GetParam(), 128, 64);
+  ASSERT_GT(c.lit, 0);
+  EXPECT_EQ(c.wrong, 0) << c.wrong << " of " << c.clear << " clear texels have a blocked ray";
+  // Most of what a light reaches in these scenes is clear of blockers.
+  EXPECT_GT(double(c.clear) / double(c.lit), 0.3) << c.clear << " of " << c.lit;
+  std::printf("%s: %lld of %lld lit (light, texel) pairs clear\n", GetParam().c_str(),
+              (long long)c.clear, (long long)c.lit);
+}
+
+INSTANTIATE_TEST_SUITE_P(Corpus, ShaftCulling,
+                         ::testing::Values("room/scene.toml", "room/scene_disk.toml",
+                                           "atrium/scene_sconce.toml", "atrium/scene_bulb.toml",
+                                           "shelf/scene.toml", "dense/scene.toml",
+                                           "showcase/scene.toml", "parallel/scene.toml"),
+                         [](const auto& info) {
+                           std::string n = info.param;
+                           for (char& ch : n)
+                             if (ch == '/' || ch == '.') ch = '_';
+                           return n;
+                         });
+
+}  // namespace
+}  // namespace sb
+
+namespace sb {
+namespace {
+
+// The convolution method without its convolution (convolve = false): the shaft test's clear
+// pairs are V = 1 and every other pair takes the reference's own estimate, so the bake is the
+// reference's, texel for texel, on a scene with two lights and contact.
+TEST(ShaftCullingBake, WithoutConvolutionEqualsTheReference) {
+  Scene reference = test_scenes::load("showcase", 64, "reference");
+  reference.bake.samples = 16;
+  Scene shaft = reference;
+  shaft.bake.method = "convolution";
+  shaft.bake.trace = true;
+  shaft.bake.convolve = false;
+  auto a = bake(reference);
+  auto b = bake(shaft);
+  ASSERT_TRUE(a) << a.error().message;
+  ASSERT_TRUE(b) << b.error().message;
+  ASSERT_EQ(a->receivers.size(), b->receivers.size());
+  for (std::size_t r = 0; r < a->receivers.size(); ++r) {
+    const Image& x = a->receivers[r].image;
+    const Image& y = b->receivers[r].image;
+    ASSERT_EQ(x.pixels.size(), y.pixels.size());
+    double worst = 0;
+    for (std::size_t i = 0; i < x.pixels.size(); ++i)
+      worst = std::max(worst, double(std::abs(x.pixels[i] - y.pixels[i])));
+    EXPECT_LT(worst, 1e-5) << a->receivers[r].name;
+  }
+  EXPECT_LT(b->shadow_rays, a->shadow_rays);  // the clear pairs took none
+
+  shaft.bake.trace = false;
+  auto neither = bake(shaft);
+  ASSERT_FALSE(neither);
+  EXPECT_NE(neither.error().message.find("convolve = false needs trace = true"), std::string::npos)
+      << neither.error().message;
+}
+
+}  // namespace
+}  // namespace sb

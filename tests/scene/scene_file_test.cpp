@@ -1,0 +1,538 @@
+// Tests of the scene file reader (src/scene/scene_file.cpp): every key and default read back, every
+// kind of bad input rejected with a one-line message naming file, line, item and key, and the
+// order in which object transforms compose.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <random>
+#include <string>
+
+#include "scene/scene.h"
+
+namespace sb {
+namespace {
+
+constexpr double degrees = std::numbers::pi / 180.0;
+
+// The smallest valid object and light; tests append keys to them or put them together.
+const std::string object_floor = "[[object]]\nname = \"floor\"\nmesh = \"m.obj\"\n";
+const std::string light_panel =
+    "[[light]]\nname = \"panel\"\nshape = \"rectangle\"\nposition = [0, 0, 1.5]\n"
+    "normal = [0, 0, -1]\nsize = [0.5, 0.5]\npower = 100.0\n";
+const std::string light_bulb =
+    "[[light]]\nname = \"bulb\"\nshape = \"sphere\"\nposition = [0, 0, 1]\nradius = 0.1\n"
+    "power = 10\n";
+const std::string light_disk =
+    "[[light]]\nname = \"spot\"\nshape = \"disk\"\nposition = [0, 0, 1]\nnormal = [0, 0, -1]\n"
+    "radius = [0.2]\npower = 10\n";
+
+// 1-based line of the first occurrence of `needle` in `text`.
+int line_of(const std::string& text, const std::string& needle) {
+  const std::size_t at = text.find(needle);
+  EXPECT_NE(at, std::string::npos) << needle;
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
+}
+
+// Each test gets its own folder holding an empty mesh "m.obj", so mesh existence checks pass.
+class SceneFile : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::random_device random;
+    dir_ = std::filesystem::temp_directory_path() /
+           ("shadowbake_scene_test_" + std::to_string(random()) + std::to_string(random()));
+    std::filesystem::create_directories(dir_);
+    std::ofstream(dir_ / "m.obj").flush();
+  }
+  void TearDown() override {
+    std::error_code ignored;
+    std::filesystem::remove_all(dir_, ignored);
+  }
+
+  std::filesystem::path write(const std::string& text, const std::string& name = "scene.toml") {
+    const std::filesystem::path file = dir_ / name;
+    std::filesystem::create_directories(file.parent_path());
+    std::ofstream(file, std::ios::binary) << text;
+    return file;
+  }
+
+  Scene load_ok(const std::string& text) {
+    Expected<Scene> scene = load_scene(write(text));
+    EXPECT_TRUE(scene.has_value()) << scene.error().message;
+    return scene ? *scene : Scene{};
+  }
+
+  std::string error_of(const std::string& text) {
+    Expected<Scene> scene = load_scene(write(text));
+    if (scene) {
+      ADD_FAILURE() << "expected an error for:\n" << text;
+      return {};
+    }
+    EXPECT_EQ(scene.error().kind, ErrorKind::scene);
+    EXPECT_EQ(scene.error().message.find('\n'), std::string::npos) << scene.error().message;
+    return scene.error().message;
+  }
+
+  // The error starts "<file>:<line of line_needle>: <item>: " and mentions `key`.
+  void expect_error(const std::string& text, const std::string& line_needle,
+                    const std::string& item, const std::string& key) {
+    const std::string message = error_of(text);
+    const std::string prefix = (dir_ / "scene.toml").string() + ":" +
+                               std::to_string(line_of(text, line_needle)) + ": " + item + ": ";
+    EXPECT_EQ(message.rfind(prefix, 0), 0u) << message << "\nexpected prefix: " << prefix;
+    EXPECT_NE(message.find(key), std::string::npos) << message << "\nexpected key: " << key;
+  }
+
+  std::filesystem::path dir_;
+};
+
+TEST_F(SceneFile, ReadsEveryValue) {
+  const std::string text = R"(
+[bake]
+resolution = 1024
+method = "reference"
+quantity = "irradiance"
+samples = 64
+margin = 2
+seed = 7
+
+[[object]]
+name = "floor"
+mesh = "m.obj"
+receiver = true
+blocker = false
+uv = 1
+translate = [1, 2, 3]
+rotate_deg = [0, 0, 90]
+scale = [2, 2, 2]
+
+[[object]]
+name = "box.01"
+mesh = "m.obj"
+receiver = false
+
+[[light]]
+name = "panel"
+shape = "rectangle"
+position = [0, 0, 1.5]
+normal = [0, 0, -2]
+up = [0, 1, 0]
+size = [0.5, 0.25]
+color = [1, 0.5, 0.25]
+power = 100.0
+
+[[light]]
+name = "bulb"
+shape = "sphere"
+position = [1, 1, 1]
+radius = 0.1
+power = 5
+)";
+  const Scene scene = load_ok(text);
+  EXPECT_EQ(scene.file, dir_ / "scene.toml");
+  EXPECT_EQ(scene.bake.resolution, 1024);
+  EXPECT_EQ(scene.bake.method, "reference");
+  EXPECT_EQ(scene.bake.quantity, Quantity::irradiance);
+  EXPECT_EQ(scene.bake.samples, 64);
+  EXPECT_EQ(scene.bake.margin, 2);
+  EXPECT_EQ(scene.bake.seed, 7u);
+
+  ASSERT_EQ(scene.objects.size(), 2u);
+  const ObjectDesc& floor = scene.objects[0];
+  EXPECT_EQ(floor.name, "floor");
+  EXPECT_EQ(floor.mesh, dir_ / "m.obj");
+  EXPECT_TRUE(floor.receiver);
+  EXPECT_FALSE(floor.blocker);
+  EXPECT_EQ(floor.uv_channel, 1);
+  EXPECT_EQ(floor.line, line_of(text, "name = \"floor\"") - 1);
+  EXPECT_TRUE(
+      floor.transform.isApprox(object_transform(Vec3(1, 2, 3), Vec3(0, 0, 90), Vec3(2, 2, 2))));
+  EXPECT_EQ(scene.objects[1].name, "box.01");
+  EXPECT_FALSE(scene.objects[1].receiver);
+  EXPECT_TRUE(scene.objects[1].blocker);
+
+  ASSERT_EQ(scene.lights.size(), 2u);
+  const LightDesc& panel = scene.lights[0];
+  EXPECT_EQ(panel.name, "panel");
+  EXPECT_EQ(panel.shape, LightShape::rectangle);
+  EXPECT_EQ(panel.position, Vec3(0, 0, 1.5));
+  EXPECT_EQ(panel.normal, Vec3(0, 0, -1));
+  EXPECT_EQ(panel.up, Vec3(0, 1, 0));
+  EXPECT_EQ(panel.width, 0.5);
+  EXPECT_EQ(panel.height, 0.25);
+  EXPECT_EQ(panel.color, Vec3(1, 0.5, 0.25));
+  EXPECT_EQ(panel.power, 100.0);
+  EXPECT_EQ(panel.line, line_of(text, "name = \"panel\"") - 1);
+  const LightDesc& bulb = scene.lights[1];
+  EXPECT_EQ(bulb.shape, LightShape::sphere);
+  EXPECT_EQ(bulb.position, Vec3(1, 1, 1));
+  EXPECT_EQ(bulb.radius, 0.1);
+  EXPECT_EQ(bulb.power, 5.0);
+}
+
+TEST_F(SceneFile, AppliesDefaults) {
+  const Scene scene = load_ok(object_floor + light_panel);
+  const BakeSettings defaults;
+  EXPECT_EQ(scene.bake.resolution, defaults.resolution);
+  EXPECT_EQ(scene.bake.resolution, 512);
+  EXPECT_EQ(scene.bake.method, "convolution");
+  EXPECT_EQ(scene.bake.quantity, Quantity::visibility);
+  EXPECT_EQ(scene.bake.samples, 256);
+  EXPECT_EQ(scene.bake.margin, 4);
+  EXPECT_EQ(scene.bake.seed, 0u);
+  ASSERT_EQ(scene.objects.size(), 1u);
+  EXPECT_TRUE(scene.objects[0].receiver);
+  EXPECT_TRUE(scene.objects[0].blocker);
+  EXPECT_EQ(scene.objects[0].uv_channel, 0);
+  EXPECT_TRUE(scene.objects[0].transform.isApprox(Affine3::Identity()));
+  ASSERT_EQ(scene.lights.size(), 1u);
+  EXPECT_EQ(scene.lights[0].up, Vec3(0, 1, 0));
+  EXPECT_EQ(scene.lights[0].color, Vec3(1, 1, 1));
+}
+
+TEST_F(SceneFile, ResolvesMeshAgainstSceneFolder) {
+  const std::filesystem::path file =
+      write("[[object]]\nname = \"floor\"\nmesh = \"../m.obj\"\n" + light_panel, "sub/scene.toml");
+  Expected<Scene> scene = load_scene(file);
+  ASSERT_TRUE(scene) << scene.error().message;
+  EXPECT_EQ(scene->objects[0].mesh, dir_ / "m.obj");
+}
+
+TEST_F(SceneFile, ReportsMissingSceneFile) {
+  const std::filesystem::path file = dir_ / "absent.toml";
+  Expected<Scene> scene = load_scene(file);
+  ASSERT_FALSE(scene);
+  EXPECT_EQ(scene.error().message.rfind(file.string() + ": cannot open scene file: ", 0), 0u)
+      << scene.error().message;
+}
+
+TEST_F(SceneFile, ReportsTomlSyntaxErrorWithLineAndColumn) {
+  const std::string text = object_floor + "receiver = = true\n" + light_panel;
+  const std::string message = error_of(text);
+  const std::string prefix =
+      (dir_ / "scene.toml").string() + ":" + std::to_string(line_of(text, "= =")) + ":";
+  EXPECT_EQ(message.rfind(prefix, 0), 0u) << message;
+  EXPECT_NE(message.find("TOML syntax error: "), std::string::npos) << message;
+}
+
+TEST_F(SceneFile, RejectsUnknownKey) {
+  const std::string text = object_floor + "recever = true\n" + light_panel;
+  expect_error(text, "recever", "object 'floor'", "unknown key 'recever'");
+  EXPECT_NE(error_of(text).find("(known: name, mesh, receiver, blocker, uv, allow_uncovered, "
+                                "translate, "
+                                "rotate_deg, scale)"),
+            std::string::npos);
+}
+
+TEST_F(SceneFile, ReportsFirstUnknownKeyInFileOrder) {
+  // toml++ iterates keys alphabetically; the message must point at the earliest line.
+  const std::string text = object_floor + "zz_first = 1\naa_second = 2\n" + light_panel;
+  expect_error(text, "zz_first", "object 'floor'", "unknown key 'zz_first'");
+}
+
+TEST_F(SceneFile, RejectsUnknownTopLevelKeyAndTable) {
+  expect_error("resolution = 5\n" + object_floor + light_panel, "resolution", "top level",
+               "'resolution'");
+  expect_error(object_floor + light_panel + "[render]\nsamples = 4\n", "[render]", "top level",
+               "'render'");
+}
+
+TEST_F(SceneFile, RejectsUnknownBakeKey) {
+  const std::string text = "[bake]\nresolution = 64\nsample = 4\n" + object_floor + light_panel;
+  expect_error(text, "sample =", "[bake]", "unknown key 'sample'");
+}
+
+TEST_F(SceneFile, RejectsUnknownMethod) {
+  const std::string text = "[bake]\nmethod = \"foo\"\n" + object_floor + light_panel;
+  expect_error(text, "method", "[bake]", "unknown method 'foo' (known: convolution, accumulation, pcf, pcss, "
+                                       "adaptive-pcf, erosion, chun-oh, reference)");
+}
+
+TEST_F(SceneFile, ReadsAndChecksMethodSettings) {
+  const Scene scene = load_ok(
+      "[bake]\nerror_texels = 0.5\nmax_image = 2048\nmax_triples = 32\nlight_parts = 2\n"
+      "blocker_combine = \"product\"\nweighting = \"emission\"\nshadow_map = 1024\npcf_radius = 3\n"
+      "erosion_factor = \"distance\"\n" +
+      object_floor + light_panel);
+  EXPECT_EQ(scene.bake.error_texels, 0.5);
+  EXPECT_EQ(scene.bake.max_image, 2048);
+  EXPECT_EQ(scene.bake.max_triples, 32);
+  EXPECT_EQ(scene.bake.light_parts, 2);
+  EXPECT_EQ(scene.bake.blocker_combine, "product");
+  EXPECT_EQ(scene.bake.weighting, "emission");
+  EXPECT_EQ(scene.bake.shadow_map, 1024);
+  EXPECT_EQ(scene.bake.pcf_radius, 3.0);
+  EXPECT_EQ(scene.bake.erosion_factor, "distance");
+  expect_error("[bake]\nerror_texels = 0\n" + object_floor + light_panel, "error_texels",
+               "[bake]", "'error_texels' must be a number > 0");
+  expect_error("[bake]\nblocker_combine = \"max\"\n" + object_floor + light_panel,
+               "blocker_combine", "[bake]", "'blocker_combine' must be \"product\" or \"sum\"");
+  expect_error("[bake]\nweighting = \"area\"\n" + object_floor + light_panel, "weighting",
+               "[bake]", "'weighting' must be \"irradiance\" or \"emission\"");
+  expect_error("[bake]\nerosion_factor = 2\n" + object_floor + light_panel, "erosion_factor",
+               "[bake]", "'erosion_factor' must be a string");
+  expect_error("[bake]\nlight_parts = 3\n" + object_floor + light_panel, "light_parts", "[bake]",
+               "'light_parts' must be 1, 2 or 4");
+  expect_error("[bake]\nlight_parts = 8\n" + object_floor + light_panel, "light_parts", "[bake]",
+               "'light_parts' must be an integer from 1 to 4");
+  expect_error("[bake]\nmax_image = 10\n" + object_floor + light_panel, "max_image", "[bake]",
+               "'max_image' must be an integer from 64 to 16384");
+}
+
+TEST_F(SceneFile, RejectsFloatWhereIntegerExpected) {
+  const std::string text = "[bake]\nresolution = 512.5\n" + object_floor + light_panel;
+  expect_error(text, "resolution", "[bake]", "'resolution' must be an integer");
+  expect_error(object_floor + "uv = 1.0\n" + light_panel, "uv =", "object 'floor'", "'uv'");
+}
+
+TEST_F(SceneFile, RejectsBakeIntegersOutOfRange) {
+  const std::string tail = object_floor + light_panel;
+  expect_error("[bake]\nresolution = 0\n" + tail, "resolution", "[bake]", "'resolution'");
+  expect_error("[bake]\nresolution = 16385\n" + tail, "resolution", "[bake]", "'resolution'");
+  expect_error("[bake]\nsamples = 0\n" + tail, "samples", "[bake]", "'samples'");
+  expect_error("[bake]\nmargin = -1\n" + tail, "margin", "[bake]", "'margin'");
+  expect_error("[bake]\nseed = -1\n" + tail, "seed", "[bake]", "'seed'");
+  EXPECT_TRUE(load_scene(write("[bake]\nresolution = 16384\nmargin = 0\n" + tail)));
+}
+
+TEST_F(SceneFile, RejectsUnknownQuantity) {
+  const std::string text = "[bake]\nquantity = \"radiance\"\n" + object_floor + light_panel;
+  expect_error(text, "quantity", "[bake]", "'quantity'");
+  EXPECT_NE(error_of(text).find("got \"radiance\""), std::string::npos);
+}
+
+TEST_F(SceneFile, RejectsMissingMeshFile) {
+  const std::string text = "[[object]]\nname = \"floor\"\nmesh = \"floor.obj\"\n" + light_panel;
+  expect_error(text, "mesh", "object 'floor'", "mesh file 'floor.obj' not found");
+  EXPECT_NE(error_of(text).find("(looked for " + (dir_ / "floor.obj").string() + ")"),
+            std::string::npos)
+      << error_of(text);
+}
+
+TEST_F(SceneFile, ReadsLightTexture) {
+  std::ofstream(dir_ / "panel.png") << "not read here";
+  const Scene scene = load_ok(object_floor + light_panel + "texture = \"panel.png\"\n");
+  EXPECT_EQ(scene.lights[0].texture, dir_ / "panel.png");
+  EXPECT_TRUE(load_ok(object_floor + light_panel).lights[0].texture.empty());
+}
+
+TEST_F(SceneFile, RejectsMissingOrMisplacedTexture) {
+  const std::string missing = object_floor + light_panel + "texture = \"nope.png\"\n";
+  expect_error(missing, "texture", "light 'panel'", "texture image 'nope.png' not found");
+  std::ofstream(dir_ / "t.png") << "x";
+  const std::string on_sphere = object_floor + light_bulb + "texture = \"t.png\"\n";
+  expect_error(on_sphere, "texture", "light 'bulb'", "'texture' applies only to rectangle");
+}
+
+TEST_F(SceneFile, RejectsMeshThatIsNotARegularFile) {
+  std::filesystem::create_directories(dir_ / "meshes");
+  const std::string text = "[[object]]\nname = \"floor\"\nmesh = \"meshes\"\n" + light_panel;
+  expect_error(text, "mesh", "object 'floor'", "not a regular file");
+}
+
+TEST_F(SceneFile, RejectsMissingObjectKeys) {
+  expect_error("[[object]]\nmesh = \"m.obj\"\n" + light_panel, "[[object]]", "[[object]] #1",
+               "missing required key 'name'");
+  expect_error(object_floor + "[[object]]\nname = \"box\"\n" + light_panel,
+               "[[object]]\nname = \"box\"", "object 'box'", "missing required key 'mesh'");
+}
+
+TEST_F(SceneFile, RejectsObjectNamesThatAreNotFileStems) {
+  const std::string named = "[[object]]\nmesh = \"m.obj\"\nname = ";
+  for (const char* bad : {"\"a/b\"", "\".hidden\"", "\"two words\"", "\"\"", "3"}) {
+    const std::string text = object_floor + named + bad + "\n" + light_panel;
+    expect_error(text, std::string("name = ") + bad, "[[object]] #2", "'name'");
+  }
+}
+
+TEST_F(SceneFile, RejectsDuplicateObjectNames) {
+  const std::string text = object_floor + "blocker = false\n" + object_floor + light_panel;
+  const std::string message = error_of(text);
+  EXPECT_NE(message.find(":5: object 'floor': object names must be unique: 'floor' is also "
+                         "defined at line 1"),
+            std::string::npos)
+      << message;
+}
+
+TEST_F(SceneFile, RejectsDuplicateLightNames) {
+  const std::string text = object_floor + light_panel + light_panel;
+  const std::string message = error_of(text);
+  EXPECT_NE(message.find(":11: light 'panel': light names must be unique: 'panel' is also "
+                         "defined at line 4"),
+            std::string::npos)
+      << message;
+}
+
+TEST_F(SceneFile, RejectsNonPositiveSize) {
+  const std::string text = object_floor +
+                           "[[light]]\nname = \"panel\"\nshape = \"rectangle\"\n"
+                           "position = [0, 0, 1.5]\nnormal = [0, 0, -1]\nsize = [0.5, 0]\n"
+                           "power = 100.0\n";
+  expect_error(text, "size", "light 'panel'", "'size' must be 2 positive numbers");
+  EXPECT_NE(error_of(text).find("got [0.5, 0]"), std::string::npos) << error_of(text);
+}
+
+TEST_F(SceneFile, RejectsMissingLightKeys) {
+  for (const char* key : {"shape", "position", "normal", "size", "power"}) {
+    std::string light = light_panel;
+    const std::size_t at = light.find(std::string(key) + " = ");
+    light.erase(at, light.find('\n', at) + 1 - at);
+    expect_error(object_floor + light, "[[light]]", "light 'panel'",
+                 "missing required key '" + std::string(key) + "'");
+  }
+  expect_error(object_floor + "[[light]]\nshape = \"sphere\"\n", "[[light]]", "[[light]] #1",
+               "missing required key 'name'");
+}
+
+TEST_F(SceneFile, RejectsUnknownShape) {
+  std::string light = light_panel;
+  light.replace(light.find("rectangle"), 9, "square");
+  expect_error(object_floor + light, "shape", "light 'panel'", "'shape'");
+}
+
+TEST_F(SceneFile, RejectsShapeSpecificKeyOnWrongShape) {
+  expect_error(object_floor + light_bulb + "size = [1, 1]\n", "size", "light 'bulb'", "'size'");
+  expect_error(object_floor + light_bulb + "normal = [0, 0, -1]\n", "normal", "light 'bulb'",
+               "'normal'");
+  expect_error(object_floor + light_bulb + "up = [0, 1, 0]\n", "up =", "light 'bulb'", "'up'");
+  expect_error(object_floor + light_disk + "up = [0, 1, 0]\n", "up =", "light 'spot'", "'up'");
+  expect_error(object_floor + light_panel + "radius = 0.1\n", "radius", "light 'panel'",
+               "'radius'");
+}
+
+TEST_F(SceneFile, AcceptsRadiusAsNumberOrOneElementArray) {
+  const Scene scene = load_ok(object_floor + light_bulb + light_disk);
+  ASSERT_EQ(scene.lights.size(), 2u);
+  EXPECT_EQ(scene.lights[0].radius, 0.1);
+  EXPECT_EQ(scene.lights[1].shape, LightShape::disk);
+  EXPECT_EQ(scene.lights[1].radius, 0.2);
+  EXPECT_EQ(scene.lights[1].normal, Vec3(0, 0, -1));
+  EXPECT_NEAR(scene.lights[1].up.dot(scene.lights[1].normal), 0.0, 1e-12);
+}
+
+TEST_F(SceneFile, RejectsBadRadius) {
+  std::string two = light_bulb;
+  two.replace(two.find("0.1"), 3, "[0.1, 0.2]");
+  expect_error(object_floor + two, "radius", "light 'bulb'", "'radius'");
+  std::string zero = light_bulb;
+  zero.replace(zero.find("0.1"), 3, "[0]");
+  expect_error(object_floor + zero, "radius", "light 'bulb'", "'radius'");
+}
+
+TEST_F(SceneFile, NormalisesNormalAndOrthogonalisesUp) {
+  std::string light = light_panel;
+  light.replace(light.find("normal = [0, 0, -1]"), 19, "normal = [0, 0, -3]\nup = [0, 2, 2]");
+  const Scene scene = load_ok(object_floor + light);
+  EXPECT_TRUE(scene.lights[0].normal.isApprox(Vec3(0, 0, -1)));
+  EXPECT_TRUE(scene.lights[0].up.isApprox(Vec3(0, 1, 0))) << scene.lights[0].up.transpose();
+}
+
+TEST_F(SceneFile, DefaultUpAvoidsNormalAlongY) {
+  std::string light = light_panel;
+  light.replace(light.find("normal = [0, 0, -1]"), 19, "normal = [0, -1, 0]");
+  const Scene scene = load_ok(object_floor + light);
+  EXPECT_EQ(scene.lights[0].up, Vec3(0, 0, 1));
+}
+
+TEST_F(SceneFile, RejectsUpParallelToNormalAndZeroNormal) {
+  expect_error(object_floor + light_panel + "up = [0, 0, 5]\n", "up =", "light 'panel'",
+               "'up' must not be parallel to 'normal'");
+  std::string light = light_panel;
+  light.replace(light.find("normal = [0, 0, -1]"), 19, "normal = [0, 0, 0]");
+  expect_error(object_floor + light, "normal", "light 'panel'", "'normal'");
+}
+
+TEST_F(SceneFile, RejectsBadColorAndPower) {
+  expect_error(object_floor + light_panel + "color = [0, 0, 0]\n", "color", "light 'panel'",
+               "'color'");
+  expect_error(object_floor + light_panel + "color = [1, -1, 1]\n", "color", "light 'panel'",
+               "'color'");
+  for (const char* power : {"0", "-5", "inf", "nan", "\"100\""}) {
+    std::string light = light_panel;
+    light.replace(light.find("100.0"), 5, power);
+    expect_error(object_floor + light, "power", "light 'panel'", "'power'");
+  }
+}
+
+TEST_F(SceneFile, RejectsBadTransformKeys) {
+  expect_error(object_floor + "scale = [1, 0, 1]\n" + light_panel, "scale", "object 'floor'",
+               "'scale'");
+  expect_error(object_floor + "translate = [1, 2]\n" + light_panel, "translate", "object 'floor'",
+               "'translate'");
+  expect_error(object_floor + "rotate_deg = [0, nan, 0]\n" + light_panel, "rotate_deg",
+               "object 'floor'", "'rotate_deg'");
+  expect_error(object_floor + "receiver = \"yes\"\n" + light_panel, "receiver", "object 'floor'",
+               "'receiver'");
+}
+
+TEST_F(SceneFile, RejectsSceneWithoutLightsObjectsOrReceivers) {
+  const std::string file = (dir_ / "scene.toml").string();
+  EXPECT_EQ(error_of(object_floor).rfind(file + ": scene: no [[light]]", 0), 0u);
+  EXPECT_EQ(error_of(light_panel).rfind(file + ": scene: no [[object]]", 0), 0u);
+  EXPECT_EQ(error_of(object_floor + "receiver = false\n" + light_panel)
+                .rfind(file + ": scene: no object has 'receiver' = true", 0),
+            0u);
+}
+
+TEST_F(SceneFile, RejectsTableWhereArrayOfTablesIsExpected) {
+  const std::string text = "[object]\nname = \"floor\"\nmesh = \"m.obj\"\n" + light_panel;
+  expect_error(text, "[object]", "top level", "[[object]]");
+}
+
+TEST_F(SceneFile, KeepsErrorsOnOneLine) {
+  std::string light = light_panel;
+  light.replace(light.find("\"panel\""), 7, "\"pa\\nnel\"");
+  const std::string message = error_of(object_floor + light + "colour = [1, 1, 1]\n");
+  EXPECT_NE(message.find("light 'pa\\nnel': unknown key 'colour'"), std::string::npos) << message;
+}
+
+TEST_F(SceneFile, NamesShapesAndQuantities) {
+  EXPECT_STREQ(to_string(Quantity::visibility), "visibility");
+  EXPECT_STREQ(to_string(Quantity::irradiance), "irradiance");
+  EXPECT_STREQ(to_string(LightShape::rectangle), "rectangle");
+  EXPECT_STREQ(to_string(LightShape::disk), "disk");
+  EXPECT_STREQ(to_string(LightShape::sphere), "sphere");
+}
+
+TEST(Transform, IsIdentityForDefaults) {
+  EXPECT_TRUE(
+      object_transform(Vec3::Zero(), Vec3::Zero(), Vec3::Ones()).isApprox(Affine3::Identity()));
+}
+
+TEST(Transform, ScalesThenRotatesThenTranslates) {
+  const Affine3 t = object_transform(Vec3(10, 0, 0), Vec3(0, 0, 90), Vec3(2, 1, 1));
+  // (1, 0, 0) scaled to (2, 0, 0), turned 90 degrees about Z to (0, 2, 0), moved to (10, 2, 0).
+  const Vec3 p = t * Vec3(1, 0, 0);
+  EXPECT_NEAR((p - Vec3(10, 2, 0)).norm(), 0.0, 1e-12) << p.transpose();
+  // Rotating before scaling would have given (10, 1, 0).
+}
+
+TEST(Transform, RotatesAboutXThenYThenZ) {
+  const Vec3 angles(90, 90, 0);
+  const Mat3 x_then_y = (Eigen::AngleAxisd(90 * degrees, Vec3::UnitY()) *
+                         Eigen::AngleAxisd(90 * degrees, Vec3::UnitX()))
+                            .toRotationMatrix();
+  const Mat3 y_then_x = (Eigen::AngleAxisd(90 * degrees, Vec3::UnitX()) *
+                         Eigen::AngleAxisd(90 * degrees, Vec3::UnitY()))
+                            .toRotationMatrix();
+  const Affine3 t = object_transform(Vec3::Zero(), angles, Vec3::Ones());
+  EXPECT_TRUE(t.linear().isApprox(x_then_y));
+  EXPECT_FALSE(t.linear().isApprox(y_then_x));
+  // Z (0, 0, 1) goes to (0, -1, 0) about X, then to (0, -1, 0) about Y.
+  EXPECT_NEAR((t * Vec3(0, 0, 1) - Vec3(0, -1, 0)).norm(), 0.0, 1e-12);
+
+  const Vec3 r(30, -45, 60);
+  const Mat3 blender = (Eigen::AngleAxisd(r.z() * degrees, Vec3::UnitZ()) *
+                        Eigen::AngleAxisd(r.y() * degrees, Vec3::UnitY()) *
+                        Eigen::AngleAxisd(r.x() * degrees, Vec3::UnitX()))
+                           .toRotationMatrix();
+  const Vec3 s(1, 2, 3);
+  const Affine3 full = object_transform(Vec3(4, 5, 6), r, s);
+  EXPECT_TRUE(full.linear().isApprox(blender * s.asDiagonal()));
+  EXPECT_TRUE(full.translation().isApprox(Vec3(4, 5, 6)));
+}
+
+}  // namespace
+}  // namespace sb
