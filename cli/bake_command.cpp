@@ -69,43 +69,14 @@ struct BakeArgs {
   bool no_convolve = false;
 };
 
-// --explain: what the convolution method chose for each light and receiver, and what it cost.
+// --explain: per receiver its stage times, the method's figures and what the method says of its
+// choices (the convolution: its plan, directions, planes, error metric, images and stage times).
 void print_explanation(const sb::BakeResult& result) {
   for (const auto& r : result.receivers) {
     fmt::print("{}: texel space {:.1f} ms, method {:.1f} ms, dilation {:.1f} ms\n", r.name,
                1e3 * r.seconds_texels, 1e3 * r.seconds_method, 1e3 * r.seconds_dilate);
-    for (const auto& [key, value] : r.stats) fmt::print("    {} = {:.4g}\n", key, value);
-    if (!r.plan.empty()) fmt::print("{}", r.plan);
-    for (const auto& p : r.pairs) {
-      fmt::print("{} <- {}{}{}: D = ({:.3f}, {:.3f}, {:.3f}), {} lit texels", p.receiver, p.light,
-                 p.part.empty() ? "" : " face ", p.part, p.axis[0], p.axis[1], p.axis[2],
-                 p.lit_texels);
-      if (p.outside_texels > 0)
-        fmt::print(" ({} beside the light, left unshadowed)", p.outside_texels);
-      fmt::print("\n");
-      if (p.image_width == 0) {
-        fmt::print("    no blocker between the light and the receiver\n");
-        continue;
-      }
-      fmt::print(
-          "    planes along D: source 0, blocker {:.3f} m (blockers {:.3f}..{:.3f}), receiver "
-          "{:.3f} m (receiver {:.3f}..{:.3f})\n",
-          p.blocker_plane, p.blocker_depth_lo, p.blocker_depth_hi, p.receiver_plane,
-          p.receiver_depth_lo, p.receiver_depth_hi);
-      fmt::print(
-          "    penumbra error: rho {:.3f} in [{:.3f}, {:.3f}], L = {:.3f} m -> {:.4f} m = {:.1f} "
-          "texels\n",
-          p.rho, p.rho_lo, p.rho_hi, p.light_extent, p.penumbra_error, p.penumbra_error_texels);
-      fmt::print("    images: blocker {}x{}, kernel {}x{}, FFT {}x{}, {} convolution(s)\n",
-                 p.image_width, p.image_height, p.kernel_width, p.kernel_height, p.fft_width,
-                 p.fft_height, p.convolutions);
-      fmt::print(
-          "    time: configure {:.1f} ms; summed over threads: source {:.1f} ms, blocker {:.1f} "
-          "ms, "
-          "FFT {:.1f} ms, lookup {:.1f} ms\n",
-          1e3 * p.seconds_configure, 1e3 * p.seconds_source, 1e3 * p.seconds_blocker,
-          1e3 * p.seconds_fft, 1e3 * p.seconds_lookup);
-    }
+    for (const auto& [key, value] : r.report.stats) fmt::print("    {} = {:.4g}\n", key, value);
+    fmt::print("{}", r.report.explain);
   }
 }
 

@@ -20,4 +20,10 @@ std::uint64_t default_max_memory();
 // Parses "8 GiB", "512MiB", "2 GB", "1.5GiB" or a plain number of bytes; false when it is none.
 bool parse_memory_size(const std::string& text, std::uint64_t& bytes);
 
+// One large allocation a bake will make, estimated before it is made (pipeline/memory_budget.h).
+struct MemoryItem {
+  std::string what;  // "texel space", "lightmaps", ...
+  double bytes = 0;
+};
+
 }  // namespace sb

@@ -92,8 +92,8 @@ LightSample constellation_point(const Light& light, const Constellation& c, int 
 
 }  // namespace
 
-Image bake_accumulation(const TexelSpace& space, const BaselineInputs& in, MethodStats* stats,
-                        std::int64_t* rays_traced) {
+MixedImages bake_accumulation(const TexelSpace& space, const BaselineInputs& in,
+                              MethodStats* stats, std::int64_t* rays_traced) {
   const auto& lights = *in.lights;
   const RayScene& rays = *in.rays;
   const BakeSettings& settings = *in.settings;
@@ -105,7 +105,7 @@ Image bake_accumulation(const TexelSpace& space, const BaselineInputs& in, Metho
   for (std::size_t l = 0; l < lights.size(); ++l)
     constellations.push_back(make_constellation(lights[l], samples, settings.seed, l));
 
-  LightMix mix(space, lights, settings.quantity);
+  LightMix mix(space, lights, settings.quantity, LightMix::Order::texel_major, in.keep_per_light);
   std::atomic<std::int64_t> traced{0}, contributing{0}, pairs{0};
 
   tbb::parallel_for(
@@ -119,6 +119,7 @@ Image bake_accumulation(const TexelSpace& space, const BaselineInputs& in, Metho
           const Vec3 normal = texel.normal.cast<double>();
           const Vec3 origin =
               texel.shadow_origin.cast<double>() + offset * texel.geometric_normal.cast<double>();
+          LightMix::Sum sum;
           for (std::size_t l = 0; l < lights.size(); ++l) {
             if (!lights[l].reaches(position, normal)) continue;
             batch.clear();
@@ -133,8 +134,9 @@ Image bake_accumulation(const TexelSpace& space, const BaselineInputs& in, Metho
             Vec3 v;
             if (!batch.visible_fraction(rays, &v)) continue;
             local_rays += batch.size();
-            mix.add(l, t, v);
+            mix.add(sum, l, t, mix.unoccluded(l, t), v);
           }
+          mix.write(t, sum);
         }
         traced += local_rays;
         contributing += local_points;
@@ -150,6 +152,82 @@ Image bake_accumulation(const TexelSpace& space, const BaselineInputs& in, Metho
                         pairs.load() > 0 ? double(contributing.load()) / double(pairs.load()) : 0);
   }
   return mix.finish();
+}
+
+namespace {
+
+// accumulation, erosion and the shadow-map filters: one receiver through their bake function.
+class BaselineMethod final : public Method {
+ public:
+  using Bake = std::function<MixedImages(const TexelSpace&, const BaselineInputs&, MethodStats*,
+                                         std::int64_t*)>;
+  BaselineMethod(const BakeContext& context, Bake bake) : context_(context), bake_(bake) {}
+
+  Expected<MethodResult> bake(const ReceiverInput& receiver) override {
+    BaselineInputs in;
+    in.lights = context_.lights;
+    in.rays = context_.rays;
+    in.blockers = context_.blockers;
+    in.receiver = receiver.mesh;
+    in.settings = &context_.scene->bake;
+    in.stream = receiver.stream;
+    in.keep_per_light = context_.keep_per_light;
+    MethodResult result;
+    result.images = bake_(*receiver.space, in, &result.report.stats, &result.rays);
+    if (context_.texels_done) {
+      const auto done = (*context_.texels_done += std::int64_t(receiver.space->texels.size()));
+      if (context_.progress) context_.progress(double(done));
+    }
+    return result;
+  }
+
+ private:
+  BakeContext context_;
+  Bake bake_;
+};
+
+// Shadow-map baselines hold a depth map (float) per light and cube face at shadow_map², and,
+// running light by light, every light's V per texel until the lights are mixed (LightMix).
+std::vector<MemoryItem> shadow_map_memory(const Scene& scene) {
+  const BakeSettings& b = scene.bake;
+  const double lights = double(scene.lights.size());
+  const double map = double(b.shadow_map) * double(b.shadow_map) * 4;
+  const double texels = double(b.resolution) * double(b.resolution);
+  return {{"shadow maps", map * lights * 6},
+          {"per-light visibility", texels * lights * (sizeof(Vec3f) + 1)}};
+}
+
+MethodEntry baseline_entry(std::string name, std::vector<std::string> settings, bool rays,
+                           BaselineMethod::Bake bake,
+                           std::function<std::vector<MemoryItem>(const Scene&)> memory) {
+  return {std::move(name), std::move(settings),
+          [rays](const BakeSettings&) { return MethodNeeds{.rays = rays}; }, std::move(memory),
+          [bake](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {
+            return std::unique_ptr<Method>(std::make_unique<BaselineMethod>(context, bake));
+          }};
+}
+
+}  // namespace
+
+MethodEntry accumulation_method() {
+  return baseline_entry("accumulation", {"samples", "seed"}, true, bake_accumulation, nullptr);
+}
+
+MethodEntry erosion_method() {
+  return baseline_entry("erosion", {"erosion_factor"}, true,
+                        [](const TexelSpace& space, const BaselineInputs& in, MethodStats* stats,
+                           std::int64_t* rays) { return bake_erosion(space, in, stats, rays); },
+                        shadow_map_memory);
+}
+
+MethodEntry shadow_map_method(const std::string& name) {
+  std::vector<std::string> settings = {"shadow_map"};
+  if (name == "pcf") settings.push_back("pcf_radius");
+  if (name == "adaptive-pcf") settings.insert(settings.end(), {"samples", "seed"});
+  return baseline_entry(name, settings, false,
+                        [](const TexelSpace& space, const BaselineInputs& in, MethodStats* stats,
+                           std::int64_t*) { return bake_shadow_map_filter(space, in, stats); },
+                        shadow_map_memory);
 }
 
 }  // namespace sb

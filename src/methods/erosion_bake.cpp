@@ -467,7 +467,7 @@ class ErosionBake {
   }
 
   void erode(std::size_t l, LightMix& mix, Figures& figures) {
-    const bool by_distance = in_.settings->erosion_factor == "distance";
+    const bool by_distance = in_.settings->erosion_factor == ErosionFactor::distance;
     if (!by_distance) build_tables();
     const EdgeIndex index(edges_, W_, H_);
     std::atomic<std::int64_t> penumbra{0};
@@ -491,7 +491,7 @@ class ErosionBake {
               v = filtered(p, centre, edge);
             }
           }
-          mix.add(l, std::size_t(texel_at_[p]), Vec3::Constant(std::clamp(v, 0.0, 1.0)));
+          mix.set(l, std::size_t(texel_at_[p]), Vec3::Constant(std::clamp(v, 0.0, 1.0)));
         }
       penumbra += local_penumbra;
     });
@@ -560,9 +560,11 @@ class ErosionBake {
 
 }  // namespace
 
-Image bake_erosion(const TexelSpace& space, const BaselineInputs& in, const ErosionOptions& options,
-                   MethodStats* stats, std::int64_t* rays_traced) {
-  LightMix mix(space, *in.lights, in.settings->quantity);
+MixedImages bake_erosion(const TexelSpace& space, const BaselineInputs& in,
+                         const ErosionOptions& options, MethodStats* stats,
+                         std::int64_t* rays_traced) {
+  LightMix mix(space, *in.lights, in.settings->quantity, LightMix::Order::light_major,
+               in.keep_per_light);
   Figures figures;
   if (!space.texels.empty()) {
     ErosionBake bake(space, in, options);
@@ -581,8 +583,8 @@ Image bake_erosion(const TexelSpace& space, const BaselineInputs& in, const Eros
   return mix.finish();
 }
 
-Image bake_erosion(const TexelSpace& space, const BaselineInputs& in, MethodStats* stats,
-                   std::int64_t* rays_traced) {
+MixedImages bake_erosion(const TexelSpace& space, const BaselineInputs& in, MethodStats* stats,
+                         std::int64_t* rays_traced) {
   return bake_erosion(space, in, ErosionOptions{}, stats, rays_traced);
 }
 

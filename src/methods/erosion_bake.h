@@ -16,7 +16,8 @@ struct ErosionOptions {
   bool line_distance = true;
 };
 
-Image bake_erosion(const TexelSpace& space, const BaselineInputs& in, const ErosionOptions& options,
-                   MethodStats* stats, std::int64_t* rays_traced);
+MixedImages bake_erosion(const TexelSpace& space, const BaselineInputs& in,
+                         const ErosionOptions& options, MethodStats* stats,
+                         std::int64_t* rays_traced);
 
 }  // namespace sb

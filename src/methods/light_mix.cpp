@@ -1,42 +1,73 @@
-// LightMix (baselines.h): the one place the baselines combine lights, as the reference does.
-#include "methods/baselines.h"
+// LightMix (light_mix.h): the one rule by which methods combine lights.
+#include "methods/light_mix.h"
 
 namespace sb {
 
-LightMix::LightMix(const TexelSpace& space, const std::vector<Light>& lights, Quantity quantity)
-    : space_(space),
-      lights_(lights),
-      quantity_(quantity),
-      weighted_(lights.size() > 1 || quantity == Quantity::irradiance),
-      sum_(space.width, space.height, 3, 0.0f),
-      weight_sum_(space.texels.size(), Vec3f::Zero()) {}
-
-void LightMix::add(std::size_t light, std::size_t t, const Vec3& v) {
-  const Texel& tx = space_.texels[t];
-  const Light& l = lights_[light];
-  // One light's visibility needs no closed form: its weight is its exitance where it reaches the
-  // texel, so that a channel it does not emit stays 0.
-  Vec3 w;
-  if (weighted_) {
-    w = l.unoccluded_irradiance(tx.position.cast<double>(), tx.normal.cast<double>());
-  } else {
-    w = l.reaches(tx.position.cast<double>(), tx.normal.cast<double>()) ? l.exitance()
-                                                                         : Vec3::Zero();
+LightMix::LightMix(const TexelSpace& space, const std::vector<Light>& lights, Quantity quantity,
+                   Order order, bool keep_per_light)
+    : space_(space), lights_(lights), quantity_(quantity), keep_per_light_(keep_per_light) {
+  out_.image = Image(space.width, space.height, 3, 0.0f);
+  if (order == Order::light_major) {
+    set_values_.assign(lights.size(), std::vector<Vec3f>(space.texels.size(), Vec3f::Zero()));
+    set_flags_.assign(lights.size(), std::vector<std::uint8_t>(space.texels.size(), 0));
   }
-  float* px = sum_.at(tx.x, tx.y);
-  for (int c = 0; c < 3; ++c) px[c] += float(w[c] * v[c]);
-  weight_sum_[t] += w.cast<float>();
+  if (keep_per_light_)
+    out_.per_light.assign(lights.size(), Image(space.width, space.height, 3, 0.0f));
 }
 
-Image LightMix::finish() {
-  if (quantity_ == Quantity::visibility) {
+Vec3 LightMix::unoccluded(std::size_t light, std::size_t texel) const {
+  const Texel& t = space_.texels[texel];
+  return lights_[light].unoccluded_irradiance(t.position.cast<double>(), t.normal.cast<double>());
+}
+
+void LightMix::keep(std::size_t light, std::size_t texel, const Vec3& h0, const Vec3& v) {
+  if (!keep_per_light_) return;
+  const Texel& t = space_.texels[texel];
+  float* px = out_.per_light[light].at(t.x, t.y);
+  for (int c = 0; c < 3; ++c) {
+    const double value = quantity_ == Quantity::irradiance ? h0[c] * v[c] : (h0[c] > 0 ? v[c] : 0);
+    px[c] = float(value);
+  }
+}
+
+void LightMix::add(Sum& sum, std::size_t light, std::size_t texel, const Vec3& h0,
+                   const Vec3& v) {
+  sum.h += h0.cwiseProduct(v);
+  sum.h0 += h0;
+  keep(light, texel, h0, v);
+}
+
+void LightMix::write(std::size_t texel, const Sum& sum) {
+  const Texel& t = space_.texels[texel];
+  float* px = out_.image.at(t.x, t.y);
+  for (int c = 0; c < 3; ++c) {
+    double v = 0;
+    if (quantity_ == Quantity::irradiance) {
+      v = sum.h[c];
+    } else if (sum.h0[c] > 0) {
+      v = sum.h[c] / sum.h0[c];
+    }
+    px[c] = float(v);
+  }
+}
+
+void LightMix::set(std::size_t light, std::size_t texel, const Vec3& v) {
+  set_values_[light][texel] = v.cast<float>();
+  set_flags_[light][texel] = 1;
+}
+
+MixedImages LightMix::finish() {
+  if (!set_values_.empty()) {
     for (std::size_t t = 0; t < space_.texels.size(); ++t) {
-      float* px = sum_.at(space_.texels[t].x, space_.texels[t].y);
-      for (int c = 0; c < 3; ++c)
-        px[c] = weight_sum_[t][c] > 0 ? px[c] / weight_sum_[t][c] : 0.0f;
+      Sum sum;
+      for (std::size_t l = 0; l < lights_.size(); ++l) {
+        if (!set_flags_[l][t]) continue;
+        add(sum, l, t, unoccluded(l, t), set_values_[l][t].cast<double>());
+      }
+      write(t, sum);
     }
   }
-  return std::move(sum_);
+  return std::move(out_);
 }
 
 }  // namespace sb

@@ -14,11 +14,11 @@
 
 namespace sb {
 
-Image bake_reference(const TexelSpace& space, const ReferenceInputs& in,
-                     std::int64_t* rays_traced) {
-  Image out(space.width, space.height, 3, 0.0f);
+MixedImages bake_reference(const TexelSpace& space, const ReferenceInputs& in,
+                           std::int64_t* rays_traced) {
   const auto& lights = *in.lights;
   const RayScene& rays = *in.rays;
+  LightMix mix(space, lights, in.quantity, LightMix::Order::texel_major, in.keep_per_light);
   std::atomic<std::int64_t> traced{0};
 
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, space.texels.size(), 64),
@@ -28,30 +28,18 @@ Image bake_reference(const TexelSpace& space, const ReferenceInputs& in,
                       std::int64_t local_rays = 0;
                       for (std::size_t t = range.begin(); t != range.end(); ++t) {
                         const Texel& texel = space.texels[t];
-                        const Vec3 position = texel.position.cast<double>();
-                        const Vec3 normal = texel.normal.cast<double>();
-                        Vec3 h_sum = Vec3::Zero(), h0_sum = Vec3::Zero();
+                        LightMix::Sum sum;
                         for (std::size_t l = 0; l < lights.size(); ++l) {
-                          const Vec3 h0 = lights[l].unoccluded_irradiance(position, normal);
+                          const Vec3 h0 = mix.unoccluded(l, t);
                           if (h0.maxCoeff() <= 0) continue;
                           Vec3 v;
                           if (!estimate_visibility(texel, l, lights[l], rays, in.samples, in.seed,
                                                    in.stream, space.width, batch, strata, &v))
                             continue;
                           local_rays += batch.size();
-                          h_sum += h0.cwiseProduct(v);
-                          h0_sum += h0;
+                          mix.add(sum, l, t, h0, v);
                         }
-                        float* px = out.at(texel.x, texel.y);
-                        for (int c = 0; c < 3; ++c) {
-                          double v = 0;
-                          if (in.quantity == Quantity::irradiance) {
-                            v = h_sum[c];
-                          } else if (h0_sum[c] > 0) {
-                            v = h_sum[c] / h0_sum[c];
-                          }
-                          px[c] = float(v);
-                        }
+                        mix.write(t, sum);
                       }
                       traced += local_rays;
                       if (in.texels_done) {
@@ -60,7 +48,46 @@ Image bake_reference(const TexelSpace& space, const ReferenceInputs& in,
                       }
                     });
   if (rays_traced) *rays_traced += traced.load();
-  return out;
+  return mix.finish();
+}
+
+namespace {
+
+class ReferenceMethod final : public Method {
+ public:
+  explicit ReferenceMethod(const BakeContext& context) : context_(context) {}
+
+  Expected<MethodResult> bake(const ReceiverInput& receiver) override {
+    const BakeSettings& settings = context_.scene->bake;
+    ReferenceInputs in;
+    in.lights = context_.lights;
+    in.rays = context_.rays;
+    in.quantity = settings.quantity;
+    in.samples = settings.samples;
+    in.seed = settings.seed;
+    in.stream = receiver.stream;
+    in.texels_done = context_.texels_done;
+    in.progress = context_.progress;
+    in.keep_per_light = context_.keep_per_light;
+    MethodResult result;
+    result.images = bake_reference(*receiver.space, in, &result.rays);
+    return result;
+  }
+
+ private:
+  BakeContext context_;
+};
+
+}  // namespace
+
+MethodEntry reference_method() {
+  return {"reference",
+          {"samples", "seed"},
+          [](const BakeSettings&) { return MethodNeeds{.rays = true}; },
+          nullptr,
+          [](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {
+            return std::unique_ptr<Method>(std::make_unique<ReferenceMethod>(context));
+          }};
 }
 
 }  // namespace sb

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "pipeline/bake.h"
+#include "methods/method.h"
 #include "scene/lights.h"
 #include "occluders/ray_scene.h"
 #include "texels/texel_space.h"
@@ -21,12 +21,16 @@ struct ReferenceInputs {
   std::uint64_t stream = 0;  // distinguishes receivers so each has its own random streams
   std::atomic<std::int64_t>* texels_done = nullptr;  // progress counter, may be null
   ProgressFn progress;  // called with texels_done after each chunk, may be empty
+  bool keep_per_light = false;
 };
 
-// Returns a width × height RGB image: per covered texel, V = Σ_l H_l / Σ_l H0_l (visibility) or
-// Σ_l H_l (irradiance, W/m²), H0 in closed form and V_l estimated from `samples` stratified
+// Returns width × height RGB images (LightMix's rule: per covered texel V = Σ_l H_l / Σ_l H0_l or
+// H = Σ_l H_l), V_l estimated from `samples` stratified
 // shadow rays per light; uncovered texels 0. Adds the number of rays traced to *rays_traced.
-Image bake_reference(const TexelSpace& texels, const ReferenceInputs& in,
-                     std::int64_t* rays_traced);
+MixedImages bake_reference(const TexelSpace& texels, const ReferenceInputs& in,
+                           std::int64_t* rays_traced);
+
+// The registry's entry: reads samples and seed.
+MethodEntry reference_method();
 
 }  // namespace sb

@@ -122,7 +122,7 @@ double lit_fraction(const ShadowMap& map, const ReceiverPoint& r, const Vec2& at
 struct ShadowFilterOptions {
   bool adaptive_always_full = false;  // adaptive-pcf takes its full sample set at every texel
 };
-Image bake_shadow_map_filter(const TexelSpace& space, const BaselineInputs& in, MethodStats* stats,
-                             const ShadowFilterOptions& options);
+MixedImages bake_shadow_map_filter(const TexelSpace& space, const BaselineInputs& in,
+                                   MethodStats* stats, const ShadowFilterOptions& options);
 
 }  // namespace sb

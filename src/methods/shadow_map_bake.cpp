@@ -33,6 +33,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <stdexcept>
 #include <array>
 #include <cmath>
 #include <numbers>
@@ -409,15 +410,23 @@ Vec3 chun_oh(const ShadowMap& map, const ReceiverPoint& r, const Horizon& horizo
 
 }  // namespace
 
-Image bake_shadow_map_filter(const TexelSpace& space, const BaselineInputs& in, MethodStats* stats,
-                             const ShadowFilterOptions& options) {
+MixedImages bake_shadow_map_filter(const TexelSpace& space, const BaselineInputs& in,
+                                   MethodStats* stats, const ShadowFilterOptions& options) {
   const BakeSettings& settings = *in.settings;
-  const Filter filter = settings.method == "pcf"            ? Filter::pcf
-                        : settings.method == "pcss"         ? Filter::pcss
-                        : settings.method == "adaptive-pcf" ? Filter::adaptive
-                                                            : Filter::chun_oh;
+  Filter filter = Filter::pcf;
+  if (settings.method == "pcss") {
+    filter = Filter::pcss;
+  } else if (settings.method == "adaptive-pcf") {
+    filter = Filter::adaptive;
+  } else if (settings.method == "chun-oh") {
+    filter = Filter::chun_oh;
+  } else if (settings.method != "pcf") {
+    // The registry makes this method for those four names only.
+    throw std::invalid_argument("bake_shadow_map_filter: not a shadow-map filter: " +
+                                settings.method);
+  }
   const auto& lights = *in.lights;
-  LightMix mix(space, lights, settings.quantity);
+  LightMix mix(space, lights, settings.quantity, LightMix::Order::light_major, in.keep_per_light);
   const int grid =
       std::max(3, int(std::sqrt(double(std::clamp(settings.samples, 1, kMaxAdaptiveSamples)))));
   const std::vector<int> rim = rim_cells(grid, kEstimationSamples);
@@ -486,7 +495,7 @@ Image bake_shadow_map_filter(const TexelSpace& space, const BaselineInputs& in, 
           });
     }
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, lit.size(), 4096), [&](const auto& r) {
-      for (std::size_t i = r.begin(); i != r.end(); ++i) mix.add(l, lit[i], visibility[i]);
+      for (std::size_t i = r.begin(); i != r.end(); ++i) mix.set(l, lit[i], visibility[i]);
     });
   }
 
@@ -511,8 +520,8 @@ Image bake_shadow_map_filter(const TexelSpace& space, const BaselineInputs& in, 
   return mix.finish();
 }
 
-Image bake_shadow_map_filter(const TexelSpace& space, const BaselineInputs& in,
-                             MethodStats* stats) {
+MixedImages bake_shadow_map_filter(const TexelSpace& space, const BaselineInputs& in,
+                                   MethodStats* stats) {
   return bake_shadow_map_filter(space, in, stats, ShadowFilterOptions{});
 }
 

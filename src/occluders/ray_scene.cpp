@@ -83,12 +83,6 @@ Expected<RayScene> RayScene::build(const std::vector<const Mesh*>& blockers) {
 const Bounds3& RayScene::bounds() const { return impl_->bounds; }
 double RayScene::surface_offset() const { return impl_->offset; }
 
-bool RayScene::occluded(const Vec3& origin, const Vec3& direction, double length) const {
-  std::uint8_t hit = 0;
-  occluded(1, &origin, &direction, &length, &hit);
-  return hit != 0;
-}
-
 namespace {
 
 // Fills lanes of an 8-wide ray packet from segments start.. (at most 8), repeating the last

@@ -21,13 +21,10 @@ class RayScene {
   RayScene& operator=(RayScene&&) noexcept;
   ~RayScene();
 
-  // True when a blocker triangle (either side) lies on the segment origin + t·direction,
-  // t ∈ [surface_offset() / |direction|, length]. direction need not be unit; length is in
-  // units of |direction|.
-  bool occluded(const Vec3& origin, const Vec3& direction, double length) const;
-
-  // Answers `count` segments at once (faster than one at a time). Writes 1 for an occluded
-  // segment into hit[i], 0 otherwise.
+  // Whether a blocker triangle (either side) lies on each segment origin + t·direction,
+  // t ∈ [surface_offset() / |direction|, length] (direction need not be unit; length is in
+  // units of |direction|), for `count` segments at once: 1 for an occluded segment in hit[i],
+  // 0 otherwise.
   void occluded(int count, const Vec3* origins, const Vec3* directions, const double* lengths,
                 std::uint8_t* hit) const;
 

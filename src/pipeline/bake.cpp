@@ -1,5 +1,6 @@
-// The bake pipeline: scene → meshes → ray scene and lights → texel space per receiver →
-// method → dilation. Methods are chosen by name (methods.cpp lists them).
+// The bake pipeline: scene → meshes → what the method needs (ray scene, clusters, shafts) and
+// lights → texel space per receiver → method → dilation. Methods come from the registry
+// (methods/registry.cpp) and are called through their interface (methods/method.h).
 #include "pipeline/bake.h"
 
 #include <fmt/format.h>
@@ -12,18 +13,16 @@
 #include <optional>
 #include <thread>
 
-#include "methods/baselines.h"
-#include "occluders/clusters.h"
-#include "methods/convolution/convolution_bake.h"
 #include "methods/convolution/fft_convolution.h"
-#include "scene/lights.h"
-#include "pipeline/memory_budget.h"
-#include "scene/mesh.h"
-#include "occluders/ray_scene.h"
-#include "methods/reference_bake.h"
-#include "occluders/shaft_culling.h"
-#include "texels/texel_space.h"
 #include "methods/convolution/traced_convolution.h"
+#include "methods/method.h"
+#include "occluders/clusters.h"
+#include "occluders/ray_scene.h"
+#include "occluders/shaft_culling.h"
+#include "pipeline/memory_budget.h"
+#include "scene/lights.h"
+#include "scene/mesh.h"
+#include "texels/texel_space.h"
 
 namespace sb {
 
@@ -68,20 +67,43 @@ std::unique_ptr<tbb::global_control> limit_threads(const BakeOptions& options) {
                                                std::size_t(options.threads));
 }
 
+// The [bake] keys every bake reads, whatever its method.
+bool read_by_every_method(const std::string& key) {
+  for (const char* k : {"resolution", "method", "quantity", "margin", "max_memory"})
+    if (key == k) return true;
+  return false;
+}
+
+// "file:line: [bake] key: method 'm' does not use it (...)" for each key the scene sets that the
+// chosen method does not read, naming the methods that do.
+void report_ignored_settings(const Scene& scene, const MethodEntry& method,
+                             std::vector<std::string>* warnings) {
+  for (const SettingGiven& given : scene.bake_keys) {
+    if (read_by_every_method(given.key)) continue;
+    if (std::find(method.settings.begin(), method.settings.end(), given.key) !=
+        method.settings.end())
+      continue;
+    std::string users;
+    for (const MethodEntry& other : method_registry())
+      if (std::find(other.settings.begin(), other.settings.end(), given.key) !=
+          other.settings.end())
+        users += (users.empty() ? "" : ", ") + other.name;
+    warnings->push_back(fmt::format("{}:{}: [bake] {}: method '{}' does not use it (read by {})",
+                                    scene.file.string(), given.line, given.key, method.name,
+                                    users));
+  }
+}
+
 }  // namespace
 
 Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
-  const auto& methods = known_methods();
-  if (std::find(methods.begin(), methods.end(), scene.bake.method) == methods.end()) {
+  const MethodEntry* entry = find_method(scene.bake.method);
+  if (!entry) {
     std::string known;
-    for (const auto& m : methods) known += (known.empty() ? "" : ", ") + m;
+    for (const auto& m : known_methods()) known += (known.empty() ? "" : ", ") + m;
     return scene_error(scene.file.string() + ": [bake]: unknown method '" + scene.bake.method +
                        "' (known: " + known + ")");
   }
-  if (scene.bake.method == "convolution" && !scene.bake.convolve && !scene.bake.trace)
-    return scene_error(scene.file.string() +
-                       ": [bake]: convolve = false needs trace = true (with neither, nothing "
-                       "would compute the shadows)");
   const std::vector<MemoryItem> estimate = bake_memory_estimate(scene);
   if (Status fits = check_memory(scene, estimate, memory_budget(scene.bake),
                                  "lower 'resolution' (--resolution) or raise max_memory "
@@ -89,34 +111,26 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
       !fits)
     return fits.error();
   const auto thread_limit = limit_threads(options);
-  FftConvolver::shared().set_threads(options.threads > 0
-                                         ? options.threads
-                                         : int(std::max(1u, std::thread::hardware_concurrency())));
 
   BakeResult result;
+  report_ignored_settings(scene, *entry, &result.warnings);
   const auto load_start = std::chrono::steady_clock::now();
   auto loaded = load_meshes(scene, &result.warnings);
   if (!loaded) return loaded.error();
   const std::vector<Mesh>& meshes = *loaded;
   const std::vector<const Mesh*> blockers = blocker_meshes(scene, meshes);
-  // The methods that cast rays: the reference and accumulation for their shadows, erosion for
-  // its hard shadow and blocker distances. The convolution and the shadow-map filters do not.
-  const std::string& method = scene.bake.method;
-  const bool ray_traced = method == "reference" || method == "accumulation" ||
-                          method == "erosion" || (method == "convolution" && scene.bake.trace);
+  // What the method asks for, built once and shared by every receiver.
+  const MethodNeeds needs = entry->needs(scene.bake);
   std::optional<RayScene> rays;
-  if (ray_traced) {
+  if (needs.rays) {
     auto built = RayScene::build(blockers);
     if (!built) return built.error();
     rays.emplace(std::move(*built));
   }
-  // The convolution's cluster hierarchy (clusters.h), over the blockers in this order.
   ClusterTree clusters;
-  std::optional<ShaftCuller> culler;
-  if (method == "convolution") {
-    if (scene.bake.convolve || !scene.bake.trace) clusters = build_clusters(blockers);
-    culler.emplace(blockers);
-  }
+  if (needs.clusters) clusters = build_clusters(blockers);
+  std::optional<ShaftCuller> shafts;
+  if (needs.shafts) shafts.emplace(blockers);
   auto lights_or = make_lights(scene.lights, scene.file);
   if (!lights_or) return lights_or.error();
   const std::vector<Light>& lights = *lights_or;
@@ -177,10 +191,26 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   }
 
   std::atomic<std::int64_t> texels_done{0};
-  ProgressFn progress;
+  BakeContext context;
+  context.scene = &scene;
+  context.lights = &lights;
+  context.blockers = blockers;
+  context.rays = rays ? &*rays : nullptr;
+  context.clusters = needs.clusters ? &clusters : nullptr;
+  context.shafts = shafts ? &*shafts : nullptr;
+  context.threads = options.threads > 0
+                        ? options.threads
+                        : int(std::max(1u, std::thread::hardware_concurrency()));
+  // What the budget leaves the method's images, beyond what the estimate above counted.
+  context.memory_for_images = double(memory_budget(scene.bake)) - total_bytes(estimate);
+  context.keep_per_light = options.keep_per_light;
+  context.texels_done = &texels_done;
   if (options.progress && total_texels > 0) {
-    progress = [&](double done) { options.progress(done / double(total_texels)); };
+    context.progress = [&](double done) { options.progress(done / double(total_texels)); };
   }
+  auto method = entry->make(context);
+  if (!method) return method.error();
+
   for (std::size_t r = 0; r < receivers.size(); ++r) {
     const auto start = std::chrono::steady_clock::now();
     const ObjectDesc& obj = scene.objects[receivers[r]];
@@ -188,83 +218,23 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     out.seconds_texels = raster_seconds[r];
     out.name = obj.name;
     out.uv_channel = obj.uv_channel;
-    if (method != "convolution" && method != "reference") {
-      BaselineInputs in;
-      in.lights = &lights;
-      in.rays = rays ? &*rays : nullptr;
-      in.blockers = blockers;
-      in.receiver = &meshes[receivers[r]];
-      in.settings = &scene.bake;
-      in.stream = receivers[r];
-      if (method == "accumulation") {
-        out.image = bake_accumulation(spaces[r], in, &out.stats, &result.shadow_rays);
-      } else if (method == "erosion") {
-        out.image = bake_erosion(spaces[r], in, &out.stats, &result.shadow_rays);
-      } else {
-        out.image = bake_shadow_map_filter(spaces[r], in, &out.stats);
-      }
-      texels_done += std::int64_t(spaces[r].texels.size());
-      if (progress) progress(double(texels_done.load()));
-    } else if (method == "reference") {
-      ReferenceInputs in;
-      in.lights = &lights;
-      in.rays = &*rays;
-      in.quantity = scene.bake.quantity;
-      in.samples = scene.bake.samples;
-      in.seed = scene.bake.seed;
-      in.stream = receivers[r];
-      in.texels_done = &texels_done;
-      in.progress = progress;
-      out.image = bake_reference(spaces[r], in, &result.shadow_rays);
-    } else {
-      ConvolutionInputs in;
-      in.lights = &lights;
-      in.receiver = &meshes[receivers[r]];
-      in.blockers = blockers;
-      in.clusters = &clusters;
-      in.quantity = scene.bake.quantity;
-      in.error_texels = scene.bake.error_texels;
-      in.max_image = scene.bake.max_image;
-      in.max_triples = scene.bake.max_triples;
-      in.light_parts = scene.bake.light_parts;
-      in.combine =
-          scene.bake.blocker_combine == "sum" ? BlockerCombine::sum : BlockerCombine::product;
-      in.weighted = scene.bake.weighting == "irradiance";
-      // What the budget leaves the leaves' images, beyond what the estimate above counted.
-      in.memory_for_images = double(memory_budget(scene.bake)) - total_bytes(estimate);
-      TracedConvolutionInputs traced;
-      traced.convolution = in;
-      traced.culler = &*culler;
-      traced.rays = rays ? &*rays : nullptr;
-      traced.convolve = scene.bake.convolve;
-      traced.samples = scene.bake.samples;
-      traced.trace_error_texels = scene.bake.trace_error_texels;
-      traced.seed = scene.bake.seed;
-      traced.stream = receivers[r];
-      ConvolutionPlan plan;
-      TracedConvolutionStats stats;
-      auto image = bake_traced_convolution(spaces[r], traced, &out.pairs, &plan, &stats);
-      if (!image) {
-        return scene_error(scene.file.string() + ":" + std::to_string(obj.line) + ": " +
-                           image.error().message);
-      }
-      out.image = std::move(*image);
-      result.shadow_rays += stats.rays;
-      const double pairs = std::max<double>(1.0, double(stats.pairs));
-      out.stats.emplace_back("clear_fraction", double(stats.clear) / pairs);
-      out.stats.emplace_back("convolved_fraction", double(stats.convolved) / pairs);
-      out.stats.emplace_back("traced_fraction", double(stats.traced) / pairs);
-      out.stats.emplace_back(
-          "rays_per_texel",
-          double(stats.rays) / std::max<double>(1.0, double(spaces[r].texels.size())));
-      out.plan = describe_plan(plan);
-      for (const auto& w : plan.warnings) result.warnings.push_back(scene.file.string() + ": " + w);
-      texels_done += std::int64_t(spaces[r].texels.size());
-      if (progress) progress(double(texels_done.load()));
-    }
+    ReceiverInput input;
+    input.space = &spaces[r];
+    input.mesh = &meshes[receivers[r]];
+    input.object = &obj;
+    input.stream = receivers[r];
+    auto baked = (*method)->bake(input);
+    if (!baked) return baked.error();
+    out.image = std::move(baked->images.image);
+    out.per_light = std::move(baked->images.per_light);
+    out.report = std::move(baked->report);
+    result.shadow_rays += baked->rays;
+    for (std::string& w : out.report.warnings) result.warnings.push_back(std::move(w));
+    out.report.warnings.clear();
     out.seconds_method = seconds_since(start);
     const auto dilate_start = std::chrono::steady_clock::now();
     dilate(out.image, spaces[r].covered, scene.bake.margin);
+    for (Image& image : out.per_light) dilate(image, spaces[r].covered, scene.bake.margin);
     out.seconds_dilate = seconds_since(dilate_start);
     out.covered_texels = std::int64_t(spaces[r].texels.size());
     out.uv = layouts[r];
@@ -286,25 +256,21 @@ Expected<std::vector<std::string>> plan(const Scene& scene, const BakeOptions& o
   auto loaded = load_meshes(scene, nullptr);
   if (!loaded) return loaded.error();
   const std::vector<Mesh>& meshes = *loaded;
-  const std::vector<const Mesh*> blockers = blocker_meshes(scene, meshes);
-  const ClusterTree clusters = build_clusters(blockers);
+  const ClusterTree clusters = build_clusters(blocker_meshes(scene, meshes));
   auto lights = make_lights(scene.lights, scene.file);
   if (!lights) return lights.error();
+  BakeContext context;
+  context.scene = &scene;
+  context.lights = &*lights;
+  context.blockers = blocker_meshes(scene, meshes);
+  context.clusters = &clusters;
+  const FftConvolver fft;
   std::vector<std::string> out;
   for (std::size_t i = 0; i < meshes.size(); ++i) {
     if (!scene.objects[i].receiver) continue;
     const TexelSpace space =
         rasterise_texels(meshes[i], scene.bake.resolution, scene.bake.resolution);
-    PlanInputs in;
-    in.lights = &*lights;
-    in.receiver = &meshes[i];
-    in.blockers = blockers;
-    in.clusters = &clusters;
-    in.error_texels = scene.bake.error_texels;
-    in.max_image = scene.bake.max_image;
-    in.max_triples = scene.bake.max_triples;
-    in.light_parts = scene.bake.light_parts;
-    out.push_back(describe_plan(plan_convolution(space, in)));
+    out.push_back(describe_plan(plan_convolution(space, plan_inputs(context, &meshes[i], &fft))));
   }
   return out;
 }

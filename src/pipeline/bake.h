@@ -10,43 +10,17 @@
 
 #include "core/error.h"
 #include "core/image.h"
+#include "methods/method.h"
 #include "scene/scene.h"
 #include "texels/uv_checks.h"
 
 namespace sb {
 
-// Called from worker threads with the fraction of the bake done, in [0, 1]; must be
-// thread-safe and cheap.
-using ProgressFn = std::function<void(double fraction)>;
-
 struct BakeOptions {
-  int threads = 0;      // 0: all cores
-  ProgressFn progress;  // may be empty
-};
-
-// What the convolution method decided and measured for one (light, receiver) pair: printed by
-// `--explain` and written to the manifest.
-struct PairReport {
-  std::string light, receiver;
-  std::string part;            // "" for one frustum; "+x" ... "-z" for cube faces
-  double axis[3] = {0, 0, 0};  // D
-  double blocker_depth_lo = 0, blocker_depth_hi = 0;    // along D, metres (0, 0: no blockers)
-  double receiver_depth_lo = 0, receiver_depth_hi = 0;  // along D, metres
-  double blocker_plane = 0, receiver_plane = 0;         // d*, r*, metres (source plane at 0)
-  double rho_lo = 1, rho_hi = 1, rho = 1;
-  double light_extent = 0;                  // L, metres
-  double penumbra_error = 0;                // ε, metres on the receiver
-  double penumbra_error_texels = 0;         // ε in receiver texels
-  double pixel = 0;                         // blocker-image pixel, tangent units
-  int image_width = 0, image_height = 0;    // blocker image, pixels
-  int kernel_width = 0, kernel_height = 0;  // source kernel, pixels (odd)
-  int fft_width = 0, fft_height = 0;        // transform size
-  int convolutions = 0;                     // FFT convolutions done (3 per coloured leaf)
-  int triples = 0;                          // leaf triples convolved
-  std::int64_t lit_texels = 0;              // texels this light reaches (H0 > 0)
-  std::int64_t outside_texels = 0;          // lit texels at or behind the light's plane across D
-  double seconds_configure = 0, seconds_source = 0, seconds_blocker = 0, seconds_fft = 0,
-         seconds_lookup = 0;
+  int threads = 0;  // 0: all cores
+  // Called from worker threads with the fraction of the bake done, in [0, 1]; may be empty.
+  ProgressFn progress;
+  bool keep_per_light = false;  // ReceiverBake::per_light wanted
 };
 
 struct ReceiverBake {
@@ -58,11 +32,12 @@ struct ReceiverBake {
   UvLayoutReport uv;   // the lightmap UV layout's checks
   double seconds = 0;  // texel space + method + dilation, this receiver only
   double seconds_texels = 0, seconds_method = 0, seconds_dilate = 0;  // its parts
-  std::vector<PairReport> pairs;  // per (light part, frustum), for the convolution method
-  std::string plan;               // the convolution's triples as text (describe_plan)
-  // Named figures of the method for this receiver (baselines.h), e.g. adaptive PCF's fraction
-  // of texels that took the full filter.
-  std::vector<std::pair<std::string, double>> stats;
+  // Per light, in scene order, when BakeOptions::keep_per_light: its own V (or H0·V), dilated
+  // like the image.
+  std::vector<Image> per_light;
+  // What the method reports beyond its values: named figures, its own manifest entries and
+  // what --explain prints (its warnings are in BakeResult::warnings).
+  MethodReport report;
 };
 
 struct BakeResult {

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "methods/method.h"
 #include "texels/texel_space.h"
 
 namespace sb {
@@ -20,14 +21,6 @@ constexpr double kResultBytesPerTexel = 3 * 4 + 1;
 // Writing one receiver: the preview's tone-mapped copy (RGB float), its 8-bit bytes and the
 // coverage mask as float and bytes (outputs.cpp, image_io.cpp).
 constexpr double kWriteBytesPerTexel = 3 * 4 + 3 + 4 + 1;
-// The convolution's arrays per receiver texel: the planner's frames (add_frames: tangents,
-// depths, groups and indices of a light part's whole and halves at once; heaptrack measured 755 MB
-// at peak for the 4.2 M texels of a floor at 2048², 180 B per texel), and while a frame is
-// convolved its occlusion, largest, Euler's counts and weight gradient (about 90 B, of frames'
-// texels that are the receiver's); and per light part the texel's V (12) and whether it is
-// reached (1).
-constexpr double kConvolutionBytesPerTexel = 180 + 90;
-constexpr double kConvolutionBytesPerTexelAndLightPart = 12 + 1;
 
 }  // namespace
 
@@ -50,18 +43,9 @@ std::vector<MemoryItem> bake_memory_estimate(const Scene& scene) {
   items.push_back({"texel space", texels * kRasterBytesPerTexel});
   items.push_back({"lightmaps", texels * kResultBytesPerTexel * receivers});
   items.push_back({"writing", texels * kWriteBytesPerTexel});
-  const double lights = double(scene.lights.size());
-  if (b.method == "convolution") {
-    // Parts of a light: at least light_parts; a sphere light's receiver may be seen through up to
-    // six cube faces, each a frame of its own.
-    const double parts = lights * std::max(b.light_parts, 1);
-    items.push_back(
-        {"convolution texel arrays",
-         texels * (kConvolutionBytesPerTexel + kConvolutionBytesPerTexelAndLightPart * parts)});
-  } else if (b.method != "reference" && b.method != "accumulation") {
-    // Shadow-map baselines: a depth map (float) per light and cube face at shadow_map².
-    const double map = double(b.shadow_map) * double(b.shadow_map) * 4;
-    items.push_back({"shadow maps", map * lights * 6});
+  // The method's own arrays and maps (its registry entry says what they are).
+  if (const MethodEntry* method = find_method(b.method); method && method->memory) {
+    for (MemoryItem& item : method->memory(scene)) items.push_back(std::move(item));
   }
   return items;
 }

@@ -15,11 +15,6 @@
 
 namespace sb {
 
-struct MemoryItem {
-  std::string what;  // "texel space", "lightmaps", ...
-  double bytes = 0;
-};
-
 double total_bytes(const std::vector<MemoryItem>& items);
 
 // The bake's memory that depends on its settings, not its meshes: texel space of the largest

@@ -156,45 +156,13 @@ Status write_outputs(OutputFolder& folder, const Scene& scene, const BakeSetting
           {"margin", r.uv.margin}}},
         {"seconds", r.seconds},
     });
-    if (!r.stats.empty()) {
+    if (!r.report.stats.empty()) {
       auto& stats = manifest["receivers"].back()["method_stats"];
       stats = nlohmann::ordered_json::object();
-      for (const auto& [key, value] : r.stats) stats[key] = value;
+      for (const auto& [key, value] : r.report.stats) stats[key] = value;
     }
-    if (!r.pairs.empty()) {
-      auto& entry = manifest["receivers"].back();
-      double worst = 0, worst_texels = 0;
-      for (const auto& p : r.pairs) {
-        worst = std::max(worst, p.penumbra_error);
-        worst_texels = std::max(worst_texels, p.penumbra_error_texels);
-      }
-      entry["penumbra_error"] = {{"metres", worst}, {"texels", worst_texels}};
-      entry["lights"] = nlohmann::ordered_json::array();
-      for (const auto& p : r.pairs) {
-        entry["lights"].push_back({
-            {"light", p.light},
-            {"frustum", p.part.empty() ? "central" : p.part},
-            {"direction", {p.axis[0], p.axis[1], p.axis[2]}},
-            {"blocker_plane", p.blocker_plane},
-            {"receiver_plane", p.receiver_plane},
-            {"blocker_depths", {p.blocker_depth_lo, p.blocker_depth_hi}},
-            {"receiver_depths", {p.receiver_depth_lo, p.receiver_depth_hi}},
-            {"rho", {p.rho_lo, p.rho, p.rho_hi}},
-            {"penumbra_error", {{"metres", p.penumbra_error}, {"texels", p.penumbra_error_texels}}},
-            {"blocker_image", {p.image_width, p.image_height}},
-            {"kernel", {p.kernel_width, p.kernel_height}},
-            {"fft", {p.fft_width, p.fft_height}},
-            {"lit_texels", p.lit_texels},
-            {"unprojected_texels", p.outside_texels},
-            {"seconds",
-             {{"configure", p.seconds_configure},
-              {"source", p.seconds_source},
-              {"blocker", p.seconds_blocker},
-              {"fft", p.seconds_fft},
-              {"lookup", p.seconds_lookup}}},
-        });
-      }
-    }
+    for (const auto& [key, value] : r.report.manifest.items())
+      manifest["receivers"].back()[key] = value;
   }
   manifest["warnings"] = result.warnings;
   manifest["load_seconds"] = result.load_seconds;

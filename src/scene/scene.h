@@ -15,6 +15,19 @@ namespace sb {
 
 enum class Quantity { visibility, irradiance };
 
+// How the occluded fractions O_i of different blocker clusters over one texel combine
+// (design-notes §5): `product` takes V = ∏(1 − O_i), clusters hiding independent parts of the
+// light; `sum` takes V = 1 − Σ O_i, clusters hiding disjoint parts. docs/methods.md has the
+// measurement that chose the default.
+enum class BlockerCombine { product, sum };
+
+// What the convolution's V averages the light's points by: `irradiance` (cos·cos/r², to first
+// order across the light, as the reference) or `emission` (V_u, exact for parallel planes).
+enum class ConvolutionWeighting { irradiance, emission };
+
+// How erosion turns the distance to a hard-shadow edge into a shadow factor.
+enum class ErosionFactor { pcf, distance };
+
 // Names of the methods this build knows, in the order docs/methods.md lists them.
 const std::vector<std::string>& known_methods();
 
@@ -42,16 +55,13 @@ struct BakeSettings {
   // against this (docs/performance.md)
   bool convolve = true;
   double trace_error_texels = 1.0;
-  std::string blocker_combine = "sum";  // how blocker clusters combine: "product" or "sum"
-  // What the convolution's V averages the light's points by: "irradiance" (cos·cos/r², to first
-  // order across the light, as the reference) or "emission" (V_u, exact for parallel planes)
-  std::string weighting = "irradiance";
+  BlockerCombine blocker_combine = BlockerCombine::sum;
+  ConvolutionWeighting weighting = ConvolutionWeighting::irradiance;
   // shadow-map baselines (pcf, pcss, adaptive-pcf, chun-oh, erosion): the shadow map's side in
-  // pixels, PCF's fixed filter radius in shadow-map pixels, and how erosion turns the distance
-  // to a hard-shadow edge into a shadow factor ("pcf" or "distance")
+  // pixels, PCF's fixed filter radius in shadow-map pixels, and erosion's shadow factor
   int shadow_map = 2048;
   double pcf_radius = 2.0;
-  std::string erosion_factor = "pcf";
+  ErosionFactor erosion_factor = ErosionFactor::pcf;
 };
 
 struct ObjectDesc {
@@ -84,9 +94,17 @@ struct LightDesc {
   int line = 0;
 };
 
+// A [bake] key the scene file sets, and its line: keys the chosen method does not read are
+// reported as ignored (pipeline/bake.cpp).
+struct SettingGiven {
+  std::string key;
+  int line = 0;
+};
+
 struct Scene {
   std::filesystem::path file;  // the scene file, as given
   BakeSettings bake;
+  std::vector<SettingGiven> bake_keys;  // in file order
   std::vector<ObjectDesc> objects;
   std::vector<LightDesc> lights;
 };

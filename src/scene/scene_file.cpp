@@ -347,14 +347,15 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
   if (auto v = r.integer("max_image", 64, 16384)) bake.max_image = static_cast<int>(*v);
   if (auto v = r.string("blocker_combine")) {
     if (*v == "product" || *v == "sum") {
-      bake.blocker_combine = *v;
+      bake.blocker_combine = *v == "sum" ? BlockerCombine::sum : BlockerCombine::product;
     } else {
       r.fail_got("blocker_combine", "\"product\" or \"sum\"");
     }
   }
   if (auto v = r.string("weighting")) {
     if (*v == "irradiance" || *v == "emission") {
-      bake.weighting = *v;
+      bake.weighting =
+          *v == "irradiance" ? ConvolutionWeighting::irradiance : ConvolutionWeighting::emission;
     } else {
       r.fail_got("weighting", "\"irradiance\" or \"emission\"");
     }
@@ -374,7 +375,7 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
   }
   if (auto v = r.string("erosion_factor")) {
     if (*v == "pcf" || *v == "distance") {
-      bake.erosion_factor = *v;
+      bake.erosion_factor = *v == "pcf" ? ErosionFactor::pcf : ErosionFactor::distance;
     } else {
       r.fail_got("erosion_factor", "\"pcf\" or \"distance\"");
     }
@@ -686,6 +687,11 @@ Expected<Scene> load_scene(const std::filesystem::path& file) {
       Expected<BakeSettings> settings = read_bake(file, *bake);
       if (!settings) return settings.error();
       scene.bake = *settings;
+      for (const auto& [name, value] : *bake)
+        scene.bake_keys.push_back({std::string(name.str()), int(name.source().begin.line)});
+      // toml++ keeps a table's keys sorted by name; the scene's readers want them as written.
+      std::stable_sort(scene.bake_keys.begin(), scene.bake_keys.end(),
+                       [](const SettingGiven& a, const SettingGiven& b) { return a.line < b.line; });
     } else {
       auto tables = tables_of(file, key, node);
       if (!tables) return tables.error();

@@ -13,6 +13,7 @@
 #include <memory>
 #include <string>
 
+#include "methods/convolution/pair_report.h"
 #include "pipeline/bake.h"
 #include "pipeline/outputs.h"
 
@@ -39,7 +40,7 @@ void BM_ConvolutionBake(benchmark::State& state) {
       return;
     }
     const ReceiverBake& r = result->receivers[0];
-    const PairReport& p = r.pairs[0];
+    const PairReport& p = convolution_pairs(r.report.details)[0];
     texels += r.seconds_texels;
     dilate += r.seconds_dilate;
     configure += p.seconds_configure;
@@ -67,12 +68,12 @@ BENCHMARK(BM_ConvolutionBake)->Arg(512)->Arg(2048)->Unit(benchmark::kMillisecond
 void BM_BareFftOfBake(benchmark::State& state) {
   const Scene scene = parallel_scene(int(state.range(0)), "convolution", 1);
   auto result = bake(scene);
-  if (!result || result->receivers[0].pairs.empty()) {
+  if (!result || convolution_pairs(result->receivers[0].report.details).empty()) {
     state.SkipWithError("bake failed");
     return;
   }
-  const int w = result->receivers[0].pairs[0].fft_width;
-  const int h = result->receivers[0].pairs[0].fft_height;
+  const int w = convolution_pairs(result->receivers[0].report.details)[0].fft_width;
+  const int h = convolution_pairs(result->receivers[0].report.details)[0].fft_height;
   const auto free = [](void* p) { fftwf_free(p); };
   std::unique_ptr<float, decltype(free)> real(fftwf_alloc_real(std::size_t(w) * h), free);
   std::unique_ptr<fftwf_complex, decltype(free)> spectrum(

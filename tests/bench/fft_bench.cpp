@@ -47,7 +47,7 @@ const RoundTripPlans& round_trip_plans(int n, unsigned flags) {
   static std::map<std::pair<int, unsigned>, RoundTripPlans> cache;
   auto found = cache.find({n, flags});
   if (found != cache.end()) return found->second;
-  FftConvolver::shared();  // runs fftwf_init_threads() before this first planner call
+  FftConvolver init;  // runs fftwf_init_threads() before this first planner call
   fftwf_plan_with_nthreads(default_threads());  // as many threads as the convolver's default
   const std::size_t reals = std::size_t(n) * std::size_t(n);
   const std::size_t complexes = std::size_t(n) * std::size_t(n / 2 + 1);
@@ -89,11 +89,11 @@ void round_trip(benchmark::State& state, unsigned flags) {
 void BM_BareFftRoundTrip(benchmark::State& state) { round_trip(state, FFTW_ESTIMATE); }
 void BM_BareFftRoundTripMeasure(benchmark::State& state) { round_trip(state, FFTW_MEASURE); }
 
-// FftConvolver::shared().convolve of an n × n image in an n × n transform with a 65 × 65
+// FftConvolver::convolve of an n × n image in an n × n transform with a 65 × 65
 // kernel whose spectrum is cached (made before the timing loop, as a bake reuses one per light).
 void BM_Convolve(benchmark::State& state) {
   const int n = int(state.range(0)), kernel_size = 65;
-  FftConvolver& convolver = FftConvolver::shared();
+  FftConvolver convolver;
   const std::vector<float> kernel =
       random_values(std::size_t(kernel_size) * std::size_t(kernel_size), 2);
   const auto spectrum = convolver.kernel_spectrum(kernel, kernel_size, kernel_size, n, n);

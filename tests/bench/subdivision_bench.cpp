@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <string>
 
+#include "methods/convolution/pair_report.h"
 #include "pipeline/bake.h"
 
 namespace sb {
@@ -40,7 +41,7 @@ void BM_SubdivisionBake(benchmark::State& state) {
     }
     triples = 0;
     for (const ReceiverBake& r : result->receivers) {
-      for (const PairReport& p : r.pairs) {
+      for (const PairReport& p : convolution_pairs(r.report.details)) {
         triples += p.triples;
         worst = std::max(worst, p.penumbra_error_texels);
       }

@@ -169,7 +169,7 @@ TEST(AccumulationBake, ShowcaseSphereLightAgreesWithReference) {
   for (const auto& r : acc.receivers) {
     for (float v : r.image.pixels) ASSERT_TRUE(v >= 0.0f && v <= 1.0f);
     double facing = 0;
-    for (const auto& [name, value] : r.stats)
+    for (const auto& [name, value] : r.report.stats)
       if (name == "mean points facing a texel") facing = value;
     // Two lights: the panel's points all face the floor's texels, half the sphere's do.
     EXPECT_GT(facing, 0.25 * n) << r.name;

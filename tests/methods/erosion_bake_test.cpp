@@ -30,7 +30,7 @@ BakeResult bake_or_fail(const Scene& scene) {
 }
 
 double stat(const ReceiverBake& r, const std::string& name) {
-  for (const auto& [key, value] : r.stats)
+  for (const auto& [key, value] : r.report.stats)
     if (key == name) return value;
   ADD_FAILURE() << "no stat " << name;
   return 0;
@@ -83,7 +83,7 @@ TEST(RayScene, FirstHitDistance) {
   EXPECT_NEAR(rays->first_hit(Vec3(0.1, 0, 0), Vec3(0, 0, 1), 1.5), 0.5, 1e-6);
   EXPECT_LT(rays->first_hit(Vec3(0.5, 0, 0), Vec3(0, 0, 1.5), 1.0), 0.0);   // beside it
   EXPECT_LT(rays->first_hit(Vec3(0.1, 0, 0), Vec3(0, 0, 1.5), 0.25), 0.0);  // stops short
-  // Batched answers agree with occluded() on a fan of segments.
+  // Batched first hits agree with batched occlusion on a fan of segments.
   std::vector<Vec3> origins, directions;
   std::vector<double> lengths;
   for (int i = 0; i < 21; ++i) {
@@ -155,9 +155,9 @@ TEST(ErosionBake, BothShadowFactorsNearReference) {
   ref_scene.bake.samples = 1024;
   const BakeResult reference = bake_or_fail(ref_scene);
   Scene scene = load("parallel", 256, "erosion");
-  scene.bake.erosion_factor = "pcf";
+  scene.bake.erosion_factor = ErosionFactor::pcf;
   const BakeResult pcf = bake_or_fail(scene);
-  scene.bake.erosion_factor = "distance";
+  scene.bake.erosion_factor = ErosionFactor::distance;
   const BakeResult distance = bake_or_fail(scene);
   const Errors e_pcf = errors(pcf, reference), e_distance = errors(distance, reference);
   std::printf("parallel 256²: pcf RMSE %.4f max %.4f; distance RMSE %.4f max %.4f\n", e_pcf.rmse,
@@ -198,7 +198,7 @@ DirectBake bake_direct(const Scene& scene, const ErosionOptions& options) {
   const TexelSpace space =
       rasterise_texels(*receiver, scene.bake.resolution, scene.bake.resolution);
   DirectBake out;
-  out.image = bake_erosion(space, in, options, nullptr, nullptr);
+  out.image = bake_erosion(space, in, options, nullptr, nullptr).image;
   out.covered = space.covered;
   return out;
 }
@@ -217,7 +217,7 @@ TEST(ErosionBake, LineFitRemovesStaircaseOnSlantedEdge) {
   const int res = 128;
   const double angle = 30.0 * 3.14159265358979 / 180.0;
   Scene scene = load("parallel", res, "erosion");
-  scene.bake.erosion_factor = "distance";
+  scene.bake.erosion_factor = ErosionFactor::distance;
   object(scene, "blocker").transform = Affine3(Eigen::AngleAxisd(angle, Vec3::UnitZ()));
   ErosionOptions fit, no_fit;
   no_fit.line_distance = false;
@@ -276,13 +276,14 @@ TEST(ErosionBake, ShowcaseNearReference) {
     s.bake.samples = 256;
     return bake_or_fail(s);
   }();
-  for (const char* factor : {"pcf", "distance"}) {
+  for (const auto& [factor, name] :
+       {std::pair{ErosionFactor::pcf, "pcf"}, std::pair{ErosionFactor::distance, "distance"}}) {
     Scene scene = load("showcase", 64, "erosion");
     scene.bake.erosion_factor = factor;
     const BakeResult result = bake_or_fail(scene);
     const Errors e = errors(result, ref);
-    std::printf("showcase 64², %s: RMSE %.4f, max %.4f\n", factor, e.rmse, e.max);
-    EXPECT_LE(e.rmse, 0.05) << factor;
+    std::printf("showcase 64², %s: RMSE %.4f, max %.4f\n", name, e.rmse, e.max);
+    EXPECT_LE(e.rmse, 0.05) << name;
     for (const auto& r : result.receivers)
       for (float v : r.image.pixels) ASSERT_TRUE(v >= 0.0f && v <= 1.0f) << r.name;
   }

@@ -74,7 +74,7 @@ Image run(const TexelSpace& s, const std::vector<Light>& lights, const RayScene&
   in.quantity = q;
   in.samples = samples;
   in.seed = 11;
-  return bake_reference(s, in, nullptr);
+  return bake_reference(s, in, nullptr).image;
 }
 
 TEST(Reference, UnoccludedFloorIsFullyVisibleAndExact) {

@@ -28,7 +28,7 @@ using test_scenes::object;
 Image bake_first(const Scene& scene, MethodStats* stats = nullptr) {
   auto result = bake(scene);
   EXPECT_TRUE(result) << result.error().message;
-  if (stats) *stats = result->receivers[0].stats;
+  if (stats) *stats = result->receivers[0].report.stats;
   return result->receivers[0].image;
 }
 
@@ -317,10 +317,10 @@ TEST(AdaptivePcf, EqualsTheFullSetWhereItTakesItAndSkipsItMostly) {
   Scene scene = load("parallel", 128, "adaptive-pcf");
   auto p = prepare(scene, "floor");
   MethodStats stats;
-  const Image adaptive = bake_shadow_map_filter(p->space, p->in, &stats, ShadowFilterOptions{});
+  const Image adaptive = bake_shadow_map_filter(p->space, p->in, &stats, ShadowFilterOptions{}).image;
   ShadowFilterOptions full_options;
   full_options.adaptive_always_full = true;
-  const Image full = bake_shadow_map_filter(p->space, p->in, nullptr, full_options);
+  const Image full = bake_shadow_map_filter(p->space, p->in, nullptr, full_options).image;
   int settled = 0, missed = 0, filtered = 0;
   double settled_error = 0;
   for (std::size_t i = 0; i < adaptive.pixels.size(); i += 3) {
@@ -448,7 +448,7 @@ TEST(ShadowMap, CurvedReceiverDoesNotShadowItself) {
   for (const char* method : {"pcf", "pcss", "adaptive-pcf", "chun-oh"}) {
     scene.bake.method = method;
     auto p = prepare(scene, "sphere");
-    const Image img = bake_shadow_map_filter(p->space, p->in, nullptr);
+    const Image img = bake_shadow_map_filter(p->space, p->in, nullptr).image;
     int facing = 0, dark = 0;
     for (const Texel& t : p->space.texels) {
       const Vec3 to_light = (p->lights[0].centre() - t.position.cast<double>()).normalized();

@@ -68,5 +68,33 @@ TEST(Bake, UnknownMethodIsAnError) {
   EXPECT_NE(result.error().message.find("scene.toml"), std::string::npos);
 }
 
+// A [bake] key the chosen method does not read is reported with its line and the methods that
+// read it; keys every bake reads and keys the method reads are not.
+TEST(Bake, ReportsSettingsTheMethodIgnores) {
+  Scene scene = parallel_scene(16, 16);
+  scene.bake.method = "pcf";
+  scene.bake_keys = {{"samples", 7}, {"resolution", 5}, {"shadow_map", 9}};
+  auto result = bake(scene);
+  ASSERT_TRUE(result) << result.error().message;
+  std::vector<std::string> ignored;
+  for (const auto& w : result->warnings)
+    if (w.find("does not use it") != std::string::npos) ignored.push_back(w);
+  ASSERT_EQ(ignored.size(), 1u);
+  EXPECT_NE(ignored[0].find("scene.toml:7: [bake] samples: method 'pcf' does not use it (read by "
+                            "convolution, accumulation, adaptive-pcf, reference)"),
+            std::string::npos)
+      << ignored[0];
+  scene.bake.method = "reference";
+  result = bake(scene);
+  ASSERT_TRUE(result) << result.error().message;
+  ignored.clear();
+  for (const auto& w : result->warnings)
+    if (w.find("does not use it") != std::string::npos) ignored.push_back(w);
+  ASSERT_EQ(ignored.size(), 1u);
+  EXPECT_NE(ignored[0].find("[bake] shadow_map: method 'reference' does not use it"),
+            std::string::npos)
+      << ignored[0];
+}
+
 }  // namespace
 }  // namespace sb

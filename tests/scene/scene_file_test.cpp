@@ -260,11 +260,17 @@ TEST_F(SceneFile, ReadsAndChecksMethodSettings) {
   EXPECT_EQ(scene.bake.max_image, 2048);
   EXPECT_EQ(scene.bake.max_triples, 32);
   EXPECT_EQ(scene.bake.light_parts, 2);
-  EXPECT_EQ(scene.bake.blocker_combine, "product");
-  EXPECT_EQ(scene.bake.weighting, "emission");
+  EXPECT_EQ(scene.bake.blocker_combine, BlockerCombine::product);
+  EXPECT_EQ(scene.bake.weighting, ConvolutionWeighting::emission);
   EXPECT_EQ(scene.bake.shadow_map, 1024);
   EXPECT_EQ(scene.bake.pcf_radius, 3.0);
-  EXPECT_EQ(scene.bake.erosion_factor, "distance");
+  EXPECT_EQ(scene.bake.erosion_factor, ErosionFactor::distance);
+  // The keys given, with their lines, for the bake to report those its method ignores.
+  ASSERT_EQ(scene.bake_keys.size(), 9u);
+  EXPECT_EQ(scene.bake_keys[0].key, "error_texels");
+  EXPECT_EQ(scene.bake_keys[0].line, 2);
+  EXPECT_EQ(scene.bake_keys[8].key, "erosion_factor");
+  EXPECT_EQ(scene.bake_keys[8].line, 10);
   expect_error("[bake]\nerror_texels = 0\n" + object_floor + light_panel, "error_texels",
                "[bake]", "'error_texels' must be a number > 0");
   expect_error("[bake]\nblocker_combine = \"max\"\n" + object_floor + light_panel,

@@ -59,7 +59,6 @@
 #include "methods/convolution/blocker_image.h"
 #include "methods/convolution/buried_texels.h"
 #include "methods/convolution/convolution_plan.h"
-#include "methods/convolution/fft_convolution.h"
 #include "core/memory_size.h"
 #include "methods/convolution/source_image.h"
 
@@ -199,7 +198,8 @@ struct LeafImages {
 // disjoint), or the whole grid alone where the windows would not save at least a third of its
 // transform.
 std::vector<LeafWindow> leaf_windows(const Triple& leaf, const SourceKernel& kernel,
-                                     const std::vector<std::pair<Vec2, Vec2>>& boxes) {
+                                     const std::vector<std::pair<Vec2, Vec2>>& boxes,
+                                     const ConvolutionBackend& fft) {
   const TangentGrid& g = leaf.grid;
   std::vector<LeafWindow> whole(1);
   whole[0].grid = g;
@@ -249,8 +249,8 @@ std::vector<LeafWindow> leaf_windows(const Triple& leaf, const SourceKernel& ker
     w.grid.height = y1 - y0;
     w.lo = (lo - reach).cwiseMax(leaf.footprint_lo);
     w.hi = (hi + reach).cwiseMin(leaf.footprint_hi);
-    tw = std::max(tw, FftConvolver::transform_size(w.grid.width));
-    th = std::max(th, FftConvolver::transform_size(w.grid.height));
+    tw = std::max(tw, fft.transform_size(w.grid.width));
+    th = std::max(th, fft.transform_size(w.grid.height));
     windows.push_back(std::move(w));
   }
   // One transform size for all windows: the kernel's spectra and FFTW's plans are shared.
@@ -265,7 +265,7 @@ std::vector<LeafWindow> leaf_windows(const Triple& leaf, const SourceKernel& ker
 
 // Renders one leaf's kernel and blocker images and convolves them.
 LeafImages convolve_leaf(const ConvolutionPlan& plan, const Triple& leaf, BlockerCombine combine,
-                         bool weighted, bool windows) {
+                         bool weighted, bool windows, ConvolutionBackend& fft) {
   LeafImages out;
   const PlanFrame& fr = plan.frames[leaf.frame];
   const Light& light = plan.light_parts[fr.light_part].part;
@@ -309,17 +309,16 @@ LeafImages convolve_leaf(const ConvolutionPlan& plan, const Triple& leaf, Blocke
     for (const auto& pg : leaf.blockers.polygons) boxes.emplace_back(pg.lo, pg.hi);
     for (const auto& pg : before.polygons) boxes.emplace_back(pg.lo, pg.hi);
   }
-  out.windows = leaf_windows(leaf, kernel, boxes);
+  out.windows = leaf_windows(leaf, kernel, boxes, fft);
   out.seconds_blocker += seconds_since(start);
 
-  auto& fft = FftConvolver::shared();
   const int channels = kernel.grey ? 1 : 3;
   weighted = weighted && !kernel.moments[0].empty();
   // A kernel wider than the window's transform (a light close to the blockers' depth, seen
   // through a small window) must still fit in it: its pixels wrap around the transform.
   for (LeafWindow& win : out.windows) {
-    win.tw = std::max(win.tw, FftConvolver::transform_size(kernel.width));
-    win.th = std::max(win.th, FftConvolver::transform_size(kernel.height));
+    win.tw = std::max(win.tw, fft.transform_size(kernel.width));
+    win.th = std::max(win.th, fft.transform_size(kernel.height));
   }
   for (LeafWindow& win : out.windows) {
     start = Clock::now();
@@ -495,26 +494,14 @@ double convolution_images_bytes(const ConvolutionPlan& plan) {
   return std::max(largest_leaf, std::min(all, double(kBatchPixels))) * kBytesPerTransformPixel;
 }
 
-Expected<Image> bake_convolution(const TexelSpace& space, const ConvolutionInputs& in,
-                                 std::vector<PairReport>* reports, ConvolutionPlan* plan_out,
-                                 ConvolutionVisibility* per_light) {
-  const auto& lights = *in.lights;
+Expected<ConvolutionVisibility> bake_convolution(const TexelSpace& space,
+                                                 const ConvolutionInputs& in,
+                                                 std::vector<PairReport>* reports,
+                                                 ConvolutionPlan* plan_out) {
+  const auto& lights = *in.plan.lights;
   const std::size_t n = space.texels.size();
   auto start = Clock::now();
-  PlanInputs pin;
-  pin.lights = in.lights;
-  pin.receiver = in.receiver;
-  pin.blockers = in.blockers;
-  pin.clusters = in.clusters;
-  pin.error_texels = in.error_texels;
-  pin.max_image = in.max_image;
-  pin.max_triples = in.max_triples;
-  pin.light_parts = in.light_parts;
-  pin.maybe_blocked = in.maybe_blocked;
-  pin.ray_cost_per_texel = in.ray_cost_per_texel;
-  pin.trace_error_texels = in.trace_error_texels;
-  pin.cost_budget_per_texel = in.cost_budget_per_texel;
-  ConvolutionPlan plan = plan_convolution(space, pin);
+  ConvolutionPlan plan = plan_convolution(space, in.plan);
   const double plan_seconds = seconds_since(start);
   if (const double needed = convolution_images_bytes(plan); needed > in.memory_for_images) {
     int widest = 0, tallest = 0;
@@ -529,7 +516,7 @@ Expected<Image> bake_convolution(const TexelSpace& space, const ConvolutionInput
         "receiver '{}': the convolution's images need about {} (its largest transform is "
         "{}x{}), more than the {} max_memory leaves them; lower 'max_image' or raise "
         "'error_texels' or max_memory",
-        in.receiver->name, format_bytes(needed), widest, tallest,
+        in.plan.receiver->name, format_bytes(needed), widest, tallest,
         format_bytes(in.memory_for_images)));
   }
 
@@ -542,7 +529,7 @@ Expected<Image> bake_convolution(const TexelSpace& space, const ConvolutionInput
     const LightPart& lp = plan.light_parts[fr.light_part];
     PairReport report;
     report.light = lp.name;
-    report.receiver = in.receiver->name;
+    report.receiver = in.plan.receiver->name;
     report.part = fr.face;
     for (int k = 0; k < 3; ++k) report.axis[k] = fr.frame.axis[k];
     report.lit_texels = std::int64_t(fr.texels.size());
@@ -583,18 +570,18 @@ Expected<Image> bake_convolution(const TexelSpace& space, const ConvolutionInput
         const Triple& tr = plan.triples[leaves[last]];
         const std::size_t area = std::size_t(tr.fft_width) * std::size_t(tr.fft_height);
         if (last > first &&
-            (FftConvolver::threaded(tr.fft_width, tr.fft_height) || pixels + area > kBatchPixels))
+            (in.fft->threaded(tr.fft_width, tr.fft_height) || pixels + area > kBatchPixels))
           break;
         pixels += area;
         ++last;
-        if (FftConvolver::threaded(tr.fft_width, tr.fft_height)) break;
+        if (in.fft->threaded(tr.fft_width, tr.fft_height)) break;
       }
       std::vector<LeafImages> images(last - first);
       std::vector<double> seconds(last - first, 0.0);
       tbb::parallel_for(std::size_t(first), last, [&](std::size_t b) {
         const auto leaf_start = Clock::now();
         images[b - first] = convolve_leaf(plan, plan.triples[leaves[b]], in.combine, in.weighted,
-                                          in.island_windows);
+                                          in.island_windows, *in.fft);
         seconds[b - first] = seconds_since(leaf_start);
       });
       for (std::size_t b = first; b < last; ++b) {
@@ -643,7 +630,7 @@ Expected<Image> bake_convolution(const TexelSpace& space, const ConvolutionInput
     // Without a shaft test a texel no leaf reached is simply lit (0); with one, it lies in a
     // shaft a blocker may cross, and the plan did not account for it (negative).
     for (std::size_t i = 0; i < fr.texels.size(); ++i)
-      err[fr.texels[i]] = in.maybe_blocked ? error[i] : std::max(error[i], 0.0f);
+      err[fr.texels[i]] = in.plan.maybe_blocked ? error[i] : std::max(error[i], 0.0f);
     for (std::size_t i = 0; i < fr.texels.size(); ++i) {
       Vec3f v;
       for (int c = 0; c < 3; ++c) {
@@ -671,7 +658,7 @@ Expected<Image> bake_convolution(const TexelSpace& space, const ConvolutionInput
     std::vector<int> parts;
     for (std::size_t p = 0; p < plan.light_parts.size(); ++p)
       if (plan.light_parts[p].light == int(l) && !part_visible[p].empty()) parts.push_back(int(p));
-    const std::vector<std::uint8_t>* maybe = in.maybe_blocked ? &(*in.maybe_blocked)[l] : nullptr;
+    const std::vector<std::uint8_t>* maybe = in.plan.maybe_blocked ? &(*in.plan.maybe_blocked)[l] : nullptr;
     if (parts.empty() && !maybe) continue;
     visible[l].assign(n, Vec3f::Zero());
     reached[l].assign(n, 0);
@@ -728,40 +715,15 @@ Expected<Image> bake_convolution(const TexelSpace& space, const ConvolutionInput
   // A texel inside a convex closed blocker (a floor under a box) sees no light: exactly, rather
   // than through the slabs' approximate count (buried_texels.h).
   const std::vector<std::uint8_t> buried =
-      in.clusters ? buried_texels(space, *in.receiver, in.blockers, *in.clusters,
+      in.plan.clusters ? buried_texels(space, *in.plan.receiver, in.plan.blockers, *in.plan.clusters,
                                   kBuriedTolerance * plan.texel)
                   : std::vector<std::uint8_t>(n, 0);
 
-  // Lights combined as V = Σ H0_l·V_l / Σ H0_l. One light's visibility needs no closed form: its
-  // weight is its exitance where it reaches the texel, so a channel it does not emit stays 0.
-  const bool weights_needed = lights.size() > 1 || in.quantity == Quantity::irradiance;
-  Image out(space.width, space.height, 3, 0.0f);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& r) {
-    for (std::size_t t = r.begin(); t != r.end(); ++t) {
-      const Texel& tx = space.texels[t];
-      const Vec3 p = tx.position.cast<double>(), normal = tx.normal.cast<double>();
-      Vec3 sum = Vec3::Zero(), weight = Vec3::Zero();
-      for (std::size_t l = 0; l < lights.size() && !buried[t]; ++l) {
-        if (visible[l].empty() || !reached[l][t]) continue;
-        const Vec3 w =
-            weights_needed ? lights[l].unoccluded_irradiance(p, normal) : lights[l].exitance();
-        sum += w.cwiseProduct(visible[l][t].cast<double>());
-        weight += w;
-      }
-      float* px = out.at(tx.x, tx.y);
-      for (int c = 0; c < 3; ++c) {
-        px[c] =
-            float(in.quantity == Quantity::irradiance ? sum[c]
-                                                      : (weight[c] > 0 ? sum[c] / weight[c] : 0.0));
-      }
-    }
-  });
-  if (per_light) {
-    per_light->visible = std::move(visible);
-    per_light->reached = std::move(reached);
-    per_light->error_texels = std::move(error);
-    per_light->buried = buried;
-  }
+  ConvolutionVisibility out;
+  out.visible = std::move(visible);
+  out.reached = std::move(reached);
+  out.error_texels = std::move(error);
+  out.buried = buried;
   if (plan_out) *plan_out = std::move(plan);
   return out;
 }

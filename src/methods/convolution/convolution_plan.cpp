@@ -42,7 +42,6 @@
 #include <tuple>
 
 #include "occluders/clusters.h"
-#include "methods/convolution/fft_convolution.h"
 #include "methods/convolution/source_image.h"
 
 namespace sb {
@@ -290,8 +289,8 @@ void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& 
     t.grid.origin = tlo - Vec2(margin_x, margin_y) * at;
     t.grid.width = int(std::ceil(span.x() / at)) + 2 * margin_x + 1;
     t.grid.height = int(std::ceil(span.y() / at)) + 2 * margin_y + 1;
-    t.fft_width = FftConvolver::transform_size(t.grid.width);
-    t.fft_height = FftConvolver::transform_size(t.grid.height);
+    t.fft_width = in.backend->transform_size(t.grid.width);
+    t.fft_height = in.backend->transform_size(t.grid.height);
     const double n = double(t.fft_width) * t.fft_height;
     // The blocker images: 4 × 4 coverage samples per pixel, for the share and the whole image
     // (blocker_image.cpp); on the showcase they took three times the transforms' time.

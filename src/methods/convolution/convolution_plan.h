@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "methods/convolution/blocker_image.h"
+#include "methods/convolution/convolution_backend.h"
 #include "scene/lights.h"
 #include "scene/mesh.h"
 #include "texels/texel_space.h"
@@ -23,11 +24,6 @@ namespace sb {
 
 struct ClusterTree;
 
-// How the occluded fractions O_i of different blocker clusters over one texel combine
-// (design-notes §5): `product` takes V = ∏(1 − O_i), clusters hiding independent parts of the
-// light; `sum` takes V = 1 − Σ O_i, clusters hiding disjoint parts. docs/methods.md has the
-// measurement that chose the default.
-enum class BlockerCombine { product, sum };
 
 struct PlanInputs {
   const std::vector<Light>* lights = nullptr;
@@ -38,7 +34,7 @@ struct PlanInputs {
   const ClusterTree* clusters = nullptr;
   double error_texels = 1.0;  // the target ε, in receiver texels
   int max_image = 4096;       // largest image side, pixels
-  int max_triples = 512;      // leaves per light: the work budget
+  int max_triples = 128;      // leaves per light: the work budget
   // Each untextured rectangular light whose plan cuts blockers into depth slabs is split into at
   // least this many parts (1, 2 or 4), whatever ε says: the slabs' error in the shares and in
   // Euler's count scales with the light's size and ε does not measure it (docs/methods.md).
@@ -57,6 +53,8 @@ struct PlanInputs {
   // leaves of a light part cost at most this much in all (refinement stops there), and a leaf
   // at most this much per texel of its footprint (its images are made coarser).
   double cost_budget_per_texel = 0;
+  // The transforms leaves will run on: their sizes set each leaf's cost.
+  const ConvolutionBackend* backend = nullptr;
 };
 
 // A shadow ray's cost in Triple::cost units (FFT pixel-log): 80 ns per ray and core (the

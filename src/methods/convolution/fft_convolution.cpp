@@ -6,7 +6,7 @@
 // circular; callers pad to get the linear convolution (see fft_convolution.h).
 //
 // Threading: FFTW's planner is process-global and not thread-safe, so plans are made once per
-// (tw, th, FFTW threads) under a mutex and cached; execution is thread-safe, so convolve() runs
+// (tw, th, FFTW threads) and convolver under a mutex shared by all convolvers, and cached; execution is thread-safe, so convolve() runs
 // the cached plans through the new-array interface on the calling thread's own arrays. Those come
 // from fftwf_malloc, like the arrays the plans were made on, because a plan may only be executed on
 // arrays with the alignment it was planned for.
@@ -98,17 +98,21 @@ Scratch& thread_scratch(std::size_t real_count, std::size_t complex_count) {
 constexpr std::size_t kMaxCachedSpectra = 64;
 constexpr std::size_t kMaxCachedSpectrumBytes = std::size_t(512) << 20;
 
-}  // namespace
+// FFTW's planner (and plan destruction) is process-global state: one lock for every convolver.
+std::mutex& fftw_planner_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
 
-struct KernelSpectrum {
-  int tw = 0, th = 0;  // transform size, pixels
-  int kw = 0, kh = 0;  // kernel size, pixels
+struct FftwSpectrum final : KernelSpectrum {
   std::uint64_t hash = 0;
   std::vector<float> kernel;  // the kernel's values, for the full compare on a hash hit
   ComplexBuffer values;       // spectrum_count(tw, th) values, already scaled by 1 / (tw·th)
 
   std::size_t bytes() const { return spectrum_count(tw, th) * sizeof(fftwf_complex); }
 };
+
+}  // namespace
 
 struct FftConvolver::Impl {
   struct PlanKey {
@@ -120,21 +124,21 @@ struct FftConvolver::Impl {
     fftwf_plan inverse = nullptr;  // c2r, unnormalised
   };
 
+  const FftConvolver* owner = nullptr;
   std::atomic<int> threads{1};
 
-  std::mutex planner_mutex;  // guards every FFTW planner call and `plans`
-  std::map<PlanKey, Plans> plans;
+  std::map<PlanKey, Plans> plans;  // guarded by fftw_planner_mutex()
 
   std::mutex spectra_mutex;  // guards `spectra` and `spectra_bytes`
   // Most recently used first.
-  std::list<std::shared_ptr<const KernelSpectrum>> spectra;
+  std::list<std::shared_ptr<const FftwSpectrum>> spectra;
   std::size_t spectra_bytes = 0;
 
   // The plans for a tw × th transform with the current thread count. The reference stays valid:
   // std::map nodes do not move, and plans are destroyed only with the convolver.
   const Plans& plans_for(int tw, int th) {
-    const PlanKey key{tw, th, FftConvolver::threaded(tw, th) ? threads.load() : 1};
-    std::lock_guard lock(planner_mutex);
+    const PlanKey key{tw, th, owner->threaded(tw, th) ? threads.load() : 1};
+    std::lock_guard lock(fftw_planner_mutex());
     auto found = plans.find(key);
     if (found != plans.end()) return found->second;
     // FFTW_ESTIMATE: a bake is one run of a command-line tool, and FFTW_MEASURE's planning (it
@@ -153,10 +157,10 @@ struct FftConvolver::Impl {
   }
 
   // A cached spectrum equal to the request, moved to the front of the list; null if none.
-  std::shared_ptr<const KernelSpectrum> find_spectrum(const std::vector<float>& kernel, int kw,
-                                                      int kh, int tw, int th, std::uint64_t hash) {
+  std::shared_ptr<const FftwSpectrum> find_spectrum(const std::vector<float>& kernel, int kw,
+                                                    int kh, int tw, int th, std::uint64_t hash) {
     for (auto it = spectra.begin(); it != spectra.end(); ++it) {
-      const KernelSpectrum& s = **it;
+      const FftwSpectrum& s = **it;
       if (s.hash != hash || s.tw != tw || s.th != th || s.kw != kw || s.kh != kh) continue;
       if (std::memcmp(s.kernel.data(), kernel.data(), kernel.size() * sizeof(float)) != 0) continue;
       spectra.splice(spectra.begin(), spectra, it);
@@ -166,7 +170,7 @@ struct FftConvolver::Impl {
   }
 
   ~Impl() {
-    std::lock_guard lock(planner_mutex);
+    std::lock_guard lock(fftw_planner_mutex());
     for (auto& [key, made] : plans) {
       fftwf_destroy_plan(made.forward);
       fftwf_destroy_plan(made.inverse);
@@ -174,15 +178,14 @@ struct FftConvolver::Impl {
   }
 };
 
-FftConvolver& FftConvolver::shared() {
-  static FftConvolver convolver;
-  return convolver;
-}
-
 FftConvolver::FftConvolver() : impl_(std::make_unique<Impl>()) {
-  // Must come before the first planner call; later calls are no-ops in FFTW 3.3.
-  [[maybe_unused]] const int initialised = fftwf_init_threads();
-  assert(initialised);
+  {
+    // Must come before the first planner call; later calls are no-ops in FFTW 3.3.
+    std::lock_guard lock(fftw_planner_mutex());
+    [[maybe_unused]] const int initialised = fftwf_init_threads();
+    assert(initialised);
+  }
+  impl_->owner = this;
   impl_->threads = std::max(1, int(std::thread::hardware_concurrency()));
 }
 
@@ -203,7 +206,7 @@ int FftConvolver::fast_size(int n) {
   }
 }
 
-int FftConvolver::transform_size(int n) {
+int FftConvolver::transform_size(int n) const {
   if (n <= 8) return 8;
   if (n <= 64) {
     int octave = 2;
@@ -217,7 +220,7 @@ int FftConvolver::transform_size(int n) {
   return 8 * octave;  // unreachable: 7·octave >= n
 }
 
-bool FftConvolver::threaded(int tw, int th) {
+bool FftConvolver::threaded(int tw, int th) const {
   constexpr std::int64_t kThreadedPoints = 400 * 400;
   return std::int64_t(tw) * std::int64_t(th) >= kThreadedPoints;
 }
@@ -235,7 +238,7 @@ std::shared_ptr<const KernelSpectrum> FftConvolver::kernel_spectrum(
   }
 
   // Transform outside the cache lock, so other threads' lookups do not wait for it.
-  auto spectrum = std::make_shared<KernelSpectrum>();
+  auto spectrum = std::make_shared<FftwSpectrum>();
   spectrum->tw = tw;
   spectrum->th = th;
   spectrum->kw = kw;
@@ -278,13 +281,6 @@ std::shared_ptr<const KernelSpectrum> FftConvolver::kernel_spectrum(
 }
 
 void FftConvolver::convolve(const std::vector<float>& image, int w, int h,
-                            const KernelSpectrum& kernel, std::vector<float>& out) {
-  const KernelSpectrum* kernels[1] = {&kernel};
-  std::vector<float>* outs[1] = {&out};
-  convolve(image, w, h, kernels, outs);
-}
-
-void FftConvolver::convolve(const std::vector<float>& image, int w, int h,
                             std::span<const KernelSpectrum* const> kernels,
                             std::span<std::vector<float>* const> outs) {
   SB_CHECK(w >= 1 && h >= 1);
@@ -320,7 +316,8 @@ void FftConvolver::convolve(const std::vector<float>& image, int w, int h,
   for (std::size_t k = 0; k < kernels.size(); ++k) {
     // Pointwise complex product, on interleaved (re, im) floats so the compiler vectorises it.
     const float* a = &spectrum[0][0];
-    const float* b = &kernels[k]->values[0][0];
+    // Every spectrum a caller holds came from this class's kernel_spectrum.
+    const float* b = &static_cast<const FftwSpectrum*>(kernels[k])->values[0][0];
     float* p = &product[0][0];
     for (std::size_t i = 0; i < 2 * count; i += 2) {
       const float re = a[i] * b[i] - a[i + 1] * b[i + 1];

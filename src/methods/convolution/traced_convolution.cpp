@@ -49,33 +49,36 @@ bool partly_below_horizon(const Light& light, const Vec3& p, const Vec3& n) {
 
 }  // namespace
 
-Expected<Image> bake_traced_convolution(const TexelSpace& space, const TracedConvolutionInputs& in,
-                                        std::vector<PairReport>* reports, ConvolutionPlan* plan,
-                                        TracedConvolutionStats* stats) {
-  const std::vector<Light>& lights = *in.convolution.lights;
+Expected<MixedImages> bake_traced_convolution(const TexelSpace& space,
+                                              const TracedConvolutionInputs& in,
+                                              std::vector<PairReport>* reports,
+                                              ConvolutionPlan* plan,
+                                              TracedConvolutionStats* stats) {
+  const std::vector<Light>& lights = *in.convolution.plan.lights;
   const std::size_t n = space.texels.size();
   ConvolutionInputs conv = in.convolution;
   // The convolution may cost at most half what the reference at 64 samples would per texel
   // (the method must never be slower than the rays it replaces), or half what tracing the texel
   // at `samples` would, where it traces.
-  conv.cost_budget_per_texel = 0.5 * 64 * kRayCostUnits;
+  conv.plan.cost_budget_per_texel = 0.5 * 64 * kRayCostUnits;
   if (in.rays) {
-    conv.ray_cost_per_texel = in.samples * kRayCostUnits;
-    conv.trace_error_texels = in.trace_error_texels;
-    conv.cost_budget_per_texel =
-        std::min(conv.cost_budget_per_texel, 0.5 * conv.ray_cost_per_texel);
+    conv.plan.ray_cost_per_texel = in.samples * kRayCostUnits;
+    conv.plan.trace_error_texels = in.trace_error_texels;
+    conv.plan.cost_budget_per_texel =
+        std::min(conv.plan.cost_budget_per_texel, 0.5 * conv.plan.ray_cost_per_texel);
   }
   std::vector<std::vector<std::uint8_t>> maybe;
   if (in.culler) {
     const double offset = in.rays ? in.rays->surface_offset() : 0.0;
     for (const Light& light : lights)
       maybe.push_back(in.culler->maybe_blocked(space, light, offset));
-    conv.maybe_blocked = &maybe;
+    conv.plan.maybe_blocked = &maybe;
   }
   ConvolutionVisibility per_light;
   if (in.convolve || !in.rays) {
-    auto convolved = bake_convolution(space, conv, reports, plan, &per_light);
+    auto convolved = bake_convolution(space, conv, reports, plan);
     if (!convolved) return convolved.error();
+    per_light = std::move(*convolved);
   } else {  // no leaf: every pair the shaft test keeps is traced
     per_light.visible.resize(lights.size());
     per_light.reached.resize(lights.size());
@@ -123,8 +126,7 @@ Expected<Image> bake_traced_convolution(const TexelSpace& space, const TracedCon
     }
   }
 
-  const bool weights_needed = lights.size() > 1 || conv.quantity == Quantity::irradiance;
-  Image out(space.width, space.height, 3, 0.0f);
+  LightMix mix(space, lights, conv.quantity, LightMix::Order::texel_major, in.keep_per_light);
   std::atomic<std::int64_t> pairs{0}, clear{0}, traced{0}, rays_traced{0};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
     ShadowRays batch(in.samples);
@@ -133,7 +135,7 @@ Expected<Image> bake_traced_convolution(const TexelSpace& space, const TracedCon
     for (std::size_t t = r.begin(); t != r.end(); ++t) {
       const Texel& tx = space.texels[t];
       const Vec3 p = tx.position.cast<double>(), normal = tx.normal.cast<double>();
-      Vec3 sum = Vec3::Zero(), weight = Vec3::Zero();
+      LightMix::Sum sum;
       const bool buried = !per_light.buried.empty() && per_light.buried[t];
       for (std::size_t l = 0; l < lights.size() && !buried; ++l) {
         if (!lights[l].reaches(p, normal)) continue;
@@ -159,17 +161,9 @@ Expected<Image> bake_traced_convolution(const TexelSpace& space, const TracedCon
           v = traced_v;
           local_rays += batch.size();
         }
-        const Vec3 w =
-            weights_needed ? lights[l].unoccluded_irradiance(p, normal) : lights[l].exitance();
-        sum += w.cwiseProduct(v);
-        weight += w;
+        mix.add(sum, l, t, mix.unoccluded(l, t), v);
       }
-      float* px = out.at(tx.x, tx.y);
-      for (int c = 0; c < 3; ++c) {
-        px[c] = float(conv.quantity == Quantity::irradiance
-                          ? sum[c]
-                          : (weight[c] > 0 ? sum[c] / weight[c] : 0.0));
-      }
+      mix.write(t, sum);
     }
     pairs += local_pairs;
     clear += local_clear;
@@ -183,7 +177,7 @@ Expected<Image> bake_traced_convolution(const TexelSpace& space, const TracedCon
     stats->convolved += pairs - clear - traced;
     stats->rays += rays_traced;
   }
-  return out;
+  return mix.finish();
 }
 
 }  // namespace sb

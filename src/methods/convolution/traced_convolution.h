@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "methods/convolution/convolution_bake.h"
+#include "methods/method.h"
 #include "occluders/ray_scene.h"
 #include "occluders/shaft_culling.h"
 
@@ -24,6 +25,7 @@ struct TracedConvolutionInputs {
   int samples = 64;                     // rays per light per traced texel
   double trace_error_texels = 1.0;      // leaves' ε above this are traced
   std::uint64_t seed = 0, stream = 0;   // as the reference's, so a traced texel matches it
+  bool keep_per_light = false;          // MixedImages::per_light wanted
 };
 
 // What the method did with the receiver's (light, texel) pairs the lights reach.
@@ -32,9 +34,20 @@ struct TracedConvolutionStats {
   std::int64_t rays = 0;
 };
 
-// Bakes one receiver; lights combined as V = Σ H0_l·V_l / Σ H0_l (or H = Σ H0_l·V_l).
-Expected<Image> bake_traced_convolution(const TexelSpace& space, const TracedConvolutionInputs& in,
-                                        std::vector<PairReport>* reports, ConvolutionPlan* plan,
-                                        TracedConvolutionStats* stats);
+// Bakes one receiver; lights combined by LightMix.
+Expected<MixedImages> bake_traced_convolution(const TexelSpace& space,
+                                              const TracedConvolutionInputs& in,
+                                              std::vector<PairReport>* reports,
+                                              ConvolutionPlan* plan,
+                                              TracedConvolutionStats* stats);
+
+// The registry's entry: the convolution and its settings (error_texels, max_image, max_triples,
+// light_parts, trace, convolve, trace_error_texels, blocker_combine, weighting, samples, seed).
+MethodEntry convolution_method();
+
+// The planner's inputs for one receiver from the bake's settings (what `shadowbake plan` and the
+// method share).
+PlanInputs plan_inputs(const BakeContext& context, const Mesh* receiver,
+                       const ConvolutionBackend* backend);
 
 }  // namespace sb

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <functional>
 
+#include "methods/convolution/pair_report.h"
 #include "pipeline/bake.h"
 #include "support/test_scenes.h"
 #include "support/closed_forms.h"
@@ -21,7 +22,7 @@ using test_scenes::object;
 Image bake_floor(const Scene& scene, std::vector<PairReport>* pairs = nullptr) {
   auto result = bake(scene);
   EXPECT_TRUE(result) << result.error().message;
-  if (pairs) *pairs = result->receivers[0].pairs;
+  if (pairs) *pairs = convolution_pairs(result->receivers[0].report.details);
   return result->receivers[0].image;
 }
 
@@ -75,7 +76,7 @@ TEST(ConvolutionBake, ParallelSquareLightMatchesClosedForm) {
     const Errors weighted = floor_errors(bake_floor(scene), 0, [&](double x, double y) {
       return closed_forms::square_light_weighted_visibility(x, y, bx, by, height);
     });
-    scene.bake.weighting = "emission";
+    scene.bake.weighting = ConvolutionWeighting::emission;
     const Errors e = floor_errors(bake_floor(scene), 0, [&](double x, double y) {
       return closed_forms::square_light_unweighted_visibility(x, y, bx, by, height);
     });
@@ -100,7 +101,7 @@ TEST(ConvolutionBake, ParallelDiskLightMatchesClosedForm) {
           return closed_forms::disk_light_weighted_visibility(x, y, 0, 0, height, 0.25);
         },
         4);
-    scene.bake.weighting = "emission";
+    scene.bake.weighting = ConvolutionWeighting::emission;
     const Errors e = floor_errors(
         bake_floor(scene), 0,
         [&](double x, double y) {
@@ -124,7 +125,7 @@ TEST(ConvolutionBake, AgreesWithReferenceWithinTheWeightingSplit) {
   Scene ref = load("parallel", 256, "reference");
   ref.bake.samples = 256;
   const Image weighted = bake_floor(conv);
-  conv.bake.weighting = "emission";
+  conv.bake.weighting = ConvolutionWeighting::emission;
   const Image c = bake_floor(conv), r = bake_floor(ref);
   const Errors against_reference = image_errors(c, r);
   const Errors weighted_against_reference = image_errors(weighted, r);

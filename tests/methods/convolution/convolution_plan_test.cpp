@@ -17,6 +17,7 @@
 #include "occluders/clusters.h"
 #include "methods/convolution/convolution_bake.h"
 #include "methods/convolution/convolution_plan.h"
+#include "methods/convolution/fft_convolution.h"
 #include "scene/mesh.h"
 #include "texels/texel_space.h"
 
@@ -52,6 +53,8 @@ std::unique_ptr<Planned> plan_scene(const Scene& scene) {
   in.clusters = &p->clusters;
   in.error_texels = scene.bake.error_texels;
   in.max_triples = scene.bake.max_triples;
+  const FftConvolver fft;
+  in.backend = &fft;
   p->plan = plan_convolution(p->space, in);
   return p;
 }
@@ -323,22 +326,28 @@ TEST(ConvolutionPlan, PostShadowHardensAtContact) {
 TEST(ConvolutionPlan, IslandWindowsChangeNothingButTheWork) {
   const Scene scene = load("table", 256, "convolution");
   const auto p = plan_scene(scene);
+  FftConvolver fft;
   ConvolutionInputs in;
-  in.lights = &p->lights;
+  in.plan.lights = &p->lights;
   std::size_t receiver = 0;
   while (!scene.objects[receiver].receiver) ++receiver;
-  in.receiver = &p->meshes[receiver];
-  in.blockers = p->blockers;
-  in.clusters = &p->clusters;
-  in.max_triples = scene.bake.max_triples;
+  in.plan.receiver = &p->meshes[receiver];
+  in.plan.blockers = p->blockers;
+  in.plan.clusters = &p->clusters;
+  in.plan.max_triples = scene.bake.max_triples;
+  in.plan.backend = &fft;
+  in.fft = &fft;
   std::vector<PairReport> with_reports, without_reports;
-  const Image with = *bake_convolution(p->space, in, &with_reports);
+  const ConvolutionVisibility with = *bake_convolution(p->space, in, &with_reports);
   in.island_windows = false;
-  const Image without = *bake_convolution(p->space, in, &without_reports);
-  ASSERT_EQ(with.pixels.size(), without.pixels.size());
+  const ConvolutionVisibility without = *bake_convolution(p->space, in, &without_reports);
+  ASSERT_EQ(with.visible.size(), without.visible.size());
   double worst = 0;
-  for (std::size_t i = 0; i < with.pixels.size(); ++i)
-    worst = std::max(worst, double(std::abs(with.pixels[i] - without.pixels[i])));
+  for (std::size_t l = 0; l < with.visible.size(); ++l) {
+    ASSERT_EQ(with.visible[l].size(), without.visible[l].size());
+    for (std::size_t t = 0; t < with.visible[l].size(); ++t)
+      worst = std::max(worst, double((with.visible[l][t] - without.visible[l][t]).cwiseAbs().maxCoeff()));
+  }
   EXPECT_LT(worst, 1e-4);
   int with_count = 0, without_count = 0;
   for (const PairReport& r : with_reports) with_count += r.convolutions;

@@ -62,8 +62,9 @@ std::vector<float> direct_convolution(const std::vector<float>& image, int w, in
 
 std::vector<float> fft_convolution(const std::vector<float>& image, int w, int h,
                                    const std::vector<float>& kernel, int kw, int kh, int tw,
-                                   int th) {
-  FftConvolver& convolver = FftConvolver::shared();
+                                   int th, int threads = 0) {
+  FftConvolver convolver;
+  if (threads > 0) convolver.set_threads(threads);
   const auto spectrum = convolver.kernel_spectrum(kernel, kw, kh, tw, th);
   std::vector<float> out;
   convolver.convolve(image, w, h, *spectrum, out);
@@ -97,7 +98,7 @@ TEST(FftConvolution, SeveralKernelsShareOneImageTransform) {
   // spectrum and the product would be misaligned without the rounding in convolve().
   const int w = 25, h = 21, kw = 5, kh = 7;
   const std::vector<float> image = random_values(std::size_t(w) * std::size_t(h), 11);
-  FftConvolver& convolver = FftConvolver::shared();
+  FftConvolver convolver;
   for (const auto& [tw, th] : {std::pair{31, 41}, std::pair{33, 29}}) {
     SCOPED_TRACE(testing::Message() << "transform " << tw << " x " << th);
     std::vector<std::vector<float>> kernels, expected;
@@ -148,7 +149,7 @@ TEST(FftConvolution, UnpaddedTransformIsExactInInteriorAndWrapsAtBorder) {
 // kernel_spectrum wrote before its buffer (the index i - kw/2 + tw went negative; the assert that
 // guarded it is compiled out of release builds). The check holds in every build now.
 TEST(FftConvolution, KernelWiderThanTransformIsRefusedNotWrittenPast) {
-  FftConvolver& convolver = FftConvolver::shared();
+  FftConvolver convolver;
   const std::vector<float> kernel(63 * 9, 1.0f / (63 * 9));
   EXPECT_THROW(convolver.kernel_spectrum(kernel, 63, 9, 24, 16), std::logic_error);
   EXPECT_THROW(convolver.kernel_spectrum(kernel, 9, 63, 16, 24), std::logic_error);
@@ -192,7 +193,7 @@ TEST(FftConvolution, ShiftedDeltaKernelShiftsImageByItsOffset) {
 }
 
 TEST(FftConvolution, SpectrumCacheReturnsSameSpectrumForSameKernel) {
-  FftConvolver& convolver = FftConvolver::shared();
+  FftConvolver convolver;
   const std::vector<float> kernel = random_values(9 * 5, 7);
   const auto first = convolver.kernel_spectrum(kernel, 9, 5, 64, 48);
   const std::vector<float> same_values = kernel;  // a different vector with equal values
@@ -209,7 +210,7 @@ TEST(FftConvolution, SpectrumCacheReturnsSameSpectrumForSameKernel) {
 TEST(FftConvolution, SpectrumCacheEvictsLeastRecentlyUsed) {
   // The cache holds 64 spectra. Fill it with 64 fresh ones (A, B, then 62 more), touch A, add one
   // more: B, now the least recently used, goes; A stays.
-  FftConvolver& convolver = FftConvolver::shared();
+  FftConvolver convolver;
   auto kernel_number = [](int n) { return std::vector<float>{1000.0f + float(n)}; };
   const auto a = convolver.kernel_spectrum(kernel_number(0), 1, 1, 8, 8);
   const auto b = convolver.kernel_spectrum(kernel_number(1), 1, 1, 8, 8);
@@ -233,20 +234,20 @@ TEST(FftConvolution, FastSizeHasOnlyFactorsTwoThreeFiveSeven) {
 }
 
 TEST(FftConvolution, TransformSizesAreFewPerOctave) {
-  EXPECT_EQ(FftConvolver::transform_size(1), 8);
-  EXPECT_EQ(FftConvolver::transform_size(11), 12);
-  EXPECT_EQ(FftConvolver::transform_size(13), 16);
-  EXPECT_EQ(FftConvolver::transform_size(25), 32);
-  EXPECT_EQ(FftConvolver::transform_size(33), 48);
-  EXPECT_EQ(FftConvolver::transform_size(64), 64);
-  EXPECT_EQ(FftConvolver::transform_size(65), 80);
-  EXPECT_EQ(FftConvolver::transform_size(113), 128);
-  EXPECT_EQ(FftConvolver::transform_size(300), 320);
-  EXPECT_EQ(FftConvolver::transform_size(449), 512);
+  EXPECT_EQ(FftConvolver().transform_size(1), 8);
+  EXPECT_EQ(FftConvolver().transform_size(11), 12);
+  EXPECT_EQ(FftConvolver().transform_size(13), 16);
+  EXPECT_EQ(FftConvolver().transform_size(25), 32);
+  EXPECT_EQ(FftConvolver().transform_size(33), 48);
+  EXPECT_EQ(FftConvolver().transform_size(64), 64);
+  EXPECT_EQ(FftConvolver().transform_size(65), 80);
+  EXPECT_EQ(FftConvolver().transform_size(113), 128);
+  EXPECT_EQ(FftConvolver().transform_size(300), 320);
+  EXPECT_EQ(FftConvolver().transform_size(449), 512);
   // Two sizes per octave up to 64 (at most half the size in padding), four beyond (a quarter).
   std::set<int> small, sizes;
   for (int n = 9; n <= 4096; ++n) {
-    const int t = FftConvolver::transform_size(n);
+    const int t = FftConvolver().transform_size(n);
     ASSERT_GE(t, n);
     ASSERT_LE(t, n + n / (n <= 64 ? 2 : 4) + 1) << n;
     ASSERT_EQ(FftConvolver::fast_size(t), t) << n;  // FFTW-friendly factors
@@ -257,21 +258,18 @@ TEST(FftConvolution, TransformSizesAreFewPerOctave) {
 }
 
 TEST(FftConvolution, SmallTransformsRunOnOneThread) {
-  EXPECT_FALSE(FftConvolver::threaded(320, 320));
-  EXPECT_TRUE(FftConvolver::threaded(512, 512));
+  EXPECT_FALSE(FftConvolver().threaded(320, 320));
+  EXPECT_TRUE(FftConvolver().threaded(512, 512));
 }
 
 TEST(FftConvolution, SingleThreadedPlansGiveSameResult) {
-  // set_threads affects plans made afterwards: a new (size, threads) plan must agree with the
-  // direct convolution too.
+  // A convolver on one FFTW thread makes plans of its own: they must agree with the direct
+  // convolution too.
   const int w = 37, h = 23, kw = 5, kh = 7;
   const std::vector<float> image = random_values(std::size_t(w) * std::size_t(h), 8);
   const std::vector<float> kernel = random_values(std::size_t(kw) * std::size_t(kh), 9);
   const std::vector<float> expected = direct_convolution(image, w, h, kernel, kw, kh);
-  FftConvolver::shared().set_threads(1);
-  const std::vector<float> out = fft_convolution(image, w, h, kernel, kw, kh, 42, 30);
-  FftConvolver::shared().set_threads(
-      std::max(1, int(std::thread::hardware_concurrency())));  // the default, for later tests
+  const std::vector<float> out = fft_convolution(image, w, h, kernel, kw, kh, 42, 30, 1);
   for (std::size_t i = 0; i < out.size(); ++i)
     ASSERT_NEAR(out[i], expected[i], 1e-5f * kernel_sum(kernel));
 }

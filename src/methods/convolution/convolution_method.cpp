@@ -1,0 +1,204 @@
+// The `convolution` method's entry in the registry (traced_convolution.h): its settings, what it
+// needs built, and what it reports per receiver — the shares of clear, convolved and traced
+// pairs, its penumbra error per light and frustum (the manifest's `penumbra_error` and
+// `lights`), and the plan and choices --explain prints.
+#include <fmt/format.h>
+
+#include <algorithm>
+
+#include "methods/convolution/fft_convolution.h"
+#include "methods/convolution/traced_convolution.h"
+
+namespace sb {
+
+namespace {
+
+// The convolution's arrays per receiver texel: the planner's frames (add_frames: tangents,
+// depths, groups and indices of a light part's whole and halves at once; heaptrack measured 755 MB
+// at peak for the 4.2 M texels of a floor at 2048², 180 B per texel), and while a frame is
+// convolved its occlusion, largest, Euler's counts and weight gradient (about 90 B, of frames'
+// texels that are the receiver's); and per light part the texel's V (12) and whether it is
+// reached (1).
+constexpr double kConvolutionBytesPerTexel = 180 + 90;
+constexpr double kConvolutionBytesPerTexelAndLightPart = 12 + 1;
+
+nlohmann::ordered_json pair_json(const PairReport& p) {
+  return {
+      {"light", p.light},
+      {"frustum", p.part.empty() ? "central" : p.part},
+      {"direction", {p.axis[0], p.axis[1], p.axis[2]}},
+      {"blocker_plane", p.blocker_plane},
+      {"receiver_plane", p.receiver_plane},
+      {"blocker_depths", {p.blocker_depth_lo, p.blocker_depth_hi}},
+      {"receiver_depths", {p.receiver_depth_lo, p.receiver_depth_hi}},
+      {"rho", {p.rho_lo, p.rho, p.rho_hi}},
+      {"penumbra_error", {{"metres", p.penumbra_error}, {"texels", p.penumbra_error_texels}}},
+      {"blocker_image", {p.image_width, p.image_height}},
+      {"kernel", {p.kernel_width, p.kernel_height}},
+      {"fft", {p.fft_width, p.fft_height}},
+      {"lit_texels", p.lit_texels},
+      {"unprojected_texels", p.outside_texels},
+      {"seconds",
+       {{"configure", p.seconds_configure},
+        {"source", p.seconds_source},
+        {"blocker", p.seconds_blocker},
+        {"fft", p.seconds_fft},
+        {"lookup", p.seconds_lookup}}},
+  };
+}
+
+std::string pair_text(const PairReport& p) {
+  std::string s =
+      fmt::format("{} <- {}{}{}: D = ({:.3f}, {:.3f}, {:.3f}), {} lit texels", p.receiver, p.light,
+                  p.part.empty() ? "" : " face ", p.part, p.axis[0], p.axis[1], p.axis[2],
+                  p.lit_texels);
+  if (p.outside_texels > 0)
+    s += fmt::format(" ({} beside the light, left unshadowed)", p.outside_texels);
+  s += "\n";
+  if (p.image_width == 0) return s + "    no blocker between the light and the receiver\n";
+  s += fmt::format(
+      "    planes along D: source 0, blocker {:.3f} m (blockers {:.3f}..{:.3f}), receiver "
+      "{:.3f} m (receiver {:.3f}..{:.3f})\n",
+      p.blocker_plane, p.blocker_depth_lo, p.blocker_depth_hi, p.receiver_plane,
+      p.receiver_depth_lo, p.receiver_depth_hi);
+  s += fmt::format(
+      "    penumbra error: rho {:.3f} in [{:.3f}, {:.3f}], L = {:.3f} m -> {:.4f} m = {:.1f} "
+      "texels\n",
+      p.rho, p.rho_lo, p.rho_hi, p.light_extent, p.penumbra_error, p.penumbra_error_texels);
+  s += fmt::format("    images: blocker {}x{}, kernel {}x{}, FFT {}x{}, {} convolution(s)\n",
+                   p.image_width, p.image_height, p.kernel_width, p.kernel_height, p.fft_width,
+                   p.fft_height, p.convolutions);
+  s += fmt::format(
+      "    time: configure {:.1f} ms; summed over threads: source {:.1f} ms, blocker {:.1f} ms, "
+      "FFT {:.1f} ms, lookup {:.1f} ms\n",
+      1e3 * p.seconds_configure, 1e3 * p.seconds_source, 1e3 * p.seconds_blocker,
+      1e3 * p.seconds_fft, 1e3 * p.seconds_lookup);
+  return s;
+}
+
+}  // namespace
+
+PlanInputs plan_inputs(const BakeContext& context, const Mesh* receiver,
+                       const ConvolutionBackend* backend) {
+  const BakeSettings& settings = context.scene->bake;
+  PlanInputs in;
+  in.lights = context.lights;
+  in.receiver = receiver;
+  in.blockers = context.blockers;
+  in.clusters = context.clusters;
+  in.error_texels = settings.error_texels;
+  in.max_image = settings.max_image;
+  in.max_triples = settings.max_triples;
+  in.light_parts = settings.light_parts;
+  in.backend = backend;
+  return in;
+}
+
+namespace {
+
+class ConvolutionMethod final : public Method {
+ public:
+  explicit ConvolutionMethod(const BakeContext& context) : context_(context) {
+    fft_.set_threads(std::max(1, context.threads));
+  }
+
+  Expected<MethodResult> bake(const ReceiverInput& receiver) override {
+    const BakeSettings& settings = context_.scene->bake;
+    ConvolutionInputs in;
+    in.plan = plan_inputs(context_, receiver.mesh, &fft_);
+    in.quantity = settings.quantity;
+    in.combine = settings.blocker_combine;
+    in.weighted = settings.weighting == ConvolutionWeighting::irradiance;
+    in.memory_for_images = context_.memory_for_images;
+    in.fft = &fft_;
+    TracedConvolutionInputs traced;
+    traced.convolution = in;
+    traced.culler = context_.shafts;
+    traced.rays = context_.rays;
+    traced.convolve = settings.convolve;
+    traced.samples = settings.samples;
+    traced.trace_error_texels = settings.trace_error_texels;
+    traced.seed = settings.seed;
+    traced.stream = receiver.stream;
+    traced.keep_per_light = context_.keep_per_light;
+    ConvolutionPlan plan;
+    TracedConvolutionStats stats;
+    std::vector<PairReport> pairs;
+    auto images = bake_traced_convolution(*receiver.space, traced, &pairs, &plan, &stats);
+    if (!images) {
+      return scene_error(context_.scene->file.string() + ":" +
+                         std::to_string(receiver.object->line) + ": " + images.error().message);
+    }
+    MethodResult result;
+    result.images = std::move(*images);
+    result.rays = stats.rays;
+    MethodReport& report = result.report;
+    const double all = std::max<double>(1.0, double(stats.pairs));
+    report.stats.emplace_back("clear_fraction", double(stats.clear) / all);
+    report.stats.emplace_back("convolved_fraction", double(stats.convolved) / all);
+    report.stats.emplace_back("traced_fraction", double(stats.traced) / all);
+    report.stats.emplace_back(
+        "rays_per_texel",
+        double(stats.rays) / std::max<double>(1.0, double(receiver.space->texels.size())));
+    report.explain = describe_plan(plan);
+    for (const auto& w : plan.warnings)
+      report.warnings.push_back(context_.scene->file.string() + ": " + w);
+    if (!pairs.empty()) {
+      double worst = 0, worst_texels = 0;
+      for (const auto& p : pairs) {
+        worst = std::max(worst, p.penumbra_error);
+        worst_texels = std::max(worst_texels, p.penumbra_error_texels);
+      }
+      report.manifest["penumbra_error"] = {{"metres", worst}, {"texels", worst_texels}};
+      report.manifest["lights"] = nlohmann::ordered_json::array();
+      for (const auto& p : pairs) {
+        report.manifest["lights"].push_back(pair_json(p));
+        report.explain += pair_text(p);
+      }
+    }
+    report.details = std::move(pairs);
+    if (context_.texels_done) {
+      const auto done = (*context_.texels_done += std::int64_t(receiver.space->texels.size()));
+      if (context_.progress) context_.progress(double(done));
+    }
+    return result;
+  }
+
+ private:
+  BakeContext context_;
+  FftConvolver fft_;  // this bake's transforms: plans made once per size, kernel spectra cached
+};
+
+}  // namespace
+
+MethodEntry convolution_method() {
+  return {"convolution",
+          {"error_texels", "max_image", "max_triples", "light_parts", "trace", "convolve",
+           "trace_error_texels", "blocker_combine", "weighting", "samples", "seed"},
+          [](const BakeSettings& s) {
+            // The planner's clusters serve the convolution (and the buried-texel test); with
+            // convolve = false and rays, no leaf is planned.
+            return MethodNeeds{.rays = s.trace, .clusters = s.convolve || !s.trace, .shafts = true};
+          },
+          [](const Scene& scene) {
+            // Parts of a light: at least light_parts; a sphere light's receiver may be seen
+            // through up to six cube faces, each a frame of its own.
+            const BakeSettings& b = scene.bake;
+            const double texels = double(b.resolution) * double(b.resolution);
+            const double parts = double(scene.lights.size()) * std::max(b.light_parts, 1);
+            return std::vector<MemoryItem>{
+                {"convolution texel arrays",
+                 texels * (kConvolutionBytesPerTexel +
+                           kConvolutionBytesPerTexelAndLightPart * parts)}};
+          },
+          [](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {
+            const BakeSettings& s = context.scene->bake;
+            if (!s.convolve && !s.trace)
+              return scene_error(context.scene->file.string() +
+                                 ": [bake]: convolve = false needs trace = true (with neither, "
+                                 "nothing would compute the shadows)");
+            return std::unique_ptr<Method>(std::make_unique<ConvolutionMethod>(context));
+          }};
+}
+
+}  // namespace sb

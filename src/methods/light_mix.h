@@ -1,0 +1,67 @@
+// How every method combines lights into a receiver's texel values, and keeps each light's own
+// values for per-light outputs. The rule is the reference's (docs/methods.md, "Several lights"):
+// per texel and colour channel, light l's visibility V_l is weighted by its unoccluded
+// irradiance H0_l (closed form, Light::unoccluded_irradiance); a light with H0_l = 0 there, or
+// one the method leaves out at the texel (none of its samples contributes), adds nothing; then
+//   visibility  V = Σ_l H0_l·V_l / Σ_l H0_l   (0 where the sum of weights is 0),
+//   irradiance  H = Σ_l H0_l·V_l              (W/m²),
+// summed in double over lights in scene order and written as float.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/image.h"
+#include "scene/lights.h"
+#include "texels/texel_space.h"
+
+namespace sb {
+
+// A method's values for one receiver: the combined image and, when kept, one image per light
+// (light l's V_l, or H0_l·V_l for irradiance, at the texels where it counts; 0 elsewhere), each
+// width × height RGB, uncovered texels 0.
+struct MixedImages {
+  Image image;
+  std::vector<Image> per_light;  // empty unless the mix was made with keep_per_light
+};
+
+class LightMix {
+ public:
+  // How the method visits (light, texel) pairs: all of a texel's lights at once (add, write), or
+  // light by light (set, then finish combines; it holds every light's V until then).
+  enum class Order { texel_major, light_major };
+  LightMix(const TexelSpace& space, const std::vector<Light>& lights, Quantity quantity,
+           Order order, bool keep_per_light);
+
+  // H0_l at texel t (per channel, W/m²): a light whose H0 is 0 everywhere need not be estimated.
+  Vec3 unoccluded(std::size_t light, std::size_t texel) const;
+
+  // Methods that estimate a texel's lights together, in light order: add each counted light's
+  // H0 and V to the texel's Sum, then write() it. Many threads may do this for distinct texels.
+  struct Sum {
+    Vec3 h = Vec3::Zero(), h0 = Vec3::Zero();
+  };
+  void add(Sum& sum, std::size_t light, std::size_t texel, const Vec3& h0, const Vec3& v);
+  void write(std::size_t texel, const Sum& sum);
+
+  // Methods that run light by light: light l's visibility at texel t (per channel, [0, 1]); a
+  // pair never set is left out. Combined in finish(). Many threads may set distinct pairs.
+  void set(std::size_t light, std::size_t texel, const Vec3& v);
+
+  MixedImages finish();
+
+ private:
+  void keep(std::size_t light, std::size_t texel, const Vec3& h0, const Vec3& v);
+
+  const TexelSpace& space_;
+  const std::vector<Light>& lights_;
+  Quantity quantity_;
+  bool keep_per_light_;
+  MixedImages out_;
+  // Light-major methods' values until finish(): per light, V per texel and whether it was set;
+  // empty for texel-major ones.
+  std::vector<std::vector<Vec3f>> set_values_;
+  std::vector<std::vector<std::uint8_t>> set_flags_;
+};
+
+}  // namespace sb

@@ -1,0 +1,117 @@
+// The shape every bake method has. A method is an entry of the registry (registry.cpp): its name,
+// what shared structures it needs built, the [bake] keys it reads, and a factory that checks its
+// settings and returns a Method, which bakes one receiver at a time into a MethodResult. The
+// pipeline (pipeline/bake.cpp) builds what the entries ask for, calls the method per receiver,
+// and writes the result without knowing which method ran: method-specific figures travel as data
+// (MethodReport).
+#pragma once
+
+#include <any>
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "core/error.h"
+#include "core/image.h"
+#include "core/memory_size.h"
+#include "methods/light_mix.h"
+#include "scene/lights.h"
+#include "scene/mesh.h"
+#include "scene/scene.h"
+#include "texels/texel_space.h"
+
+namespace sb {
+
+class RayScene;
+class ShaftCuller;
+struct ClusterTree;
+
+// Called from worker threads with the texels done so far; must be thread-safe and cheap.
+using ProgressFn = std::function<void(double texels_done)>;
+
+// Named figures a method reports per receiver (e.g. adaptive PCF's fraction of texels that took
+// the full filter): the manifest's method_stats, printed by --explain.
+using MethodStats = std::vector<std::pair<std::string, double>>;
+
+// What a method needs the pipeline to build before its first receiver, shared by all of them.
+struct MethodNeeds {
+  bool rays = false;      // RayScene of the blockers (Embree)
+  bool clusters = false;  // ClusterTree of the blockers (the convolution's planner)
+  bool shafts = false;    // ShaftCuller of the blockers
+};
+
+// The bake's shared, read-only inputs, valid for the method's lifetime.
+struct BakeContext {
+  const Scene* scene = nullptr;  // settings, and the file name errors start with
+  const std::vector<Light>* lights = nullptr;
+  std::vector<const Mesh*> blockers;      // every blocker mesh, in scene order
+  const RayScene* rays = nullptr;         // built when needs().rays
+  const ClusterTree* clusters = nullptr;  // built when needs().clusters
+  const ShaftCuller* shafts = nullptr;    // built when needs().shafts
+  int threads = 1;                        // worker threads the bake runs on
+  double memory_for_images = 0;  // bytes the budget leaves a method's images beyond the estimate
+  bool keep_per_light = false;   // MethodResult::images.per_light wanted
+  std::atomic<std::int64_t>* texels_done = nullptr;  // progress counter, may be null
+  ProgressFn progress;                               // may be empty
+};
+
+// One receiver to bake.
+struct ReceiverInput {
+  const TexelSpace* space = nullptr;
+  const Mesh* mesh = nullptr;
+  const ObjectDesc* object = nullptr;
+  std::uint64_t stream = 0;  // the receiver's index in the scene: its own random streams
+};
+
+// What a method says about one receiver beyond its values, as data the pipeline passes on.
+struct MethodReport {
+  MethodStats stats;
+  // Further entries of the receiver's manifest object, written after method_stats (the
+  // convolution's penumbra error and per-light frusta).
+  nlohmann::ordered_json manifest = nlohmann::ordered_json::object();
+  std::string explain;                // what --explain prints for the receiver after its stats
+  std::vector<std::string> warnings;  // the bake's warnings, each a whole line
+  // The method's own records, for its tests and benchmarks (the convolution's: a
+  // std::vector<PairReport>, per light part and frustum); the pipeline passes them on unread.
+  std::any details;
+};
+
+struct MethodResult {
+  MixedImages images;  // combined (LightMix's rule) and, when asked, per light
+  MethodReport report;
+  std::int64_t rays = 0;  // shadow rays traced
+};
+
+class Method {
+ public:
+  virtual ~Method() = default;
+  // Bakes one receiver. Called for receivers in scene order, one at a time (a method runs its
+  // own work in parallel).
+  virtual Expected<MethodResult> bake(const ReceiverInput& receiver) = 0;
+};
+
+struct MethodEntry {
+  std::string name;
+  // The [bake] keys it reads beyond those of every bake (resolution, method, quantity, margin,
+  // max_memory); others given in the scene are reported as ignored.
+  std::vector<std::string> settings;
+  std::function<MethodNeeds(const BakeSettings&)> needs;
+  // Its own large arrays for a bake of `scene`, beyond texel space and the lightmaps (counted by
+  // pipeline/memory_budget.cpp), estimated before anything is allocated; may be empty.
+  std::function<std::vector<MemoryItem>(const Scene&)> memory;
+  // Checks the settings (errors name the scene file and [bake]) and makes the method.
+  std::function<Expected<std::unique_ptr<Method>>(const BakeContext&)> make;
+};
+
+// Every method of this build, in the order docs/methods.md lists them.
+const std::vector<MethodEntry>& method_registry();
+// The entry named `name`, or null.
+const MethodEntry* find_method(std::string_view name);
+
+}  // namespace sb

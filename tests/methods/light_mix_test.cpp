@@ -1,0 +1,94 @@
+// Tests of LightMix (src/methods/light_mix.h) through every method of the registry: the per-light
+// images a bake keeps are each light's own values, and the combined image is the mix of them.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "methods/method.h"
+#include "pipeline/bake.h"
+#include "support/test_scenes.h"
+
+namespace sb {
+namespace {
+
+using test_scenes::load;
+
+BakeResult bake_or_fail(const Scene& scene, bool keep_per_light) {
+  BakeOptions options;
+  options.keep_per_light = keep_per_light;
+  auto result = bake(scene, options);
+  EXPECT_TRUE(result) << result.error().message;
+  if (!result) throw std::runtime_error(result.error().message);
+  return std::move(*result);
+}
+
+// Largest |a − b| over covered texels, relative to max(1, |b|).
+double worst_difference(const Image& a, const Image& b, const std::vector<std::uint8_t>& covered) {
+  double worst = 0;
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x) {
+      if (!covered[std::size_t(y) * std::size_t(a.width) + std::size_t(x)]) continue;
+      for (int c = 0; c < 3; ++c) {
+        const double va = a.at(x, y)[c], vb = b.at(x, y)[c];
+        worst = std::max(worst, std::abs(va - vb) / std::max(1.0, std::abs(vb)));
+      }
+    }
+  return worst;
+}
+
+class PerLight : public ::testing::TestWithParam<std::string> {};
+
+// The showcase's two lights (a tilted panel and a sphere), irradiance: light l's per-light image
+// is H0_l·V_l, which is what the scene gives with every other light dimmed a trillion-fold (the
+// same lights in the same order, so the same random streams and shadow maps: only the mix
+// changes). To float rounding, for every method.
+TEST_P(PerLight, EachLightsImageIsThatLightAlone) {
+  Scene scene = load("showcase", 32, GetParam());
+  scene.bake.quantity = Quantity::irradiance;
+  scene.bake.samples = 8;
+  scene.bake.shadow_map = 256;
+  ASSERT_EQ(scene.lights.size(), 2u);
+  const BakeResult all = bake_or_fail(scene, true);
+  for (std::size_t l = 0; l < scene.lights.size(); ++l) {
+    Scene alone = scene;
+    for (std::size_t k = 0; k < alone.lights.size(); ++k)
+      if (k != l) alone.lights[k].power *= 1e-12;
+    const BakeResult one = bake_or_fail(alone, false);
+    ASSERT_EQ(one.receivers.size(), all.receivers.size());
+    for (std::size_t r = 0; r < all.receivers.size(); ++r) {
+      const ReceiverBake& rb = all.receivers[r];
+      ASSERT_EQ(rb.per_light.size(), scene.lights.size()) << rb.name;
+      EXPECT_LE(worst_difference(rb.per_light[l], one.receivers[r].image, rb.covered), 1e-5)
+          << rb.name << ", light " << scene.lights[l].name;
+    }
+  }
+  // And the combined image is the sum of the per-light ones (irradiance).
+  for (const ReceiverBake& rb : all.receivers) {
+    Image sum = rb.per_light[0];
+    for (std::size_t i = 0; i < sum.pixels.size(); ++i) sum.pixels[i] += rb.per_light[1].pixels[i];
+    EXPECT_LE(worst_difference(sum, rb.image, rb.covered), 1e-5) << rb.name;
+  }
+}
+
+// Keeping the per-light images changes nothing in the combined one.
+TEST_P(PerLight, KeepingThemLeavesTheMixAlone) {
+  Scene scene = load("showcase", 32, GetParam());
+  scene.bake.samples = 8;
+  scene.bake.shadow_map = 256;
+  const BakeResult with = bake_or_fail(scene, true), without = bake_or_fail(scene, false);
+  for (std::size_t r = 0; r < with.receivers.size(); ++r) {
+    EXPECT_EQ(with.receivers[r].image.pixels, without.receivers[r].image.pixels);
+    EXPECT_TRUE(without.receivers[r].per_light.empty());
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryMethod, PerLight, ::testing::ValuesIn(known_methods()),
+                         [](const auto& info) {
+                           std::string name = info.param;
+                           std::replace(name.begin(), name.end(), '-', '_');
+                           return name;
+                         });
+
+}  // namespace
+}  // namespace sb
