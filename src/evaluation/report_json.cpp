@@ -1,27 +1,16 @@
 // report.json: the scene's settings, per method its times and summary over receivers, and per
-// receiver and method its metrics and the convolution's predicted penumbra error.
+// receiver and method its metrics (metrics_json.h) and the convolution's predicted penumbra error.
 #include "evaluation/report_json.h"
 
 #include <nlohmann/json.hpp>
 
-#include <cmath>
+#include "evaluation/metrics_json.h"
 
 namespace sb {
 
 namespace {
 
 using json = nlohmann::ordered_json;
-
-// NaN (an empty region) and +inf (a PSNR of identical images) have no JSON number: null.
-json json_number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-
-json region_json(const RegionErrors& region) {
-  const ChannelErrors& e = region.overall;
-  return {{"texels", region.texels},      {"rmse", json_number(e.rmse)},
-          {"mae", json_number(e.mae)},    {"max", json_number(e.max_abs)},
-          {"max_at", {e.max_x, e.max_y}}, {"psnr", json_number(e.psnr)},
-          {"ssim", json_number(e.ssim)}};
-}
 
 json optional_text(const std::string& text) { return text.empty() ? json(nullptr) : json(text); }
 
@@ -70,8 +59,8 @@ json summary_json(const MethodSummary& s) {
 json cell_json(const ReportCell& cell, const std::string& method) {
   json c = {{"method", method}};
   if (cell.comparison) {
-    c["covered"] = region_json(cell.comparison->covered);
-    c["penumbra"] = region_json(cell.comparison->penumbra);
+    c["covered"] = to_json(cell.comparison->covered);
+    c["penumbra"] = to_json(cell.comparison->penumbra);
     c["non_finite_texels"] = cell.comparison->non_finite_a;
     c["image"] = cell.texture;
     c["difference_image"] = cell.difference;

@@ -1,4 +1,5 @@
-// report.json (report_json.cpp): a report's data for scripts; docs/reports.md lists the fields.
+// report.json (report_json.cpp): a report's data for scripts, its comparisons in the encoding
+// compare.json uses (metrics_json.h); docs/reports.md lists the fields.
 #pragma once
 
 #include <filesystem>
