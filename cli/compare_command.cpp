@@ -16,6 +16,7 @@
 #include "commands.h"
 #include "core/image_io.h"
 #include "evaluation/image_metrics.h"
+#include "evaluation/metrics_json.h"
 #include "pipeline/output_folder.h"
 
 namespace sbcli {
@@ -113,34 +114,6 @@ void print_table(const sb::Comparison& c) {
         print_row(fmt::format("  channel {}", ch), r.texels, r.channels[ch]);
     }
   }
-}
-
-// JSON has no NaN or infinity: those are written as null.
-nlohmann::ordered_json json_number(double v) {
-  return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr);
-}
-
-nlohmann::ordered_json json_errors(const sb::ChannelErrors& e) {
-  nlohmann::ordered_json j;
-  j["count"] = e.count;
-  j["rmse"] = json_number(e.rmse);
-  j["mae"] = json_number(e.mae);
-  j["max"] = json_number(e.max_abs);
-  j["max_at"] = e.max_x < 0 ? nlohmann::ordered_json(nullptr)
-                            : nlohmann::ordered_json{
-                                  {"x", e.max_x}, {"y", e.max_y}, {"channel", e.max_channel}};
-  j["psnr"] = json_number(e.psnr);
-  j["ssim"] = json_number(e.ssim);
-  return j;
-}
-
-nlohmann::ordered_json json_region(const sb::RegionErrors& r) {
-  nlohmann::ordered_json j;
-  j["texels"] = r.texels;
-  j["overall"] = json_errors(r.overall);
-  j["channels"] = nlohmann::ordered_json::array();
-  for (const auto& c : r.channels) j["channels"].push_back(json_errors(c));
-  return j;
 }
 
 void warn_non_finite(const std::string& file, std::int64_t texels) {
@@ -242,7 +215,7 @@ int run_compare(const CompareArgs& args) {
     gate_results.push_back({{"metric", gate.metric},
                             {"threshold", gate.threshold},
                             {"fails", gate.fail_below ? "below" : "above"},
-                            {"value", json_number(value)},
+                            {"value", sb::json_number(value)},
                             {"passed", !failed}});
   }
 
@@ -265,8 +238,8 @@ int run_compare(const CompareArgs& args) {
     j["peak"] = c.peak;
     j["penumbra_range"] = {options.penumbra_lo, options.penumbra_hi};
     j["non_finite"] = {{"a", c.non_finite_a}, {"reference", c.non_finite_reference}};
-    j["covered"] = json_region(c.covered);
-    j["penumbra"] = json_region(c.penumbra);
+    j["covered"] = sb::to_json(c.covered);
+    j["penumbra"] = sb::to_json(c.penumbra);
     j["heat_map"] = {{"file", "difference.png"}, {"scale", scale}};
     j["gates"] = gate_results;
 

@@ -137,6 +137,18 @@ TEST(Report, FailedRunKeepsItsErrorAndNamesAreEscaped) {
   const auto& floor = report["receivers"][0]["methods"];
   EXPECT_DOUBLE_EQ(floor[0]["predicted_penumbra_error"]["texels"].get<double>(), 2.5);
   EXPECT_TRUE(floor[0].contains("measured_penumbra_rmse"));
+  // A receiver's metrics are encoded as in compare.json: overall and per channel, the worst
+  // texel with its channel.
+  const auto& floor_covered = floor[0]["covered"];
+  EXPECT_EQ(floor_covered["texels"], 56);
+  EXPECT_NEAR(floor_covered["overall"]["rmse"].get<double>(), 0.1 * std::sqrt(52.0 / 56.0), 1e-5);
+  EXPECT_EQ(floor_covered["channels"].size(), 3u);
+  const auto& worst = floor_covered["overall"]["max_at"];
+  EXPECT_GE(worst["x"].get<int>(), 1);  // column 0 is not covered
+  EXPECT_GE(worst["y"].get<int>(), 0);
+  EXPECT_GE(worst["channel"].get<int>(), 0);
+  EXPECT_LT(worst["channel"].get<int>(), 3);
+  EXPECT_TRUE(floor[0]["penumbra"]["overall"]["max_at"].is_null());  // no penumbra texels
   EXPECT_FALSE(floor[1]["error"].is_null());
 
   const std::string html = slurp(out / "index.html");
