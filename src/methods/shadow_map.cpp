@@ -19,24 +19,11 @@
 #include <cmath>
 #include <numbers>
 
+#include "occluders/depth_clipping.h"
+
 namespace sb {
 
 namespace {
-
-// Sutherland–Hodgman against the near plane: keeps the points with depth >= near.
-std::vector<Vec3> clip_near(const std::vector<Vec3>& poly, const ProjectionFrame& frame,
-                            double near) {
-  std::vector<Vec3> out;
-  out.reserve(poly.size() + 1);
-  for (std::size_t i = 0; i < poly.size(); ++i) {
-    const Vec3& a = poly[i];
-    const Vec3& b = poly[(i + 1) % poly.size()];
-    const double da = frame.depth(a) - near, db = frame.depth(b) - near;
-    if (da >= 0) out.push_back(a);
-    if ((da >= 0) != (db >= 0)) out.push_back(a + (b - a) * (da / (da - db)));
-  }
-  return out;
-}
 
 // A triangle in pixel coordinates, ready to scan: three edge functions that are >= 0 inside,
 // and 1/depth as an affine function of the pixel (exact for a perspective projection).
@@ -130,7 +117,7 @@ ShadowMap render_shadow_map(const std::vector<const Mesh*>& blockers, const Proj
         const auto& p = m->mesh.point(v);
         poly.emplace_back(p[0], p[1], p[2]);
       }
-      poly = clip_near(poly, frame, near);
+      poly = clip_to_depth(poly, frame, near, KeepDepth::at_least);
       if (poly.size() < 3) continue;
       std::vector<Vec2> pixels(poly.size());
       std::vector<double> inverse(poly.size());
