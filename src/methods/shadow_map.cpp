@@ -17,9 +17,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <numbers>
+#include <optional>
 
 #include "occluders/depth_clipping.h"
+#include "occluders/light_frusta.h"
 
 namespace sb {
 
@@ -89,10 +90,6 @@ void scan_row(const ScreenTriangle& t, int y, int size, float* row) {
 
 constexpr int kBandRows = 16;  // rows per parallel task; each task owns its rows outright
 
-// The widest angle, from the light's centre, between a receiver point and its frustum's axis
-// that one frustum serves; the convolution method splits at the same angle (tan 60° = 1.7).
-constexpr double kMaxFrustumHalfAngleDeg = 60.0;
-
 // The depth bias beyond the receiver's own plane, in shadow-map pixels' world footprints at the
 // receiver's depth (shadow_map.h says why one is enough).
 constexpr double kBiasPixels = 1.0;
@@ -158,34 +155,18 @@ std::vector<ShadowFrustum> fit_frusta(const Vec3& centre, const std::vector<Vec3
                                       double margin) {
   std::vector<ShadowFrustum> frusta;
   if (points.empty()) return frusta;
-  Bounds3 bounds;
-  for (const Vec3& p : points) bounds.extend(p);
-  const ProjectionFrame central = frame_towards(centre, bounds.centre());
-  double widest = 1.0;  // the smallest cosine between a point and the axis
-  for (const Vec3& p : points) {
-    const Vec3 d = p - centre;
-    const double len = d.norm();
-    widest = std::min(widest, len > 0 ? d.dot(central.axis) / len : 1.0);
-  }
-  if (widest >= std::cos(kMaxFrustumHalfAngleDeg * std::numbers::pi / 180.0)) {
-    frusta.push_back({central, 1.0, 0.0, {}, ""});
+  if (const std::optional<ProjectionFrame> central = central_frustum(centre, points)) {
+    frusta.push_back({*central, 1.0, 0.0, {}, ""});
     frusta[0].points.resize(points.size());
     for (std::size_t i = 0; i < points.size(); ++i) frusta[0].points[i] = i;
   } else {
-    static const char* kFaces[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
-    std::array<std::vector<std::size_t>, 6> faces;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      const Vec3 d = points[i] - centre;
-      int axis;
-      d.cwiseAbs().maxCoeff(&axis);
-      faces[2 * axis + (d[axis] < 0 ? 1 : 0)].push_back(i);
-    }
-    for (int f = 0; f < 6; ++f) {
+    std::array<std::vector<std::size_t>, kCubeFaces> faces;
+    for (std::size_t i = 0; i < points.size(); ++i)
+      faces[cube_face(centre, points[i])].push_back(i);
+    for (int f = 0; f < kCubeFaces; ++f) {
       if (faces[f].empty()) continue;
-      Vec3 axis = Vec3::Zero();
-      axis[f / 2] = f % 2 ? -1.0 : 1.0;
       frusta.push_back(
-          {frame_towards(centre, centre + axis), 1.0, 0.0, std::move(faces[f]), kFaces[f]});
+          {cube_face_frame(centre, f), 1.0, 0.0, std::move(faces[f]), cube_face_name(f)});
     }
   }
   for (ShadowFrustum& f : frusta) {
