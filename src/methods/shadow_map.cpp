@@ -21,6 +21,7 @@
 
 #include "occluders/depth_clipping.h"
 #include "occluders/light_frusta.h"
+#include "occluders/tangent_bounds.h"
 
 namespace sb {
 
@@ -170,14 +171,15 @@ std::vector<ShadowFrustum> fit_frusta(const Vec3& centre, const std::vector<Vec3
     }
   }
   for (ShadowFrustum& f : frusta) {
-    double widest_tangent = 0, closest = std::numeric_limits<double>::infinity();
+    TangentBounds tangents;
+    double closest = std::numeric_limits<double>::infinity();
     for (std::size_t i : f.points) {
       const double depth = f.frame.depth(points[i]);
       if (depth <= 0) continue;  // at the light's centre: the caller leaves it unshadowed
       closest = std::min(closest, depth);
-      widest_tangent = std::max(widest_tangent, f.frame.tangent(points[i]).cwiseAbs().maxCoeff());
+      tangents.extend(f.frame.tangent(points[i]));
     }
-    f.half_extent = std::max(widest_tangent * (1 + margin), 1e-6);
+    f.half_extent = std::max(tangents.widest() * (1 + margin), 1e-6);
     // Blocker parts nearer than this are clipped: projecting a point at depth ≈ 0 would throw
     // it to infinity. A thousandth of the nearest receiver point's depth, as the convolution.
     f.near = std::isfinite(closest) ? std::max(1e-3 * closest, 1e-9) : 1e-9;

@@ -16,6 +16,7 @@
 #include <limits>
 
 #include "occluders/depth_clipping.h"
+#include "occluders/tangent_bounds.h"
 
 namespace sb {
 
@@ -142,11 +143,9 @@ ProjectedBlockers project_faces(const std::vector<FaceRef>& faces, const Project
       pg.inverse_depth =
           Vec3(normal.dot(frame.e1), normal.dot(frame.e2), normal.dot(frame.axis)) / h;
     }
-    pg.lo = pg.hi = pg.points[0];
-    for (const Vec2& p : pg.points) {
-      pg.lo = pg.lo.cwiseMin(p);
-      pg.hi = pg.hi.cwiseMax(p);
-    }
+    const TangentBounds bounds = tangent_bounds(pg.points);
+    pg.lo = bounds.lo;
+    pg.hi = bounds.hi;
     out.polygons.push_back(std::move(pg));
   }
   return out;
