@@ -154,7 +154,7 @@ MethodSummary summarise(const std::vector<ReceiverReport>& receivers, std::size_
 // Compares every method with the reference on the receiver of the reference manifest's `entry`,
 // staging its images.
 Expected<ReceiverReport> compare_receiver(const json& entry, const MethodRun& reference,
-                                          const std::vector<MethodReport>& methods,
+                                          const std::vector<MethodSection>& methods,
                                           const std::vector<json>& manifests, bool irradiance,
                                           ImageStager& images) {
   ReceiverReport receiver;

@@ -17,26 +17,15 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <numbers>
+#include <optional>
+
+#include "occluders/depth_clipping.h"
+#include "occluders/light_frusta.h"
+#include "occluders/tangent_bounds.h"
 
 namespace sb {
 
 namespace {
-
-// Sutherland–Hodgman against the near plane: keeps the points with depth >= near.
-std::vector<Vec3> clip_near(const std::vector<Vec3>& poly, const ProjectionFrame& frame,
-                            double near) {
-  std::vector<Vec3> out;
-  out.reserve(poly.size() + 1);
-  for (std::size_t i = 0; i < poly.size(); ++i) {
-    const Vec3& a = poly[i];
-    const Vec3& b = poly[(i + 1) % poly.size()];
-    const double da = frame.depth(a) - near, db = frame.depth(b) - near;
-    if (da >= 0) out.push_back(a);
-    if ((da >= 0) != (db >= 0)) out.push_back(a + (b - a) * (da / (da - db)));
-  }
-  return out;
-}
 
 // A triangle in pixel coordinates, ready to scan: three edge functions that are >= 0 inside,
 // and 1/depth as an affine function of the pixel (exact for a perspective projection).
@@ -102,10 +91,6 @@ void scan_row(const ScreenTriangle& t, int y, int size, float* row) {
 
 constexpr int kBandRows = 16;  // rows per parallel task; each task owns its rows outright
 
-// The widest angle, from the light's centre, between a receiver point and its frustum's axis
-// that one frustum serves; the convolution method splits at the same angle (tan 60° = 1.7).
-constexpr double kMaxFrustumHalfAngleDeg = 60.0;
-
 // The depth bias beyond the receiver's own plane, in shadow-map pixels' world footprints at the
 // receiver's depth (shadow_map.h says why one is enough).
 constexpr double kBiasPixels = 1.0;
@@ -130,7 +115,7 @@ ShadowMap render_shadow_map(const std::vector<const Mesh*>& blockers, const Proj
         const auto& p = m->mesh.point(v);
         poly.emplace_back(p[0], p[1], p[2]);
       }
-      poly = clip_near(poly, frame, near);
+      poly = clip_to_depth(poly, frame, near, KeepDepth::at_least);
       if (poly.size() < 3) continue;
       std::vector<Vec2> pixels(poly.size());
       std::vector<double> inverse(poly.size());
@@ -171,45 +156,30 @@ std::vector<ShadowFrustum> fit_frusta(const Vec3& centre, const std::vector<Vec3
                                       double margin) {
   std::vector<ShadowFrustum> frusta;
   if (points.empty()) return frusta;
-  Bounds3 bounds;
-  for (const Vec3& p : points) bounds.extend(p);
-  const ProjectionFrame central = frame_towards(centre, bounds.centre());
-  double widest = 1.0;  // the smallest cosine between a point and the axis
-  for (const Vec3& p : points) {
-    const Vec3 d = p - centre;
-    const double len = d.norm();
-    widest = std::min(widest, len > 0 ? d.dot(central.axis) / len : 1.0);
-  }
-  if (widest >= std::cos(kMaxFrustumHalfAngleDeg * std::numbers::pi / 180.0)) {
-    frusta.push_back({central, 1.0, 0.0, {}, ""});
+  if (const std::optional<ProjectionFrame> central = central_frustum(centre, points)) {
+    frusta.push_back({*central, 1.0, 0.0, {}, ""});
     frusta[0].points.resize(points.size());
     for (std::size_t i = 0; i < points.size(); ++i) frusta[0].points[i] = i;
   } else {
-    static const char* kFaces[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
-    std::array<std::vector<std::size_t>, 6> faces;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      const Vec3 d = points[i] - centre;
-      int axis;
-      d.cwiseAbs().maxCoeff(&axis);
-      faces[2 * axis + (d[axis] < 0 ? 1 : 0)].push_back(i);
-    }
-    for (int f = 0; f < 6; ++f) {
+    std::array<std::vector<std::size_t>, kCubeFaces> faces;
+    for (std::size_t i = 0; i < points.size(); ++i)
+      faces[cube_face(centre, points[i])].push_back(i);
+    for (int f = 0; f < kCubeFaces; ++f) {
       if (faces[f].empty()) continue;
-      Vec3 axis = Vec3::Zero();
-      axis[f / 2] = f % 2 ? -1.0 : 1.0;
       frusta.push_back(
-          {frame_towards(centre, centre + axis), 1.0, 0.0, std::move(faces[f]), kFaces[f]});
+          {cube_face_frame(centre, f), 1.0, 0.0, std::move(faces[f]), cube_face_name(f)});
     }
   }
   for (ShadowFrustum& f : frusta) {
-    double widest_tangent = 0, closest = std::numeric_limits<double>::infinity();
+    TangentBounds tangents;
+    double closest = std::numeric_limits<double>::infinity();
     for (std::size_t i : f.points) {
       const double depth = f.frame.depth(points[i]);
       if (depth <= 0) continue;  // at the light's centre: the caller leaves it unshadowed
       closest = std::min(closest, depth);
-      widest_tangent = std::max(widest_tangent, f.frame.tangent(points[i]).cwiseAbs().maxCoeff());
+      tangents.extend(f.frame.tangent(points[i]));
     }
-    f.half_extent = std::max(widest_tangent * (1 + margin), 1e-6);
+    f.half_extent = std::max(tangents.widest() * (1 + margin), 1e-6);
     // Blocker parts nearer than this are clipped: projecting a point at depth ≈ 0 would throw
     // it to infinity. A thousandth of the nearest receiver point's depth, as the convolution.
     f.near = std::isfinite(closest) ? std::max(1e-3 * closest, 1e-9) : 1e-9;

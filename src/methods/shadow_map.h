@@ -8,10 +8,10 @@
 #include <limits>
 #include <vector>
 
-#include "methods/baselines.h"
 #include "core/geometry.h"
-#include "scene/mesh.h"
+#include "methods/baselines.h"
 #include "occluders/virtual_configuration.h"
+#include "scene/mesh.h"
 
 namespace sb {
 
@@ -55,9 +55,10 @@ struct ShadowFrustum {
 };
 
 // The frusta that cover `points` (receiver positions lit by a light centred at `centre`), like
-// the convolution method's: one frustum with its axis towards the middle of their bounding box
-// when every point lies within 60° of that axis, otherwise the six faces of a cube around the
-// light, each point to the face of its dominant direction. Each square frustum is fitted to its
+// the convolution method's (occluders/light_frusta.h): one frustum with its axis towards the
+// middle of their bounding box when every point lies within kMaxFrustumHalfAngleDeg (60°) of
+// that axis, otherwise the six faces of a cube around the light, each point to the face of its
+// dominant direction. Each square frustum is fitted to its
 // points' largest tangent coordinate and widened by `margin` (a fraction) so that the filters'
 // footprints around the outermost points stay inside it.
 std::vector<ShadowFrustum> fit_frusta(const Vec3& centre, const std::vector<Vec3>& points,

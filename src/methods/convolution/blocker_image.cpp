@@ -15,24 +15,12 @@
 #include <cmath>
 #include <limits>
 
+#include "occluders/depth_clipping.h"
+#include "occluders/tangent_bounds.h"
+
 namespace sb {
 
 namespace {
-
-// Sutherland–Hodgman against one plane: keeps the points with sign·(depth − limit) >= 0.
-std::vector<Vec3> clip_depth(const std::vector<Vec3>& poly, const ProjectionFrame& frame,
-                             double limit, double sign) {
-  std::vector<Vec3> out;
-  out.reserve(poly.size() + 1);
-  for (std::size_t i = 0; i < poly.size(); ++i) {
-    const Vec3& a = poly[i];
-    const Vec3& b = poly[(i + 1) % poly.size()];
-    const double da = sign * (frame.depth(a) - limit), db = sign * (frame.depth(b) - limit);
-    if (da >= 0) out.push_back(a);
-    if ((da >= 0) != (db >= 0)) out.push_back(a + (b - a) * (da / (da - db)));
-  }
-  return out;
-}
 
 constexpr int kSamplesPerSide = 4;  // 16 samples: one bit each of a uint16_t
 
@@ -128,8 +116,8 @@ ProjectedBlockers project_faces(const std::vector<FaceRef>& faces, const Project
         if (lowest >= -1e-6 * scale) continue;  // light and receiver on one side
       }
     }
-    std::vector<Vec3> clipped = clip_depth(poly, frame, near, +1.0);
-    if (clipped.size() >= 3) clipped = clip_depth(clipped, frame, far, -1.0);
+    std::vector<Vec3> clipped = clip_to_depth(poly, frame, near, KeepDepth::at_least);
+    if (clipped.size() >= 3) clipped = clip_to_depth(clipped, frame, far, KeepDepth::at_most);
     if (clipped.size() < 3) continue;
     ProjectedBlockers::Polygon pg;
     pg.source = int(i);
@@ -152,13 +140,12 @@ ProjectedBlockers project_faces(const std::vector<FaceRef>& faces, const Project
     // 1/depth along the ray o + λ(D + t1·e1 + t2·e2) meeting the plane n·(x − p0) = 0.
     const double h = normal.dot(poly[0] - frame.origin);
     if (std::abs(h) > 0) {
-      pg.inverse_depth = Vec3(normal.dot(frame.e1), normal.dot(frame.e2), normal.dot(frame.axis)) / h;
+      pg.inverse_depth =
+          Vec3(normal.dot(frame.e1), normal.dot(frame.e2), normal.dot(frame.axis)) / h;
     }
-    pg.lo = pg.hi = pg.points[0];
-    for (const Vec2& p : pg.points) {
-      pg.lo = pg.lo.cwiseMin(p);
-      pg.hi = pg.hi.cwiseMax(p);
-    }
+    const TangentBounds bounds = tangent_bounds(pg.points);
+    pg.lo = bounds.lo;
+    pg.hi = bounds.hi;
     out.polygons.push_back(std::move(pg));
   }
   return out;
@@ -215,7 +202,7 @@ std::vector<float> nearest_layer_coverage(const ProjectedBlockers& layer,
   constexpr int kS = kSamplesPerSide * kSamplesPerSide;
   constexpr int kBand = 8;
   tbb::parallel_for(tbb::blocked_range<int>(0, (my1 - my0) / kBand + 1), [&](const auto& bands) {
-    std::vector<float> nearest;      // per sample: largest 1/depth so far
+    std::vector<float> nearest;       // per sample: largest 1/depth so far
     std::vector<std::uint8_t> owner;  // per sample: whether that polygon is mine
     for (int band = bands.begin(); band != bands.end(); ++band) {
       const int row0 = my0 + band * kBand, row1 = std::min(my1 + 1, row0 + kBand);
@@ -240,8 +227,9 @@ std::vector<float> nearest_layer_coverage(const ProjectedBlockers& layer,
             const float corner =
                 float(r.inverse_depth.x() * x + r.inverse_depth.y() * y + r.inverse_depth.z());
             for (int k = 0; k < kS; ++k) {
-              if (cls == 0 && !px_poly.edges.contains(x + (k % kSamplesPerSide + 0.5) / kSamplesPerSide,
-                                                      y + (k / kSamplesPerSide + 0.5) / kSamplesPerSide))
+              if (cls == 0 &&
+                  !px_poly.edges.contains(x + (k % kSamplesPerSide + 0.5) / kSamplesPerSide,
+                                          y + (k / kSamplesPerSide + 0.5) / kSamplesPerSide))
                 continue;
               const float inv = corner + sample_inv[std::size_t(k)];
               if (inv > nearest[base + std::size_t(k)]) {
@@ -310,7 +298,8 @@ std::vector<float> blocker_coverage(const ProjectedBlockers& blockers, const Tan
               for (int sx = 0; sx < kSamplesPerSide; ++sx) {
                 const double px = x + (sx + 0.5) / kSamplesPerSide;
                 const double py = y + (sy + 0.5) / kSamplesPerSide;
-                if (r.edges.contains(px, py)) bits |= std::uint16_t(1u << (sy * kSamplesPerSide + sx));
+                if (r.edges.contains(px, py))
+                  bits |= std::uint16_t(1u << (sy * kSamplesPerSide + sx));
               }
             }
             mask |= bits;

@@ -41,8 +41,8 @@
 #include <queue>
 #include <tuple>
 
-#include "occluders/clusters.h"
 #include "methods/convolution/source_image.h"
+#include "occluders/clusters.h"
 
 namespace sb {
 
@@ -82,14 +82,11 @@ double ConvolutionPlan::estimated_cost() const {
 void TexelIndex::build(const std::vector<int>& texels, const std::vector<Vec2>& tangent,
                        const std::vector<double>& depth, const std::vector<Vec3>& position) {
   if (texels.empty()) return;
-  Vec2 hi = tangent[std::size_t(texels[0])];
-  lo = hi;
-  for (int i : texels) {
-    lo = lo.cwiseMin(tangent[std::size_t(i)]);
-    hi = hi.cwiseMax(tangent[std::size_t(i)]);
-  }
+  TangentBounds bounds;
+  for (int i : texels) bounds.extend(tangent[std::size_t(i)]);
+  lo = bounds.lo;
   // About 16 texels per cell.
-  const Vec2 span = (hi - lo).cwiseMax(1e-12);
+  const Vec2 span = (bounds.hi - lo).cwiseMax(1e-12);
   cell = std::sqrt(span.x() * span.y() * 16.0 / double(texels.size()));
   cell = std::max({cell, span.maxCoeff() / 4096.0, 1e-12});
   nx = std::max(1, int(span.x() / cell) + 1);
@@ -107,14 +104,9 @@ void TexelIndex::build(const std::vector<int>& texels, const std::vector<Vec2>& 
   std::vector<int> fill(start.begin(), start.end() - 1);
   for (int i : texels) items[std::size_t(fill[cell_of(i)]++)] = i;
   cells.assign(std::size_t(nx) * ny, Cell{});
-  for (auto& c : cells) {
-    c.lo = Vec2::Constant(std::numeric_limits<double>::infinity());
-    c.hi = -c.lo;
-  }
   for (int i : texels) {
     Cell& c = cells[cell_of(i)];
-    c.lo = c.lo.cwiseMin(tangent[std::size_t(i)]);
-    c.hi = c.hi.cwiseMax(tangent[std::size_t(i)]);
+    c.tangents.extend(tangent[std::size_t(i)]);
     c.depth.extend(depth[std::size_t(i)]);
     c.box.extend(position[std::size_t(i)]);
     ++c.count;
@@ -122,17 +114,12 @@ void TexelIndex::build(const std::vector<int>& texels, const std::vector<Vec2>& 
   bx = (nx + kBlock - 1) / kBlock;
   by = (ny + kBlock - 1) / kBlock;
   blocks.assign(std::size_t(bx) * by, Cell{});
-  for (auto& b : blocks) {
-    b.lo = Vec2::Constant(std::numeric_limits<double>::infinity());
-    b.hi = -b.lo;
-  }
   for (int y = 0; y < ny; ++y) {
     for (int x = 0; x < nx; ++x) {
       const Cell& c = cells[std::size_t(y) * nx + x];
       if (c.count == 0) continue;
       Cell& b = blocks[std::size_t(y / kBlock) * bx + x / kBlock];
-      b.lo = b.lo.cwiseMin(c.lo);
-      b.hi = b.hi.cwiseMax(c.hi);
+      b.tangents.extend(c.tangents);
       b.depth.extend(c.depth.lo);
       b.depth.extend(c.depth.hi);
       b.box.extend(c.box.lo);
@@ -204,22 +191,20 @@ void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& 
   if (t.blockers.polygons.empty()) return;
   if (!t.layer) t.layer = std::make_shared<const ProjectedBlockers>(t.blockers);
   DepthRange blocker_depths;
-  Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  TangentBounds projection;
   for (const auto& pg : t.blockers.polygons) {
     blocker_depths.extend(pg.depth_lo);
     blocker_depths.extend(pg.depth_hi);
-    lo = lo.cwiseMin(pg.lo);
-    hi = hi.cwiseMax(pg.hi);
+    projection.extend(TangentBounds{pg.lo, pg.hi});
   }
   // The footprint: the blockers' projection grown by the widest penumbra they can cast on the
   // part, k_max times the light's half extents (tangent units).
-  t.view = 0.5 * (lo + hi);
+  t.view = projection.centre();
   const Vec2 half = projected_half_extents(light, fr.frame, t.view, part_depth_hi);
   const double k_max = std::max(0.0, 1.0 / blocker_depths.lo - 1.0 / part_depth_hi);
-  lo -= half * k_max;
-  hi += half * k_max;
+  const Vec2 lo = projection.lo - half * k_max, hi = projection.hi + half * k_max;
   DepthRange receiver_depths;
-  Vec2 tlo = Vec2::Constant(std::numeric_limits<double>::infinity()), thi = -tlo;
+  TangentBounds footprint;
   Bounds3 box;
   const double d_floor = blocker_depths.lo;
   fr.index[std::size_t(t.group)].for_each_cell(
@@ -230,8 +215,7 @@ void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& 
       [&](const TexelIndex::Cell& c) {
         receiver_depths.extend(c.depth.lo);
         receiver_depths.extend(c.depth.hi);
-        tlo = tlo.cwiseMin(c.lo);
-        thi = thi.cwiseMax(c.hi);
+        footprint.extend(c.tangents);
         box.extend(c.box.lo);
         box.extend(c.box.hi);
         t.footprint_texels += c.count;
@@ -242,8 +226,7 @@ void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& 
         const Vec2& tc = fr.tangent[i];
         if ((tc.array() < lo.array()).any() || (tc.array() > hi.array()).any()) return;
         receiver_depths.extend(d);
-        tlo = tlo.cwiseMin(tc);
-        thi = thi.cwiseMax(tc);
+        footprint.extend(tc);
         box.extend(fr.position[std::size_t(i)]);
         ++t.footprint_texels;
       });
@@ -252,12 +235,13 @@ void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& 
   t.receiver_box = box;
   t.blocker_depths = blocker_depths;
   t.receiver_depths = receiver_depths;
-  t.footprint_lo = tlo;
-  t.footprint_hi = thi;
+  t.footprint_lo = footprint.lo;
+  t.footprint_hi = footprint.hi;
   const double extent = light.extent_across(fr.frame.axis);
   t.config = choose_configuration(fr.frame, blocker_depths, receiver_depths, extent);
   t.smallest_penumbra = extent * (t.config.rho_lo - 1.0);
-  const Vec2 reach = (tlo - t.view).cwiseAbs().cwiseMax((thi - t.view).cwiseAbs());
+  const Vec2 reach =
+      (footprint.lo - t.view).cwiseAbs().cwiseMax((footprint.hi - t.view).cwiseAbs());
   t.view_error = depth_half_spread(light, fr.frame) * reach.norm() * (t.config.rho_hi - 1.0);
   const double scale = std::max(plan.texel, t.smallest_penumbra / kRelativeSpan);
   t.penumbra_error_texels = scale > 0 ? (t.config.penumbra_error + t.view_error) / scale : 0;
@@ -267,10 +251,11 @@ void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& 
   // resolution"); then within max_image, flagging any loss of detail.
   const double r_star = t.config.receiver_plane;
   const double detail = std::max(plan.texel, t.smallest_penumbra / kPenumbraPixels);
-  double pixel = (plan.texel > 0 ? detail : (thi - tlo).maxCoeff() / 512) / r_star;
+  double pixel =
+      (plan.texel > 0 ? detail : (footprint.hi - footprint.lo).maxCoeff() / 512) / r_star;
   const double k = std::max(0.0, 1.0 / t.config.blocker_plane - 1.0 / r_star);
   const Vec2 kernel_extent = 2 * k * projected_half_extents(light, fr.frame, t.view, r_star);
-  const Vec2 span = thi - tlo;
+  const Vec2 span = footprint.hi - footprint.lo;
   const double needed = (span + kernel_extent).maxCoeff();
   if (needed / pixel + 8 > in.max_image) {
     pixel = needed / (in.max_image - 8);
@@ -286,7 +271,7 @@ void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& 
     const int kernel_h = 2 * int(std::ceil(kernel_extent.y() / (2 * at))) + 1;
     const int margin_x = kernel_w / 2 + 1, margin_y = kernel_h / 2 + 1;
     t.grid.pixel = at;
-    t.grid.origin = tlo - Vec2(margin_x, margin_y) * at;
+    t.grid.origin = footprint.lo - Vec2(margin_x, margin_y) * at;
     t.grid.width = int(std::ceil(span.x() / at)) + 2 * margin_x + 1;
     t.grid.height = int(std::ceil(span.y() / at)) + 2 * margin_y + 1;
     t.fft_width = in.backend->transform_size(t.grid.width);
@@ -448,13 +433,11 @@ class Planner {
     // keeps each side's solids whole for add_sections.
     if (polys.size() >= 2) {
       std::vector<Vec2> centroid(polys.size());
-      Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-      for (std::size_t i = 0; i < polys.size(); ++i) {
+      for (std::size_t i = 0; i < polys.size(); ++i)
         centroid[i] = 0.5 * (polys[i].lo + polys[i].hi);
-        lo = lo.cwiseMin(centroid[i]);
-        hi = hi.cwiseMax(centroid[i]);
-      }
-      const int axis = (hi - lo).x() >= (hi - lo).y() ? 0 : 1;
+      const TangentBounds centroids = tangent_bounds(centroid);
+      const Vec2 span = centroids.hi - centroids.lo;
+      const int axis = span.x() >= span.y() ? 0 : 1;
       // Per polygon, its component's index among those present.
       std::vector<int> part(polys.size(), 0);
       std::vector<Vec2> part_centroid;
@@ -500,7 +483,7 @@ class Planner {
           (first[std::size_t(part[std::size_t(p)])] ? near_side : far_side).push_back(p);
         add(near_side, far_side);
       }
-      if (hi[axis] > lo[axis]) {
+      if (centroids.hi[axis] > centroids.lo[axis]) {
         std::vector<int> order = all;
         const auto middle = order.begin() + std::ptrdiff_t(order.size() / 2);
         std::nth_element(order.begin(), middle, order.end(),

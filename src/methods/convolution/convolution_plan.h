@@ -15,10 +15,11 @@
 
 #include "methods/convolution/blocker_image.h"
 #include "methods/convolution/convolution_backend.h"
+#include "occluders/tangent_bounds.h"
+#include "occluders/virtual_configuration.h"
 #include "scene/lights.h"
 #include "scene/mesh.h"
 #include "texels/texel_space.h"
-#include "occluders/virtual_configuration.h"
 
 namespace sb {
 
@@ -147,7 +148,7 @@ struct TexelIndex {
   // Per cell: the bounds of its texels' tangents, depths and positions, and their count, so a
   // footprint that holds a whole cell takes it at once (for_each_cell).
   struct Cell {
-    Vec2 lo, hi;
+    TangentBounds tangents;
     DepthRange depth;
     Bounds3 box;
     int count = 0;
@@ -173,8 +174,8 @@ struct TexelIndex {
     const int y1 = std::min(ny - 1, int((box_hi.y() - lo.y()) / this->cell));
     if (x0 > x1 || y0 > y1) return;
     auto inside = [&](const Cell& k) {
-      return (k.lo.array() >= box_lo.array()).all() && (k.hi.array() <= box_hi.array()).all() &&
-             whole(k);
+      return (k.tangents.lo.array() >= box_lo.array()).all() &&
+             (k.tangents.hi.array() <= box_hi.array()).all() && whole(k);
     };
     for (int yb = y0 / kBlock; yb <= y1 / kBlock; ++yb) {
       for (int xb = x0 / kBlock; xb <= x1 / kBlock; ++xb) {

@@ -1,23 +1,21 @@
 // Frames, texel groups and root triples of a convolution plan (design-notes §3): which frustum
 // from a light part's centre serves which receiver texels, which texels share their blockers,
-// and which blocker faces lie in the shaft between the light and each group. Split from
-// convolution_plan.cpp, which refines the roots made here.
+// and which blocker faces lie in the shaft between the light and each group. convolution_plan.cpp
+// refines the roots made here.
 #include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <optional>
+#include <ranges>
 
-#include "occluders/clusters.h"
 #include "methods/convolution/convolution_plan.h"
+#include "occluders/clusters.h"
+#include "occluders/light_frusta.h"
 
 namespace sb {
 
 namespace {
-
-// The widest angle, from the light's centre, between a receiver's texels and its frustum's axis
-// that one projection serves; beyond it the tangent plane stretches without bound (tan 60° = 1.7;
-// each leaf sizes its own pixels, so the stretch costs image size, not accuracy).
-constexpr double kMaxFrustumHalfAngleDeg = 60.0;
 
 // Points whose convex hull holds the light: the shaft's light end.
 std::vector<Vec3> light_outline(const Light& light) {
@@ -187,7 +185,6 @@ void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part) {
     std::vector<std::pair<int, std::vector<std::size_t>>> members;
   };
   std::vector<FrameGroups> frames;
-  Bounds3 rest_bounds;
   std::vector<int> rest;
   for (std::size_t g = 0; g < groups.size(); ++g) {
     if (groups[g].planar) {
@@ -198,43 +195,35 @@ void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part) {
       frames.push_back(std::move(f));
     } else {
       rest.push_back(int(g));
-      for (std::size_t t : groups[g].texels) rest_bounds.extend(position(t));
     }
   }
   if (!rest.empty()) {
-    const ProjectionFrame central = frame_towards(light.centre(), rest_bounds.centre());
-    double widest = 1.0;
-    for (int g : rest) {
-      for (std::size_t t : groups[std::size_t(g)].texels) {
-        const Vec3 d = position(t) - light.centre();
-        const double len = d.norm();
-        widest = std::min(widest, len > 0 ? d.dot(central.axis) / len : 1.0);
-      }
-    }
-    if (widest >= std::cos(kMaxFrustumHalfAngleDeg * std::numbers::pi / 180.0)) {
+    auto rest_positions = rest |
+                          std::views::transform([&](int g) -> const std::vector<std::size_t>& {
+                            return groups[std::size_t(g)].texels;
+                          }) |
+                          std::views::join | std::views::transform(position);
+    // Each leaf sizes its own pixels, so the tangent plane's stretch towards the widest angle
+    // costs image size, not accuracy.
+    if (const std::optional<ProjectionFrame> central =
+            central_frustum(light.centre(), rest_positions)) {
       FrameGroups f;
-      f.frame.frame = central;
+      f.frame.frame = *central;
       for (int g : rest) f.members.emplace_back(g, groups[std::size_t(g)].texels);
       frames.push_back(std::move(f));
     } else {
-      static const char* kFaces[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
       const std::size_t first = frames.size();
-      for (int face = 0; face < 6; ++face) {
-        Vec3 axis = Vec3::Zero();
-        axis[face / 2] = face % 2 ? -1.0 : 1.0;
+      for (int face = 0; face < kCubeFaces; ++face) {
         FrameGroups f;
-        f.frame.frame = frame_towards(light.centre(), light.centre() + axis);
-        f.frame.face = kFaces[face];
+        f.frame.frame = cube_face_frame(light.centre(), face);
+        f.frame.face = cube_face_name(face);
         for (int g : rest) f.members.emplace_back(g, std::vector<std::size_t>{});
         frames.push_back(std::move(f));
       }
       for (std::size_t r = 0; r < rest.size(); ++r) {
         for (std::size_t t : groups[std::size_t(rest[r])].texels) {
-          const Vec3 d = position(t) - light.centre();
-          int axis;
-          d.cwiseAbs().maxCoeff(&axis);
-          frames[first + 2 * std::size_t(axis) + (d[axis] < 0 ? 1 : 0)].members[r].second.push_back(
-              t);
+          const int face = cube_face(light.centre(), position(t));
+          frames[first + std::size_t(face)].members[r].second.push_back(t);
         }
       }
     }

@@ -1,17 +1,17 @@
 // Convex closed solids in a plan (add_sections, convolution_plan.h): which triples are slabs
 // of such solids, and the section leaves between their slabs, so that the bake can count the
-// light each solid hides by Euler's formula (convolution_bake.cpp, docs/methods.md). Split from
-// convolution_plan.cpp, whose planner makes the trees this walks.
+// light each solid hides by Euler's formula (convolution_bake.cpp, docs/methods.md). The planner
+// in convolution_plan.cpp makes the trees this walks.
 #include <algorithm>
 #include <cstdint>
-#include <limits>
 #include <map>
 #include <memory>
 #include <vector>
 
-#include "occluders/clusters.h"
 #include "methods/convolution/convolution_plan.h"
 #include "methods/convolution/source_image.h"
+#include "occluders/clusters.h"
+#include "occluders/tangent_bounds.h"
 
 namespace sb {
 
@@ -22,7 +22,8 @@ void add_sections(ConvolutionPlan& plan, const PlanInputs& in) {
   for (std::size_t m = 0; m < in.blockers.size(); ++m) mesh_index.emplace(in.blockers[m], int(m));
   using Component = std::pair<int, int>;  // (mesh, connected component)
   std::map<Component, int> root_of;       // its cluster tree's root node
-  for (int r : tree.roots) root_of.emplace(Component(tree.nodes[r].mesh, tree.nodes[r].component), r);
+  for (int r : tree.roots)
+    root_of.emplace(Component(tree.nodes[r].mesh, tree.nodes[r].component), r);
   auto component_of = [&](const FaceRef& f) {
     const int m = mesh_index.at(f.mesh);
     return Component(m, tree.face_component[std::size_t(m)][std::size_t(f.face)]);
@@ -88,12 +89,8 @@ void add_sections(ConvolutionPlan& plan, const PlanInputs& in) {
                          (1.0 / t.blocker_depths.lo - 1.0 / t.blocker_depths.hi);
       std::vector<std::pair<Vec2, Vec2>> boxes;
       for (int root : roots) {
-        Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-        for (const Vec3& p : tree.nodes[std::size_t(root)].hull) {
-          lo = lo.cwiseMin(fr.frame.tangent(p));
-          hi = hi.cwiseMax(fr.frame.tangent(p));
-        }
-        boxes.emplace_back(lo - reach, hi + reach);
+        const TangentBounds hull = tangent_bounds(fr.frame, tree.nodes[std::size_t(root)].hull);
+        boxes.emplace_back(hull.lo - reach, hull.hi + reach);
       }
       for (std::size_t a = 0; a < boxes.size() && solid; ++a)
         for (std::size_t b = a + 1; b < boxes.size() && solid; ++b)
