@@ -1,5 +1,5 @@
 // How every method combines lights into a receiver's texel values, and keeps each light's own
-// values for per-light outputs. The rule is the reference's (docs/methods.md, "Several lights"):
+// values for per-light outputs. The rule is the reference's (docs/methods.md, its opening):
 // per texel and colour channel, light l's visibility V_l is weighted by its unoccluded
 // irradiance H0_l (closed form, Light::unoccluded_irradiance); a light with H0_l = 0 there, or
 // one the method leaves out at the texel (none of its samples contributes), adds nothing; then
