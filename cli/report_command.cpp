@@ -8,8 +8,6 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
@@ -24,6 +22,7 @@
 
 #include "commands.h"
 #include "evaluation/report.h"
+#include "pipeline/manifest.h"
 #include "scene/scene.h"
 
 extern char** environ;
@@ -108,15 +107,12 @@ ChildResult run_bake_child(const std::vector<std::string>& args, const fs::path&
     result.error = fmt::format("{} (exit code {})", why, WEXITSTATUS(status));
     return result;
   }
-  const fs::path manifest_path = folder / "manifest.json";
-  std::ifstream in(manifest_path, std::ios::binary);
-  const auto manifest = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-  if (manifest.is_discarded() || !manifest.contains("bake_seconds") ||
-      !manifest["bake_seconds"].is_number()) {
-    result.error = manifest_path.string() + ": no bake_seconds in the bake's manifest";
+  const auto manifest = sb::read_manifest(folder);
+  if (!manifest) {
+    result.error = manifest.error().message;
     return result;
   }
-  result.bake_seconds = manifest["bake_seconds"].get<double>();
+  result.bake_seconds = manifest->bake_seconds;
   return result;
 }
 

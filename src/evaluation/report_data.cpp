@@ -6,8 +6,6 @@
 
 #include <fmt/core.h>
 
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -17,6 +15,7 @@
 #include <string_view>
 
 #include "core/image_io.h"
+#include "pipeline/manifest.h"
 #include "pipeline/outputs.h"
 
 namespace sb {
@@ -24,7 +23,6 @@ namespace sb {
 namespace {
 
 namespace fs = std::filesystem;
-using json = nlohmann::ordered_json;
 
 // A file-name stem that needs no escaping in a relative URL: letters, digits, '.', '_', '-'.
 std::string url_safe(std::string_view name) {
@@ -37,32 +35,22 @@ std::string url_safe(std::string_view name) {
   return out.empty() ? std::string("_") : out;
 }
 
-Expected<json> read_manifest(const fs::path& folder) {
-  const fs::path path = folder / "manifest.json";
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return input_error(path.string() + ": cannot read the bake's manifest");
-  json manifest = json::parse(in, nullptr, /*allow_exceptions=*/false);
-  if (manifest.is_discarded() || !manifest.contains("receivers") ||
-      !manifest["receivers"].is_array()) {
-    return input_error(path.string() + ": not a bake manifest (no receivers array)");
-  }
-  return manifest;
-}
-
-// The run's manifest; an empty one, with the reason in run.error, when it failed or has none.
-json manifest_of(MethodRun& run) {
-  if (!run.error.empty()) return json();
+// The run's manifest; none, with the reason in run.error, when it failed or has none.
+std::optional<Manifest> manifest_of(MethodRun& run) {
+  if (!run.error.empty()) return std::nullopt;
   auto manifest = read_manifest(run.folder);
   if (!manifest) {
     run.error = manifest.error().message;
-    return json();
+    return std::nullopt;
   }
   return std::move(*manifest);
 }
 
-const json* find_receiver(const json& manifest, const std::string& name) {
-  for (const auto& r : manifest["receivers"])
-    if (r.value("name", "") == name) return &r;
+const ManifestReceiver* find_receiver(const std::optional<Manifest>& manifest,
+                                      const std::string& name) {
+  if (!manifest) return nullptr;
+  for (const auto& r : manifest->receivers)
+    if (r.name == name) return &r;
   return nullptr;
 }
 
@@ -92,15 +80,14 @@ class ImageStager {
 
   // The texture shown for a bake: its preview, or for irradiance its EXR tone-mapped with the
   // reference's white point, so every method is shown at one exposure.
-  Status stage_texture(const fs::path& bake_folder, const json& entry, const Image& exr,
+  Status stage_texture(const fs::path& bake_folder, const ManifestReceiver& entry, const Image& exr,
                        const std::string& relative) {
     staged_.push_back(relative);
     if (irradiance_) {
       return write_image(folder_.staged(relative), tone_map_irradiance(exr, white_),
                          PixelFormat::uint8);
     }
-    const std::string png = entry.contains("files") ? entry["files"].value("png", "") : "";
-    return copy_into_staging(bake_folder / png, folder_.staged(relative));
+    return copy_into_staging(bake_folder / entry.files.png, folder_.staged(relative));
   }
 
   Status stage_image(const Image& image, const std::string& relative) {
@@ -153,17 +140,15 @@ MethodSummary summarise(const std::vector<ReceiverReport>& receivers, std::size_
 
 // Compares every method with the reference on the receiver of the reference manifest's `entry`,
 // staging its images.
-Expected<ReceiverReport> compare_receiver(const json& entry, const MethodRun& reference,
+Expected<ReceiverReport> compare_receiver(const ManifestReceiver& entry, const MethodRun& reference,
                                           const std::vector<MethodSection>& methods,
-                                          const std::vector<json>& manifests, bool irradiance,
-                                          ImageStager& images) {
+                                          const std::vector<std::optional<Manifest>>& manifests,
+                                          bool irradiance, ImageStager& images) {
   ReceiverReport receiver;
-  receiver.name = entry.value("name", "");
+  receiver.name = entry.name;
   receiver.cells.resize(methods.size());
-  const json files = entry.value("files", json::object());
-  auto ref_image = read_image(reference.folder / files.value("exr", receiver.name + ".exr"));
-  auto coverage =
-      read_image(reference.folder / files.value("coverage", receiver.name + ".coverage.png"));
+  auto ref_image = read_image(reference.folder / entry.files.exr);
+  auto coverage = read_image(reference.folder / entry.files.coverage);
   if (!ref_image || !coverage) {
     receiver.error = !ref_image ? ref_image.error().message : coverage.error().message;
     for (auto& cell : receiver.cells) cell.error = "no reference: " + receiver.error;
@@ -191,18 +176,17 @@ Expected<ReceiverReport> compare_receiver(const json& entry, const MethodRun& re
       cell.error = run.error;
       continue;
     }
-    const json* run_entry = find_receiver(manifests[m], receiver.name);
+    const ManifestReceiver* run_entry = find_receiver(manifests[m], receiver.name);
     if (!run_entry) {
-      cell.error =
-          (run.folder / "manifest.json").string() + ": no receiver '" + receiver.name + "'";
+      cell.error = (run.folder / kManifestFile).string() + ": no receiver '" + receiver.name + "'";
       continue;
     }
-    if (run_entry->contains("penumbra_error")) {
-      cell.predicted_metres = (*run_entry)["penumbra_error"].value("metres", 0.0);
-      cell.predicted_texels = (*run_entry)["penumbra_error"].value("texels", 0.0);
+    // The convolution's own entry (its MethodReport::manifest).
+    if (const auto& own = run_entry->method_entries; own.contains("penumbra_error")) {
+      cell.predicted_metres = own["penumbra_error"].value("metres", 0.0);
+      cell.predicted_texels = own["penumbra_error"].value("texels", 0.0);
     }
-    const json run_files = run_entry->value("files", json::object());
-    const fs::path exr = run.folder / run_files.value("exr", receiver.name + ".exr");
+    const fs::path exr = run.folder / run_entry->files.exr;
     auto image = read_image(exr);
     if (!image) {
       cell.error = image.error().message;
@@ -233,8 +217,7 @@ Expected<ReceiverReport> compare_receiver(const json& entry, const MethodRun& re
         difference_heat_map(*method_images[m], *ref_image, options.mask, receiver.heat_scale, true);
     if (auto s = images.stage_image(map, cell.difference); !s) return s.error();
   }
-  if (receiver.covered_texels == 0)
-    receiver.covered_texels = entry.value("covered_texels", std::int64_t(0));
+  if (receiver.covered_texels == 0) receiver.covered_texels = entry.covered_texels;
   return receiver;
 }
 
@@ -253,20 +236,19 @@ Expected<ReportData> compute_report_data(const Scene& scene, const std::vector<M
   ReportData data;
   data.scene = scene;
   data.irradiance = scene.bake.quantity == Quantity::irradiance;
-  std::vector<json> manifests;
+  std::vector<std::optional<Manifest>> manifests;
   for (const auto& run : runs) {
     data.methods.push_back({run, {}});
     manifests.push_back(manifest_of(data.methods.back().run));
   }
   data.reference = reference;
-  const json reference_manifest = manifest_of(data.reference);
-  const bool has_reference = reference_manifest.is_object();
-  const double white = has_reference ? reference_manifest.value("png_white_point", 1.0) : 1.0;
-  data.reference_samples = has_reference ? reference_manifest.value("samples", 0) : 0;
+  const std::optional<Manifest> reference_manifest = manifest_of(data.reference);
+  const double white = reference_manifest ? reference_manifest->png_white_point.value_or(1.0) : 1.0;
+  data.reference_samples = reference_manifest ? reference_manifest->samples : 0;
 
   ImageStager images(folder, data.irradiance, white);
-  if (has_reference) {
-    for (const auto& entry : reference_manifest["receivers"]) {
+  if (reference_manifest) {
+    for (const auto& entry : reference_manifest->receivers) {
       auto receiver =
           compare_receiver(entry, data.reference, data.methods, manifests, data.irradiance, images);
       if (!receiver) return receiver.error();

@@ -1,7 +1,5 @@
 #include "pipeline/outputs.h"
 
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -11,6 +9,7 @@
 #include <vector>
 
 #include "core/image_io.h"
+#include "pipeline/manifest.h"
 
 namespace sb {
 
@@ -56,7 +55,31 @@ std::vector<std::string> receiver_files(const std::string& name) {
   return {name + ".exr", name + ".png", name + ".coverage.png"};
 }
 
-constexpr const char* kManifestName = "manifest.json";
+// A receiver's manifest entry: its files, texels, UV layout checks, time and the method's own
+// figures and entries.
+ManifestReceiver describe_receiver(const ReceiverBake& r, const BakeSettings& effective,
+                                   ManifestFiles files) {
+  ManifestReceiver entry;
+  entry.name = r.name;
+  entry.files = std::move(files);
+  entry.uv_channel = r.uv_channel;
+  entry.width = r.image.width;
+  entry.height = r.image.height;
+  entry.method = effective.method;
+  entry.quantity = effective.quantity;
+  entry.samples = effective.samples;
+  entry.covered_texels = r.covered_texels;
+  entry.uv_layout = {.charts = r.uv.charts,
+                     .uv_area = r.uv.uv_area,
+                     .uv_area_outside = r.uv.uv_area_outside,
+                     .overlapping_texels = r.uv.overlapping_texels,
+                     .texels_near_other_charts = r.uv.texels_near_other_charts,
+                     .margin = r.uv.margin};
+  entry.seconds = r.seconds;
+  entry.method_stats = r.report.stats;
+  entry.method_entries = r.report.manifest;
+  return entry;
+}
 
 std::string lower(std::string text) {
   for (char& c : text) c = char(std::tolower(static_cast<unsigned char>(c)));
@@ -71,7 +94,7 @@ std::vector<std::string> output_names(const Scene& scene) {
     if (!obj.receiver) continue;
     for (std::string& file : receiver_files(obj.name)) names.push_back(std::move(file));
   }
-  names.push_back(kManifestName);
+  names.push_back(kManifestFile);
   return names;
 }
 
@@ -81,7 +104,7 @@ Status check_output_names(const Scene& scene) {
     if (!obj.receiver) continue;
     for (const std::string& file : receiver_files(obj.name)) {
       const std::string key = lower(file);
-      if (key == kManifestName) continue;  // no receiver file ends in .json
+      if (key == kManifestFile) continue;  // no receiver file ends in .json
       const auto [it, inserted] = owner.emplace(key, &obj);
       if (inserted) continue;
       const ObjectDesc& first = *it->second;
@@ -103,25 +126,21 @@ Status write_outputs(OutputFolder& folder, const Scene& scene, const BakeSetting
   const bool irradiance = effective.quantity == Quantity::irradiance;
   const double white = irradiance ? irradiance_white_point(result) : 1.0;
 
-  nlohmann::ordered_json manifest;
-  manifest["shadowbake"] = SHADOWBAKE_VERSION;
-  manifest["scene"] = scene.file.string();
-  manifest["method"] = effective.method;
-  manifest["quantity"] = to_string(effective.quantity);
-  manifest["resolution"] = effective.resolution;
-  manifest["samples"] = effective.samples;
-  manifest["seed"] = effective.seed;
-  manifest["margin"] = effective.margin;
+  Manifest manifest;
+  manifest.shadowbake = SHADOWBAKE_VERSION;
+  manifest.scene = scene.file.string();
+  manifest.method = effective.method;
+  manifest.quantity = effective.quantity;
+  manifest.resolution = effective.resolution;
+  manifest.samples = effective.samples;
+  manifest.seed = effective.seed;
+  manifest.margin = effective.margin;
   if (effective.method == "convolution") {
-    manifest["trace"] = effective.trace;
-    manifest["convolve"] = effective.convolve;
+    manifest.trace = effective.trace;
+    manifest.convolve = effective.convolve;
   }
-  manifest["lights"] = nlohmann::ordered_json::array();
-  for (const auto& l : scene.lights) {
-    manifest["lights"].push_back({{"name", l.name}, {"shape", to_string(l.shape)}});
-  }
-  if (irradiance) manifest["png_white_point"] = white;
-  manifest["receivers"] = nlohmann::ordered_json::array();
+  for (const auto& l : scene.lights) manifest.lights.push_back({l.name, l.shape});
+  if (irradiance) manifest.png_white_point = white;
 
   for (const auto& r : result.receivers) {
     const std::vector<std::string> files = receiver_files(r.name);
@@ -135,41 +154,18 @@ Status write_outputs(OutputFolder& folder, const Scene& scene, const BakeSetting
     for (std::size_t i = 0; i < r.covered.size() && i < mask.pixels.size(); ++i)
       mask.pixels[i] = r.covered[i] ? 1.0f : 0.0f;
     if (Status s = write_image(coverage, mask, PixelFormat::uint8); !s) return s;
-    manifest["receivers"].push_back({
-        {"name", r.name},
-        {"files",
-         {{"exr", exr.filename().string()},
-          {"png", png.filename().string()},
-          {"coverage", coverage.filename().string()}}},
-        {"uv_channel", r.uv_channel},
-        {"resolution", {r.image.width, r.image.height}},
-        {"method", effective.method},
-        {"quantity", to_string(effective.quantity)},
-        {"samples", effective.samples},
-        {"covered_texels", r.covered_texels},
-        {"uv_layout",
-         {{"charts", r.uv.charts},
-          {"uv_area", r.uv.uv_area},
-          {"uv_area_outside", r.uv.uv_area_outside},
-          {"overlapping_texels", r.uv.overlapping_texels},
-          {"texels_near_other_charts", r.uv.texels_near_other_charts},
-          {"margin", r.uv.margin}}},
-        {"seconds", r.seconds},
-    });
-    if (!r.report.stats.empty()) {
-      auto& stats = manifest["receivers"].back()["method_stats"];
-      stats = nlohmann::ordered_json::object();
-      for (const auto& [key, value] : r.report.stats) stats[key] = value;
-    }
-    for (const auto& [key, value] : r.report.manifest.items())
-      manifest["receivers"].back()[key] = value;
+    manifest.receivers.push_back(describe_receiver(
+        r, effective,
+        {exr.filename().string(), png.filename().string(), coverage.filename().string()}));
   }
-  manifest["warnings"] = result.warnings;
-  manifest["load_seconds"] = result.load_seconds;
-  manifest["bake_seconds"] = result.bake_seconds;
-  manifest["shadow_rays"] = result.shadow_rays;
+  manifest.warnings = result.warnings;
+  manifest.load_seconds = result.load_seconds;
+  manifest.bake_seconds = result.bake_seconds;
+  manifest.shadow_rays = result.shadow_rays;
 
-  if (Status s = write_text_file(folder.staged(kManifestName), manifest.dump(2) + "\n"); !s)
+  if (Status s =
+          write_text_file(folder.staged(kManifestFile), manifest_to_json(manifest).dump(2) + "\n");
+      !s)
     return s;
   return folder.publish(names);
 }

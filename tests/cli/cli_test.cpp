@@ -3,8 +3,6 @@
 // with no partial output left behind.
 #include <gtest/gtest.h>
 
-#include <nlohmann/json.hpp>
-
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -13,6 +11,7 @@
 #include <thread>
 
 #include "core/image_io.h"
+#include "pipeline/manifest.h"
 
 namespace fs = std::filesystem;
 
@@ -94,19 +93,21 @@ TEST_F(Cli, BakesFilesAndManifest) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(listing(dir_ / "out"), (std::vector<std::string>{"floor.coverage.png", "floor.exr",
                                                              "floor.png", "manifest.json"}));
-  const auto manifest = nlohmann::json::parse(slurp(dir_ / "out" / "manifest.json"));
-  ASSERT_EQ(manifest["receivers"].size(), 1u);
-  const auto& floor = manifest["receivers"][0];
-  EXPECT_EQ(floor["name"], "floor");
-  EXPECT_EQ(floor["files"]["exr"], "floor.exr");
-  EXPECT_EQ(floor["files"]["png"], "floor.png");
-  EXPECT_EQ(floor["files"]["coverage"], "floor.coverage.png");
-  EXPECT_EQ(floor["uv_channel"], 0);
-  EXPECT_EQ(floor["resolution"], nlohmann::json::array({32, 32}));
-  EXPECT_EQ(floor["method"], "convolution");  // the default
-  EXPECT_EQ(floor["quantity"], "visibility");
-  EXPECT_EQ(floor["samples"], 16);
-  EXPECT_GE(floor["seconds"].get<double>(), 0.0);
+  const auto manifest = sb::read_manifest(dir_ / "out");
+  ASSERT_TRUE(manifest) << manifest.error().message;
+  ASSERT_EQ(manifest->receivers.size(), 1u);
+  const sb::ManifestReceiver& floor = manifest->receivers[0];
+  EXPECT_EQ(floor.name, "floor");
+  EXPECT_EQ(floor.files.exr, "floor.exr");
+  EXPECT_EQ(floor.files.png, "floor.png");
+  EXPECT_EQ(floor.files.coverage, "floor.coverage.png");
+  EXPECT_EQ(floor.uv_channel, 0);
+  EXPECT_EQ(floor.width, 32);
+  EXPECT_EQ(floor.height, 32);
+  EXPECT_EQ(floor.method, "convolution");  // the default
+  EXPECT_EQ(floor.quantity, sb::Quantity::visibility);
+  EXPECT_EQ(floor.samples, 16);
+  EXPECT_GE(floor.seconds, 0.0);
 
   auto exr = sb::read_image(dir_ / "out" / "floor.exr");
   ASSERT_TRUE(exr);
@@ -150,10 +151,13 @@ TEST_F(Cli, OverridesReachTheManifest) {
                        " --quantity irradiance --resolution 16 --samples 4 --quiet");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(r.out.empty());
-  const auto manifest = nlohmann::json::parse(slurp(dir_ / "out" / "manifest.json"));
-  EXPECT_EQ(manifest["quantity"], "irradiance");
-  EXPECT_EQ(manifest["receivers"][0]["resolution"], nlohmann::json::array({16, 16}));
-  EXPECT_EQ(manifest["receivers"][0]["samples"], 4);
+  const auto manifest = sb::read_manifest(dir_ / "out");
+  ASSERT_TRUE(manifest) << manifest.error().message;
+  EXPECT_EQ(manifest->quantity, sb::Quantity::irradiance);
+  ASSERT_EQ(manifest->receivers.size(), 1u);
+  EXPECT_EQ(manifest->receivers[0].width, 16);
+  EXPECT_EQ(manifest->receivers[0].height, 16);
+  EXPECT_EQ(manifest->receivers[0].samples, 4);
   auto exr = sb::read_image(dir_ / "out" / "floor.exr");
   ASSERT_TRUE(exr);
   // A corner texel in full light: irradiance of the order of P/(π d²) ≈ 14 W/m².

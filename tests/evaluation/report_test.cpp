@@ -16,6 +16,7 @@
 
 #include "core/image_io.h"
 #include "evaluation/report.h"
+#include "pipeline/manifest.h"
 
 namespace fs = std::filesystem;
 
@@ -77,18 +78,20 @@ void write_bake(const fs::path& folder, const std::string& method, float value) 
   ASSERT_TRUE(sb::write_image(folder / "floor.exr", image, sb::PixelFormat::float32));
   ASSERT_TRUE(sb::write_image(folder / "floor.png", image, sb::PixelFormat::uint8));
   ASSERT_TRUE(sb::write_image(folder / "floor.coverage.png", coverage, sb::PixelFormat::uint8));
-  nlohmann::json manifest = {
-      {"method", method},
-      {"samples", 64},
-      {"bake_seconds", 0.5},
-      {"receivers",
-       {{{"name", "floor"},
-         {"files",
-          {{"exr", "floor.exr"}, {"png", "floor.png"}, {"coverage", "floor.coverage.png"}}},
-         {"covered_texels", 56}}}}};
+  sb::Manifest manifest;
+  manifest.method = method;
+  manifest.samples = 64;
+  manifest.bake_seconds = 0.5;
+  sb::ManifestReceiver& floor = manifest.receivers.emplace_back();
+  floor.name = "floor";
+  floor.files = {"floor.exr", "floor.png", "floor.coverage.png"};
+  floor.width = floor.height = 8;
+  floor.method = method;
+  floor.samples = 64;
+  floor.covered_texels = 56;
   if (method == "convolution")
-    manifest["receivers"][0]["penumbra_error"] = {{"metres", 0.01}, {"texels", 2.5}};
-  std::ofstream(folder / "manifest.json") << manifest.dump(2);
+    floor.method_entries["penumbra_error"] = {{"metres", 0.01}, {"texels", 2.5}};
+  std::ofstream(folder / sb::kManifestFile) << sb::manifest_to_json(manifest).dump(2);
 }
 
 sb::Scene tiny_scene() {

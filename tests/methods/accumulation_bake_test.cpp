@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "pipeline/bake.h"
+#include "support/image_errors.h"
 #include "support/test_scenes.h"
 
 namespace sb {
@@ -28,31 +29,8 @@ BakeResult bake_or_fail(const Scene& scene) {
   return std::move(*result);
 }
 
-struct Errors {
-  double rmse = 0, max = 0;
-};
-
-// Over covered texels of every receiver, first channel (visibility is grey on these scenes'
-// white panels) or all three.
-Errors errors(const BakeResult& a, const BakeResult& b) {
-  double sq = 0, max = 0;
-  std::int64_t n = 0;
-  for (std::size_t r = 0; r < a.receivers.size(); ++r) {
-    const auto& ia = a.receivers[r].image;
-    const auto& ib = b.receivers[r].image;
-    const auto& covered = a.receivers[r].covered;
-    for (std::size_t p = 0; p < covered.size(); ++p) {
-      if (!covered[p]) continue;
-      for (int c = 0; c < 3; ++c) {
-        const double d = ia.pixels[3 * p + c] - ib.pixels[3 * p + c];
-        sq += d * d;
-        max = std::max(max, std::abs(d));
-        ++n;
-      }
-    }
-  }
-  return {std::sqrt(sq / double(std::max<std::int64_t>(n, 1))), max};
-}
+using image_errors::Errors;
+using image_errors::errors;
 
 // Stratified jittered points on a visibility edge: only the √N strata the edge crosses are
 // uncertain, each a Bernoulli of variance ≤ 1/4 in a sum divided by N, so the per-texel error

@@ -8,12 +8,13 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "pipeline/bake.h"
-#include "support/test_scenes.h"
 #include "methods/erosion_bake.h"
+#include "occluders/ray_scene.h"
+#include "pipeline/bake.h"
 #include "scene/lights.h"
 #include "scene/mesh.h"
-#include "occluders/ray_scene.h"
+#include "support/image_errors.h"
+#include "support/test_scenes.h"
 #include "texels/texel_space.h"
 
 namespace sb {
@@ -36,40 +37,8 @@ double stat(const ReceiverBake& r, const std::string& name) {
   return 0;
 }
 
-struct Errors {
-  double rmse = 0, max = 0;
-};
-
-// Over the covered texels of every receiver, all channels; only where `where(ref value)` holds.
-template <typename Pred>
-Errors errors(const std::vector<const Image*>& a, const std::vector<const Image*>& b,
-              const std::vector<const std::vector<std::uint8_t>*>& covered, Pred where) {
-  double sq = 0, max = 0;
-  std::int64_t n = 0;
-  for (std::size_t r = 0; r < a.size(); ++r)
-    for (std::size_t p = 0; p < covered[r]->size(); ++p) {
-      if (!(*covered[r])[p]) continue;
-      for (int c = 0; c < 3; ++c) {
-        if (!where(b[r]->pixels[3 * p + c])) continue;
-        const double d = a[r]->pixels[3 * p + c] - b[r]->pixels[3 * p + c];
-        sq += d * d;
-        max = std::max(max, std::abs(d));
-        ++n;
-      }
-    }
-  return {std::sqrt(sq / double(std::max<std::int64_t>(n, 1))), max};
-}
-
-Errors errors(const BakeResult& a, const BakeResult& b) {
-  std::vector<const Image*> ia, ib;
-  std::vector<const std::vector<std::uint8_t>*> cov;
-  for (std::size_t r = 0; r < a.receivers.size(); ++r) {
-    ia.push_back(&a.receivers[r].image);
-    ib.push_back(&b.receivers[r].image);
-    cov.push_back(&a.receivers[r].covered);
-  }
-  return errors(ia, ib, cov, [](double) { return true; });
-}
+using image_errors::Errors;
+using image_errors::errors;
 
 TEST(RayScene, FirstHitDistance) {
   Scene scene = load("parallel", 16, "reference");
@@ -254,10 +223,10 @@ TEST(ErosionBake, LineFitRemovesStaircaseOnSlantedEdge) {
   ref_scene.bake.method = "reference";
   ref_scene.bake.samples = 1024;
   const BakeResult reference = bake_or_fail(ref_scene);
-  auto penumbra = [](double v) { return v > 0.02 && v < 0.98; };
   const Image& ref = reference.receivers[0].image;
-  const Errors e_with = errors({&with.image}, {&ref}, {&with.covered}, penumbra);
-  const Errors e_without = errors({&without.image}, {&ref}, {&with.covered}, penumbra);
+  const image_errors::Options penumbra = {.region = image_errors::Region::penumbra};
+  const Errors e_with = errors(with.image, ref, with.covered, penumbra);
+  const Errors e_without = errors(without.image, ref, with.covered, penumbra);
   std::printf(
       "30° edge: against the exact edge, RMSE %.4f with the line fit, %.4f without; "
       "against the reference, %.4f and %.4f\n",

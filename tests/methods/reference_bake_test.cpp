@@ -5,8 +5,9 @@
 
 #include <cmath>
 
-#include "support/closed_forms.h"
 #include "methods/reference_bake.h"
+#include "support/closed_forms.h"
+#include "support/image_errors.h"
 
 namespace sb {
 namespace {
@@ -104,16 +105,16 @@ TEST(Reference, ParallelPlanesMatchWeightedClosedForm) {
   const double y0 = 0.1;
   const TexelSpace s = floor_texels(xs, y0);
   const Image vis = run(s, lights, *rays, Quantity::visibility, 1024);
-  double sq = 0, max_err = 0, sq_split = 0;
-  for (std::size_t i = 0; i < xs.size(); ++i) {
-    const double v = closed_forms::parallel_weighted_visibility(xs[i], y0);
-    const double err = vis.at(int(i), 0)[0] - v;
-    sq += err * err;
-    max_err = std::max(max_err, std::abs(err));
-    const double split = closed_forms::parallel_unweighted_visibility(xs[i], y0) - v;
+  const image_errors::Errors e = image_errors::errors_against(vis, 0, [&](int x, int) {
+    return closed_forms::parallel_weighted_visibility(xs[std::size_t(x)], y0);
+  });
+  const double rmse = e.rmse, max_err = e.max;
+  double sq_split = 0;
+  for (const double x : xs) {
+    const double split = closed_forms::parallel_unweighted_visibility(x, y0) -
+                         closed_forms::parallel_weighted_visibility(x, y0);
     sq_split += split * split;
   }
-  const double rmse = std::sqrt(sq / xs.size());
   const double rmse_split = std::sqrt(sq_split / xs.size());
   // 1024 stratified samples: a penumbra texel's standard error is about 0.005.
   EXPECT_LT(rmse, 0.004);

@@ -13,11 +13,12 @@
 #include <memory>
 #include <numbers>
 
-#include "pipeline/bake.h"
-#include "support/test_scenes.h"
-#include "support/closed_forms.h"
 #include "core/image_io.h"
 #include "methods/shadow_map.h"
+#include "pipeline/bake.h"
+#include "support/closed_forms.h"
+#include "support/image_errors.h"
+#include "support/test_scenes.h"
 
 namespace sb {
 namespace {
@@ -39,22 +40,11 @@ double stat(const MethodStats& stats, const std::string& name) {
   return 0;
 }
 
-struct Errors {
-  double rmse = 0, max = 0;
-};
+using image_errors::Errors;
 
+// Channel `c` of `a` against `b`, over every texel.
 Errors image_errors(const Image& a, const Image& b, int c = 0) {
-  Errors e;
-  double sq = 0;
-  int count = 0;
-  for (std::size_t i = c; i < a.pixels.size(); i += 3) {
-    const double d = a.pixels[i] - b.pixels[i];
-    sq += d * d;
-    e.max = std::max(e.max, std::abs(d));
-    ++count;
-  }
-  e.rmse = std::sqrt(sq / count);
-  return e;
+  return image_errors::errors(a, b, {}, {.channel = c});
 }
 
 // The shadow's right-hand edge along a row of a floor image (x = 2(i + 0.5)/width − 1): from the
@@ -317,7 +307,8 @@ TEST(AdaptivePcf, EqualsTheFullSetWhereItTakesItAndSkipsItMostly) {
   Scene scene = load("parallel", 128, "adaptive-pcf");
   auto p = prepare(scene, "floor");
   MethodStats stats;
-  const Image adaptive = bake_shadow_map_filter(p->space, p->in, &stats, ShadowFilterOptions{}).image;
+  const Image adaptive =
+      bake_shadow_map_filter(p->space, p->in, &stats, ShadowFilterOptions{}).image;
   ShadowFilterOptions full_options;
   full_options.adaptive_always_full = true;
   const Image full = bake_shadow_map_filter(p->space, p->in, nullptr, full_options).image;

@@ -7,6 +7,7 @@
 
 #include "pipeline/bake.h"
 #include "support/closed_forms.h"
+#include "support/image_errors.h"
 
 namespace sb {
 namespace {
@@ -30,18 +31,12 @@ TEST(Bake, ParallelSceneMatchesClosedFormWithOffsetBlocker) {
   ASSERT_EQ(result->receivers.size(), 1u);
   const Image& img = result->receivers[0].image;
   ASSERT_EQ(img.width, 32);
-  double sq = 0, max_err = 0;
-  for (int y = 0; y < img.height; ++y)
-    for (int x = 0; x < img.width; ++x) {
-      // The floor's UVs are u = (x + 1)/2, v = (y + 1)/2; row 0 is v = 1.
-      const double u = (x + 0.5) / img.width, v = 1.0 - (y + 0.5) / img.height;
-      const double expected =
-          closed_forms::parallel_weighted_visibility(2 * u - 1, 2 * v - 1, bx, by, 600);
-      const double err = img.at(x, y)[0] - expected;
-      sq += err * err;
-      max_err = std::max(max_err, std::abs(err));
-    }
-  const double rmse = std::sqrt(sq / (img.width * img.height));
+  const image_errors::Errors e = image_errors::errors_against(img, 0, [&](int x, int y) {
+    // The floor's UVs are u = (x + 1)/2, v = (y + 1)/2; row 0 is v = 1.
+    const double u = (x + 0.5) / img.width, v = 1.0 - (y + 0.5) / img.height;
+    return closed_forms::parallel_weighted_visibility(2 * u - 1, 2 * v - 1, bx, by, 600);
+  });
+  const double rmse = e.rmse, max_err = e.max;
   EXPECT_LT(rmse, 0.005);
   EXPECT_LT(max_err, 0.04);
   RecordProperty("rmse", std::to_string(rmse));

@@ -31,9 +31,10 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/bake.h"
 #include "core/image_io.h"
+#include "pipeline/bake.h"
 #include "scene/scene.h"
+#include "support/image_errors.h"
 
 namespace {
 
@@ -103,21 +104,6 @@ double median(std::vector<double> v) {
   return v.empty()      ? NAN
          : v.size() % 2 ? v[v.size() / 2]
                         : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
-
-// RMSE over the texels `covered` marks, every channel.
-double rmse(const sb::Image& a, const sb::Image& b, const std::vector<std::uint8_t>& covered) {
-  double sum = 0;
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < covered.size(); ++i) {
-    if (!covered[i]) continue;
-    for (int c = 0; c < a.channels; ++c) {
-      const double d = double(a.pixels[i * a.channels + c]) - double(b.pixels[i * b.channels + c]);
-      sum += d * d;
-      ++n;
-    }
-  }
-  return n ? std::sqrt(sum / double(n)) : NAN;
 }
 
 // Peak resident memory of a whole `shadowbake bake` process, MiB.
@@ -299,7 +285,8 @@ int main(int argc, char** argv) {
           measured[k].seconds[r.name].push_back(r.seconds + share * result->load_seconds);
           if (rep == 0) {
             // Covered texels of this bake (margin 0: every texel with a value is covered).
-            measured[k].error[r.name] = rmse(r.image, truth[r.name], r.covered);
+            measured[k].error[r.name] =
+                image_errors::errors(r.image, truth[r.name], r.covered).rmse;
           }
         }
         measured[k].scene_runs.push_back(result->load_seconds + result->bake_seconds);

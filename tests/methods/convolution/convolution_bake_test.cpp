@@ -7,11 +7,12 @@
 #include <filesystem>
 #include <functional>
 
+#include "core/image_io.h"
 #include "methods/convolution/pair_report.h"
 #include "pipeline/bake.h"
-#include "support/test_scenes.h"
 #include "support/closed_forms.h"
-#include "core/image_io.h"
+#include "support/image_errors.h"
+#include "support/test_scenes.h"
 
 namespace sb {
 namespace {
@@ -26,40 +27,23 @@ Image bake_floor(const Scene& scene, std::vector<PairReport>* pairs = nullptr) {
   return result->receivers[0].image;
 }
 
-struct Errors {
-  double rmse = 0, max = 0;
-  int count = 0;
-};
+using image_errors::Errors;
 
 // Error of channel `c` of a floor image (UV (u, v) = ((x + 1)/2, (y + 1)/2)) against expected(x,
 // y), over every `stride`-th texel.
 Errors floor_errors(const Image& img, int c, const std::function<double(double, double)>& expected,
                     int stride = 1) {
-  Errors e;
-  double sq = 0;
-  for (int j = 0; j < img.height; j += stride)
-    for (int i = 0; i < img.width; i += stride) {
-      const double x = 2 * (i + 0.5) / img.width - 1, y = 1 - 2 * (j + 0.5) / img.height;
-      const double d = img.at(i, j)[c] - expected(x, y);
-      sq += d * d;
-      e.max = std::max(e.max, std::abs(d));
-      ++e.count;
-    }
-  e.rmse = std::sqrt(sq / e.count);
-  return e;
+  return image_errors::errors_against(
+      img, c,
+      [&](int i, int j) {
+        return expected(2 * (i + 0.5) / img.width - 1, 1 - 2 * (j + 0.5) / img.height);
+      },
+      stride);
 }
 
+// Channel `c` of `a` against `b`, over every texel.
 Errors image_errors(const Image& a, const Image& b, int c = 0) {
-  Errors e;
-  double sq = 0;
-  for (std::size_t i = c; i < a.pixels.size(); i += 3) {
-    const double d = a.pixels[i] - b.pixels[i];
-    sq += d * d;
-    e.max = std::max(e.max, std::abs(d));
-    ++e.count;
-  }
-  e.rmse = std::sqrt(sq / e.count);
-  return e;
+  return image_errors::errors(a, b, {}, {.channel = c});
 }
 
 // Exact case (design-notes §2): a square light, a parallel square blocker, at three distance
@@ -150,12 +134,13 @@ TEST(ConvolutionBake, AgreesWithReferenceWithinTheWeightingSplit) {
       4);
   std::printf("convolution vs V_u %.4f (max %.4f), reference vs V %.4f (max %.4f)\n",
               conv_exact.rmse, conv_exact.max, ref_exact.rmse, ref_exact.max);
-  std::printf("emission-weighted convolution vs reference RMSE %.4f (max %.4f); V_u vs V RMSE "
-              "%.4f (max %.4f); irradiance-weighted convolution vs reference RMSE %.4f (max %.4f)\n",
-              against_reference.rmse, against_reference.max, split.rmse, split.max,
-              weighted_against_reference.rmse, weighted_against_reference.max);
+  std::printf(
+      "emission-weighted convolution vs reference RMSE %.4f (max %.4f); V_u vs V RMSE "
+      "%.4f (max %.4f); irradiance-weighted convolution vs reference RMSE %.4f (max %.4f)\n",
+      against_reference.rmse, against_reference.max, split.rmse, split.max,
+      weighted_against_reference.rmse, weighted_against_reference.max);
   EXPECT_LE(against_reference.rmse, split.rmse + conv_exact.rmse + ref_exact.rmse);
-  EXPECT_GE(against_reference.rmse, 0.5 * split.rmse);  // the split is really there
+  EXPECT_GE(against_reference.rmse, 0.5 * split.rmse);            // the split is really there
   EXPECT_LE(weighted_against_reference.rmse, 0.25 * split.rmse);  // and the weighting removes it
 }
 

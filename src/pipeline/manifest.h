@@ -1,0 +1,92 @@
+// manifest.json, the description a bake leaves beside its images (docs/cli.md): its schema
+// as C++ types, written by write_outputs (outputs.h) and read by the report. One definition of
+// every key, in the order the file lists them.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/error.h"
+#include "methods/method.h"
+#include "scene/scene.h"
+
+namespace sb {
+
+// The manifest's file name in a bake's output folder.
+inline constexpr const char* kManifestFile = "manifest.json";
+
+struct ManifestLight {
+  std::string name;
+  LightShape shape = LightShape::rectangle;
+};
+
+// A receiver's files, relative to the bake's folder.
+struct ManifestFiles {
+  std::string exr;       // the lightmap, linear float RGB
+  std::string png;       // its 8-bit preview
+  std::string coverage;  // 1 where a triangle covers the texel
+};
+
+// The receiver's lightmap UV layout checks (UvLayoutReport, texels/uv_checks.h).
+struct ManifestUvLayout {
+  int charts = 0;
+  double uv_area = 0, uv_area_outside = 0;
+  std::int64_t overlapping_texels = 0, texels_near_other_charts = 0;
+  int margin = 0;  // texels
+};
+
+struct ManifestReceiver {
+  std::string name;
+  ManifestFiles files;
+  int uv_channel = 0;
+  int width = 0, height = 0;  // texels ("resolution": [width, height])
+  std::string method;
+  Quantity quantity = Quantity::visibility;
+  int samples = 0;
+  std::int64_t covered_texels = 0;
+  ManifestUvLayout uv_layout;
+  double seconds = 0;
+  MethodStats method_stats;  // written only when there are some
+  // The method's own entries (MethodReport::manifest), written after method_stats in their
+  // order; on reading, every key the schema does not name. They must not reuse a schema key.
+  nlohmann::ordered_json method_entries = nlohmann::ordered_json::object();
+};
+
+struct Manifest {
+  std::string shadowbake;  // the version that baked
+  std::string scene;       // the scene file, as given
+  std::string method;
+  Quantity quantity = Quantity::visibility;
+  int resolution = 0, samples = 0;
+  std::uint64_t seed = 0;
+  int margin = 0;
+  std::optional<bool> trace, convolve;  // the convolution's switches; only for it
+  std::vector<ManifestLight> lights;
+  std::optional<double> png_white_point;  // irradiance only: W/m² the previews map to white
+  std::vector<ManifestReceiver> receivers;
+  std::vector<std::string> warnings;
+  double load_seconds = 0, bake_seconds = 0;
+  std::int64_t shadow_rays = 0;
+};
+
+// The manifest as JSON, keys in the schema's order; `dump(2)` of it is the file's text.
+nlohmann::ordered_json manifest_to_json(const Manifest& manifest);
+
+// The manifest `json` describes. An error, naming `where` (the file), when it is not an object
+// with a receivers array ("not a bake manifest"), or a key is missing ("no <key>") or has the
+// wrong type.
+Expected<Manifest> manifest_from_json(const nlohmann::ordered_json& json, const std::string& where);
+
+// Parses manifest.json's text; malformed JSON is "not a bake manifest".
+Expected<Manifest> parse_manifest(std::string_view text, const std::string& where);
+
+// Reads `folder`/manifest.json; an error when it cannot be read or is not a manifest.
+Expected<Manifest> read_manifest(const std::filesystem::path& folder);
+
+}  // namespace sb
