@@ -1,5 +1,5 @@
 // The files a bake leaves for a pipeline: per receiver <name>.exr (linear float RGB) and
-// <name>.png (8-bit preview), and manifest.json describing them (docs/outputs.md).
+// <name>.png (8-bit preview), and manifest.json describing them (docs/cli.md).
 #pragma once
 
 #include <filesystem>
