@@ -38,6 +38,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -83,8 +84,17 @@ namespace {
 // Light splits: at most this many halvings (2^2 = 4 parts).
 constexpr int kMaxLightSplits = 2;
 
-// Appends `from` (planned for the same receiver) to `to`, renumbering its indices.
-void merge_plan(ConvolutionPlan& to, ConvolutionPlan&& from) {
+// A plan whose invariants fail (validate) would make the bake index past its arrays: refused in
+// every build, as an internal error (core/error.h).
+void require_valid(const ConvolutionPlan& plan, std::size_t lights) {
+  if (const Status valid = validate(plan, lights); !valid)
+    throw std::logic_error("invariant failed: " + valid.error().message);
+}
+
+// Appends `from` (planned for the same receiver, with `lights` lights) to `to`, renumbering its
+// indices; `from` is validated first.
+void merge_plan(ConvolutionPlan& to, ConvolutionPlan&& from, std::size_t lights) {
+  require_valid(from, lights);
   const int parts = int(to.light_parts.size()), frames = int(to.frames.size()),
             triples = int(to.triples.size());
   for (auto& lp : from.light_parts) to.light_parts.push_back(std::move(lp));
@@ -153,7 +163,7 @@ ConvolutionPlan plan_halves(const ConvolutionPlan& base, const PlanInputs& in,
         plan_light_part(base, in, std::move(half), std::max(1, budget / 2), level + 1);
   });
   ConvolutionPlan halves = empty_like(base);
-  for (ConvolutionPlan& h : half_plans) merge_plan(halves, std::move(h));
+  for (ConvolutionPlan& h : half_plans) merge_plan(halves, std::move(h), in.lights->size());
   return halves;
 }
 
@@ -195,7 +205,8 @@ ConvolutionPlan plan_convolution(const TexelSpace& space, const PlanInputs& in) 
   for (std::size_t l = 0; l < in.lights->size(); ++l) {
     const Light& light = (*in.lights)[l];
     LightPart whole{int(l), light.desc().name, light, 1.0};
-    merge_plan(plan, plan_light_part(plan, in, std::move(whole), in.max_triples, 0));
+    merge_plan(plan, plan_light_part(plan, in, std::move(whole), in.max_triples, 0),
+               in.lights->size());
   }
   // Leaves the budget left above the tracing threshold are traced rather than convolved: their
   // values would be replaced anyway.
@@ -219,6 +230,7 @@ ConvolutionPlan plan_convolution(const TexelSpace& space, const PlanInputs& in) 
         " texels after " + std::to_string(in.max_triples) +
         " triples per light, above error_texels = " + std::to_string(in.error_texels).substr(0, 5));
   }
+  require_valid(plan, in.lights->size());
   return plan;
 }
 

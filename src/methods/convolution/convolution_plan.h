@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/error.h"
 #include "methods/convolution/blocker_image.h"
 #include "methods/convolution/convolution_backend.h"
 #include "methods/convolution/texel_index.h"
@@ -204,6 +205,15 @@ struct ConvolutionPlan {
   double worst_error_texels() const;
   double estimated_cost() const;
 };
+
+// Checks the invariants the bake relies on to index `plan`'s arrays (plan_validation.cpp):
+// light parts of the scene's `lights` lights; frames of their light parts, their texels, depths,
+// groups, texel indices and one root per group, in range; every triple's frame, group, parent,
+// children and Euler head in range, parents before children and each child listed once by its
+// parent, a split's children of its frame and group with the slabs it cut; leaves' faces,
+// polygons, layer, grid and transform sizes consistent; sections under depth splits of a convex
+// solid. The error names the triple or frame and the broken invariant.
+Status validate(const ConvolutionPlan& plan, std::size_t lights);
 
 // Plans one receiver's convolutions: per light, the frusta from its centre (one towards the lit
 // texels, or cube faces when they spread wider than 60°), and per frustum the refinement of its
