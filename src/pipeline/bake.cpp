@@ -13,6 +13,7 @@
 #include <optional>
 #include <thread>
 
+#include "core/stopwatch.h"
 #include "methods/convolution/fft_convolution.h"
 #include "methods/convolution/traced_convolution.h"
 #include "methods/method.h"
@@ -27,10 +28,6 @@
 namespace sb {
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 // Every object's mesh, in scene order; skipped degenerate triangles become warnings. A mesh file
 // may be a quarter of the memory budget, and its reader may use half of it: Assimp's scene and
@@ -198,9 +195,8 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   context.rays = rays ? &*rays : nullptr;
   context.clusters = needs.clusters ? &clusters : nullptr;
   context.shafts = shafts ? &*shafts : nullptr;
-  context.threads = options.threads > 0
-                        ? options.threads
-                        : int(std::max(1u, std::thread::hardware_concurrency()));
+  context.threads = options.threads > 0 ? options.threads
+                                        : int(std::max(1u, std::thread::hardware_concurrency()));
   // What the budget leaves the method's images, beyond what the estimate above counted.
   context.memory_for_images = double(memory_budget(scene.bake)) - total_bytes(estimate);
   context.keep_per_light = options.keep_per_light;

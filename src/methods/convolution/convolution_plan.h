@@ -13,8 +13,10 @@
 #include <utility>
 #include <vector>
 
+#include "core/error.h"
 #include "methods/convolution/blocker_image.h"
 #include "methods/convolution/convolution_backend.h"
+#include "methods/convolution/texel_index.h"
 #include "occluders/tangent_bounds.h"
 #include "occluders/virtual_configuration.h"
 #include "scene/lights.h"
@@ -24,7 +26,6 @@
 namespace sb {
 
 struct ClusterTree;
-
 
 struct PlanInputs {
   const std::vector<Light>* lights = nullptr;
@@ -78,13 +79,19 @@ struct ReceiverCut {
 // The depth interval of a receiver part: where every cut's weight is positive.
 std::pair<double, double> part_interval(const std::vector<ReceiverCut>& cuts);
 
+// How a triple's children were made: none (a leaf), or the two halves of its blockers by depth
+// or by tangent position, or of its receiver texels by depth (plan_refinement.cpp).
+enum class TripleSplit { none, blocker_depth, blocker_space, receiver_depth };
+
+// "", "blocker depth", "blocker space" or "receiver depth": the words of describe_plan.
+const char* to_string(TripleSplit split);
+
 // A node of the hierarchy: the root of a (light part, frame), a split, or a leaf to convolve.
 struct Triple {
-  int frame = -1;     // index into ConvolutionPlan::frames
-  int group = 0;      // index into the frame's texel groups
-  int parent = -1;    // index into ConvolutionPlan::triples; -1 for a root
-  std::string split;  // how the children were made: "", "blocker depth", "blocker space",
-                      // "receiver depth"
+  int frame = -1;                         // index into ConvolutionPlan::frames
+  int group = 0;                          // index into the frame's texel groups
+  int parent = -1;                        // index into ConvolutionPlan::triples; -1 for a root
+  TripleSplit split = TripleSplit::none;  // how the children were made
   std::vector<int> children;
   // The blocker cluster: faces, and the slab of depth along D they are clipped to.
   std::vector<FaceRef> faces;
@@ -106,7 +113,7 @@ struct Triple {
   // z·|t − view|·(ρ_hi − 1) on the receiver (source_image.cpp), metres.
   double view_error = 0;
   // (ε + view_error) in receiver texels while the narrowest penumbra is below kRelativeSpan
-  // texels, in kRelativeSpan-ths of that penumbra beyond (convolution_plan.cpp).
+  // texels, in kRelativeSpan-ths of that penumbra beyond (triple_evaluation.cpp).
   double penumbra_error_texels = 0;
   double smallest_penumbra = 0;  // L·(ρ_lo − 1), metres on the receiver
   TangentGrid grid;
@@ -136,92 +143,32 @@ struct Triple {
   bool section = false;
 };
 
-// A uniform grid over tangent coordinates holding texel indices, so a footprint's texels are
-// found without visiting the others.
-struct TexelIndex {
-  Vec2 lo = Vec2::Zero();
-  double cell = 1;
-  int nx = 0, ny = 0;
-  std::vector<int> start;  // nx·ny + 1 offsets into items
-  std::vector<int> items;  // frame texel indices, by cell
-
-  // Per cell: the bounds of its texels' tangents, depths and positions, and their count, so a
-  // footprint that holds a whole cell takes it at once (for_each_cell).
-  struct Cell {
-    TangentBounds tangents;
-    DepthRange depth;
-    Bounds3 box;
-    int count = 0;
-  };
-  std::vector<Cell> cells;
-  // Blocks of kBlock × kBlock cells with the same aggregates, so that a footprint covering most
-  // of a large receiver takes it a block at a time (thousands of footprints are scanned while
-  // planning).
-  static constexpr int kBlock = 8;
-  int bx = 0, by = 0;
-  std::vector<Cell> blocks;
-
-  void build(const std::vector<int>& texels, const std::vector<Vec2>& tangent,
-             const std::vector<double>& depth, const std::vector<Vec3>& position);
-  // Like for_each, but a block or cell whose texels all lie in the box and pass `whole(cell)`
-  // goes to cell(cell) instead of texel by texel.
-  template <class W, class C, class F>
-  void for_each_cell(const Vec2& box_lo, const Vec2& box_hi, W&& whole, C&& cell, F&& f) const {
-    if (nx == 0) return;
-    const int x0 = std::max(0, int((box_lo.x() - lo.x()) / this->cell));
-    const int y0 = std::max(0, int((box_lo.y() - lo.y()) / this->cell));
-    const int x1 = std::min(nx - 1, int((box_hi.x() - lo.x()) / this->cell));
-    const int y1 = std::min(ny - 1, int((box_hi.y() - lo.y()) / this->cell));
-    if (x0 > x1 || y0 > y1) return;
-    auto inside = [&](const Cell& k) {
-      return (k.tangents.lo.array() >= box_lo.array()).all() &&
-             (k.tangents.hi.array() <= box_hi.array()).all() && whole(k);
-    };
-    for (int yb = y0 / kBlock; yb <= y1 / kBlock; ++yb) {
-      for (int xb = x0 / kBlock; xb <= x1 / kBlock; ++xb) {
-        const Cell& b = blocks[std::size_t(yb) * bx + xb];
-        if (b.count == 0) continue;
-        if (inside(b)) {
-          cell(b);
-          continue;
-        }
-        const int cy1 = std::min(y1, yb * kBlock + kBlock - 1);
-        const int cx1 = std::min(x1, xb * kBlock + kBlock - 1);
-        for (int y = std::max(y0, yb * kBlock); y <= cy1; ++y) {
-          for (int x = std::max(x0, xb * kBlock); x <= cx1; ++x) {
-            const std::size_t c = std::size_t(y) * nx + x;
-            const Cell& k = cells[c];
-            if (k.count == 0) continue;
-            if (inside(k)) {
-              cell(k);
-              continue;
-            }
-            for (int i = start[c]; i < start[c + 1]; ++i) f(items[std::size_t(i)]);
-          }
-        }
-      }
-    }
-  }
-  // Calls f(i) for every texel i whose cell meets the box [lo, hi] (callers test the box).
-  template <class F>
-  void for_each(const Vec2& box_lo, const Vec2& box_hi, F&& f) const {
-    if (nx == 0) return;
-    const int x0 = std::max(0, int((box_lo.x() - lo.x()) / cell));
-    const int y0 = std::max(0, int((box_lo.y() - lo.y()) / cell));
-    const int x1 = std::min(nx - 1, int((box_hi.x() - lo.x()) / cell));
-    const int y1 = std::min(ny - 1, int((box_hi.y() - lo.y()) / cell));
-    for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x)
-        for (int k = start[std::size_t(y) * nx + x]; k < start[std::size_t(y) * nx + x + 1]; ++k)
-          f(items[std::size_t(k)]);
-  }
+// The frustum a frame looks through: the one central frustum from the light part's centre
+// towards its lit texels, the frustum along a planar group's normal, or a face of the cube around
+// the light, in light_frusta.h's order (+x, −x, +y, −y, +z, −z).
+enum class FrameFace {
+  central,
+  plane,
+  cube_pos_x,
+  cube_neg_x,
+  cube_pos_y,
+  cube_neg_y,
+  cube_pos_z,
+  cube_neg_z
 };
+
+// The frame face of cube face `face` (0 … kCubeFaces − 1, light_frusta.h).
+FrameFace cube_frame_face(int face);
+
+// "" for the central frustum, "plane", or the cube face's name ("+x" … "-z"): the words of
+// describe_plan and of the convolution's pair reports.
+const char* to_string(FrameFace face);
 
 // One light part seen through one frustum from its centre: the texels it serves.
 struct PlanFrame {
   int light = -1;       // index into the scene's lights
   int light_part = -1;  // index into ConvolutionPlan::light_parts
-  std::string face;     // "" for one central frustum; "+x" ... "-z" for cube faces
+  FrameFace face = FrameFace::central;
   ProjectionFrame frame;
   std::vector<std::size_t> texels;  // indices into TexelSpace::texels
   std::vector<double> depth;        // per texel of `texels`: depth along D
@@ -259,6 +206,15 @@ struct ConvolutionPlan {
   double estimated_cost() const;
 };
 
+// Checks the invariants the bake relies on to index `plan`'s arrays (plan_validation.cpp):
+// light parts of the scene's `lights` lights; frames of their light parts, their texels, depths,
+// groups, texel indices and one root per group, in range; every triple's frame, group, parent,
+// children and Euler head in range, parents before children and each child listed once by its
+// parent, a split's children of its frame and group with the slabs it cut; leaves' faces,
+// polygons, layer, grid and transform sizes consistent; sections under depth splits of a convex
+// solid. The error names the triple or frame and the broken invariant.
+Status validate(const ConvolutionPlan& plan, std::size_t lights);
+
 // Plans one receiver's convolutions: per light, the frusta from its centre (one towards the lit
 // texels, or cube faces when they spread wider than 60°), and per frustum the refinement of its
 // root triple: while the worst leaf's ε exceeds the target, split it where ε falls most per unit
@@ -273,7 +229,7 @@ void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part);
 
 // A new child of `parent` made by `split`: the same frame, group, slab, cuts and layer, for the
 // caller to narrow and evaluate.
-Triple child_triple(const Triple& parent, const char* split);
+Triple child_triple(const Triple& parent, TripleSplit split);
 
 // Marks the triples of `plan` that are slabs of convex closed solids and adds, under every depth
 // split between two of a solid's slabs, the section leaf at the split's depth (used by

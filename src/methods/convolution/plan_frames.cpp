@@ -190,7 +190,7 @@ void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part) {
     if (groups[g].planar) {
       FrameGroups f;
       f.frame.frame = frame_towards(light.centre(), light.centre() - groups[g].normal);
-      f.frame.face = "plane";
+      f.frame.face = FrameFace::plane;
       f.members.emplace_back(int(g), groups[g].texels);
       frames.push_back(std::move(f));
     } else {
@@ -216,7 +216,7 @@ void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part) {
       for (int face = 0; face < kCubeFaces; ++face) {
         FrameGroups f;
         f.frame.frame = cube_face_frame(light.centre(), face);
-        f.frame.face = cube_face_name(face);
+        f.frame.face = cube_frame_face(face);
         for (int g : rest) f.members.emplace_back(g, std::vector<std::size_t>{});
         frames.push_back(std::move(f));
       }

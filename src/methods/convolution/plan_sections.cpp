@@ -47,7 +47,7 @@ void add_sections(ConvolutionPlan& plan, const PlanInputs& in) {
     } else {
       const Triple& parent = plan.triples[std::size_t(t.parent)];
       complete[i] = complete[std::size_t(t.parent)];
-      if (complete[i] && parent.split == "blocker space") {
+      if (complete[i] && parent.split == TripleSplit::blocker_space) {
         for (int sibling : parent.children) {
           if (sibling == int(i)) continue;
           for (const FaceRef& f : plan.triples[std::size_t(sibling)].faces)
@@ -128,9 +128,9 @@ void add_sections(ConvolutionPlan& plan, const PlanInputs& in) {
     if (!whole) continue;
     for (int s : subtree) plan.triples[std::size_t(s)].euler = int(top);
     for (int s : subtree) {
-      if (plan.triples[std::size_t(s)].split != "blocker depth") continue;
+      if (plan.triples[std::size_t(s)].split != TripleSplit::blocker_depth) continue;
       const Triple& split = plan.triples[std::size_t(s)];
-      Triple section = child_triple(split, "");
+      Triple section = child_triple(split, TripleSplit::none);
       section.parent = s;
       section.slab_lo = section.slab_hi = plan.triples[std::size_t(split.children[0])].slab_hi;
       section.faces = split.faces;

@@ -135,7 +135,7 @@ TEST(ConvolutionPlan, ConvexSolidsGetTheirSections) {
     ++sections;
     ASSERT_GE(t.parent, 0);
     const Triple& split = plan.triples[std::size_t(t.parent)];
-    EXPECT_EQ(split.split, "blocker depth");
+    EXPECT_EQ(split.split, TripleSplit::blocker_depth);
     EXPECT_EQ(t.slab_lo, t.slab_hi);
     EXPECT_EQ(t.slab_lo, plan.triples[std::size_t(split.children[0])].slab_hi);
     ASSERT_TRUE(t.solid_faces);

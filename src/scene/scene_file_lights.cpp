@@ -1,0 +1,152 @@
+// The [[light]] tables of a scene file (docs/scene-format.md): shape, placement, size, colour,
+// power and texture, each shape's keys refused on the others.
+#include "scene/scene_file_tables.h"
+#include "scene/toml_table_reader.h"
+
+#include <numbers>
+
+namespace sb {
+
+namespace {
+
+// Below this sine of the angle between them, an up vector counts as parallel to the normal.
+constexpr double parallel_sine = 1e-6;
+
+// The default height axis of a rectangle or disk: +Y, or +Z where +Y is along the normal, made
+// perpendicular to the normal like a given `up` (Gram-Schmidt), so the light lies in its plane.
+Vec3 default_up(const Vec3& normal) {
+  const Vec3 y = Vec3::UnitY();
+  const Vec3 axis = (y - y.dot(normal) * normal).norm() < parallel_sine ? Vec3::UnitZ() : y;
+  return (axis - axis.dot(normal) * normal).normalized();
+}
+
+}  // namespace
+
+Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::table& table,
+                               std::size_t index) {
+  TableReader r(file, table, fmt::format("[[light]] #{}", index + 1));
+  LightDesc light;
+  light.line = static_cast<int>(r.line());
+  if (r.require("name")) {
+    if (auto name = r.string("name")) {
+      if (name->empty()) {
+        r.fail("name", "'name' must not be empty");
+      } else {
+        light.name = *name;
+        r.set_item(item_name("light", light.name));
+      }
+    }
+  }
+  r.check_known_keys(
+      {"name", "shape", "position", "normal", "up", "size", "radius", "color", "power", "texture"});
+  if (r.require("shape")) {
+    if (auto shape = r.string("shape")) {
+      if (*shape == "rectangle") {
+        light.shape = LightShape::rectangle;
+      } else if (*shape == "disk") {
+        light.shape = LightShape::disk;
+      } else if (*shape == "sphere") {
+        light.shape = LightShape::sphere;
+      } else {
+        r.fail_got("shape", "\"rectangle\", \"disk\" or \"sphere\"");
+      }
+    }
+  }
+  if (r.failed()) return r.error();  // every later key depends on the shape
+  const std::string shape_name = to_string(light.shape);
+  const bool is_rectangle = light.shape == LightShape::rectangle;
+  const bool is_sphere = light.shape == LightShape::sphere;
+
+  if (r.require("position")) {
+    if (auto v = r.vec3("position", "3 finite numbers (metres)", is_finite)) light.position = *v;
+  }
+
+  if (is_sphere) {
+    r.forbid("normal", "applies only to rectangle and disk lights, not sphere");
+  } else if (r.require("normal")) {
+    if (auto v = r.vec3("normal", "3 finite numbers, not all zero", is_finite)) {
+      if (v->isZero(0)) r.fail_got("normal", "3 finite numbers, not all zero");
+      light.normal = v->normalized();
+    }
+  }
+
+  if (!is_rectangle) {
+    r.forbid("up", fmt::format("applies only to rectangle lights, not {}", shape_name));
+    if (!is_sphere) light.up = default_up(light.normal);
+  } else if (r.find("up")) {
+    if (auto v = r.vec3("up", "3 finite numbers, not all zero", is_finite)) {
+      // Gram-Schmidt: keep only the part of up across the normal.
+      const Vec3 across = *v - v->dot(light.normal) * light.normal;
+      if (v->isZero(0)) {
+        r.fail_got("up", "3 finite numbers, not all zero");
+      } else if (across.norm() < parallel_sine * v->norm()) {
+        r.fail("up", fmt::format("'up' must not be parallel to 'normal', got {} with normal {}",
+                                 describe(*r.find("up")), describe(*r.find("normal"))));
+      } else {
+        light.up = across.normalized();
+      }
+    }
+  } else {
+    light.up = default_up(light.normal);
+  }
+
+  if (!is_rectangle) {
+    r.forbid("size", fmt::format("applies only to rectangle lights, not {}", shape_name));
+  } else if (r.require("size")) {
+    if (auto v =
+            r.numbers("size", 2, "2 positive numbers (width, height in metres)", is_positive)) {
+      light.width = (*v)[0];
+      light.height = (*v)[1];
+    }
+  }
+
+  if (is_rectangle) {
+    r.forbid("radius", "applies only to disk and sphere lights, not rectangle");
+  } else if (r.require("radius")) {
+    // Both `radius = 0.1` and `radius = [0.1]` are accepted.
+    const std::string_view requirement = "a positive number or [r] (metres)";
+    if (r.find("radius")->is_array()) {
+      if (auto v = r.numbers("radius", 1, requirement, is_positive)) light.radius = (*v)[0];
+    } else if (auto v = r.number("radius", requirement, is_positive)) {
+      light.radius = *v;
+    }
+  }
+
+  const std::string_view color_requirement = "3 finite numbers >= 0, not all zero";
+  if (auto v =
+          r.vec3("color", color_requirement, [](double x) { return std::isfinite(x) && x >= 0; })) {
+    if (v->isZero(0)) r.fail_got("color", color_requirement);
+    light.color = *v;
+  }
+
+  if (r.require("power")) {
+    if (auto v = r.number("power", "a finite number > 0 (watts)", is_positive)) light.power = *v;
+  }
+  if (!r.failed() && light.power > 0) {
+    // Radiant exitance of the brightest channel. Irradiance never exceeds it (a form factor is at
+    // most 1); the bounds keep every lightmap value a normal 32-bit float.
+    const double area = is_rectangle ? light.width * light.height
+                        : is_sphere  ? 4 * std::numbers::pi * light.radius * light.radius
+                                     : std::numbers::pi * light.radius * light.radius;
+    const double exitance = light.power * light.color.maxCoeff() / area;
+    constexpr double kMaxExitance = 1e15;  // the Sun's surface: 6.3e7 W/m²
+    constexpr double kMinExitance = 1e-15;
+    if (!(exitance <= kMaxExitance) || !(exitance >= kMinExitance)) {
+      r.fail("power",
+             fmt::format("'power' {} W over {} m² is an exitance of {} W/m², outside "
+                         "the {} to {} W/m² a lightmap holds; check 'power' and the "
+                         "light's size",
+                         format_double(light.power), format_double(area), format_double(exitance),
+                         format_double(kMinExitance), format_double(kMaxExitance)));
+    }
+  }
+  if (is_sphere) {
+    r.forbid("texture", "applies only to rectangle and disk lights, not sphere");
+  } else if (r.find("texture")) {
+    if (auto texture = existing_file(r, file, "texture", "texture image")) light.texture = *texture;
+  }
+  if (r.failed()) return r.error();
+  return light;
+}
+
+}  // namespace sb

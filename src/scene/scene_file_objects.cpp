@@ -1,0 +1,60 @@
+// The [[object]] tables of a scene file (docs/scene-format.md): name, mesh file, roles, UV
+// channel and object transform.
+#include "scene/scene_file_tables.h"
+#include "scene/toml_table_reader.h"
+
+namespace sb {
+
+namespace {
+
+// Usable as a file stem on every platform the outputs travel to: no separators, no hidden files.
+bool is_valid_object_name(std::string_view name) {
+  if (name.empty() || name.front() == '.') return false;
+  for (char c : name) {
+    const bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
+                    c == '_' || c == '.' || c == '-';
+    if (!ok) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+Expected<ObjectDesc> read_object(const std::filesystem::path& file, const toml::table& table,
+                                 std::size_t index) {
+  TableReader r(file, table, fmt::format("[[object]] #{}", index + 1));
+  ObjectDesc obj;
+  obj.line = static_cast<int>(r.line());
+  if (r.require("name")) {
+    if (auto name = r.string("name")) {
+      if (is_valid_object_name(*name)) {
+        obj.name = *name;
+        r.set_item(item_name("object", obj.name));
+      } else {
+        r.fail_got("name",
+                   "usable as a file stem: letters, digits, '_', '.', '-', not starting with '.'");
+      }
+    }
+  }
+  r.check_known_keys({"name", "mesh", "receiver", "blocker", "uv", "allow_uncovered", "translate",
+                      "rotate_deg", "scale"});
+  r.require("mesh");
+  if (auto mesh = existing_file(r, file, "mesh", "mesh file")) obj.mesh = *mesh;
+  if (auto v = r.boolean("receiver")) obj.receiver = *v;
+  if (auto v = r.boolean("blocker")) obj.blocker = *v;
+  if (auto v = r.boolean("allow_uncovered")) obj.allow_uncovered = *v;
+  if (auto v = r.integer("uv", 0, std::numeric_limits<int>::max())) {
+    obj.uv_channel = static_cast<int>(*v);
+  }
+  const Vec3 translate = r.vec3("translate", "3 finite numbers", is_finite).value_or(Vec3::Zero());
+  const Vec3 rotate_deg =
+      r.vec3("rotate_deg", "3 finite numbers (degrees)", is_finite).value_or(Vec3::Zero());
+  const Vec3 scale = r.vec3("scale", "3 finite non-zero numbers", [](double x) {
+                        return std::isfinite(x) && x != 0;
+                      }).value_or(Vec3::Ones());
+  obj.transform = object_transform(translate, rotate_deg, scale);
+  if (r.failed()) return r.error();
+  return obj;
+}
+
+}  // namespace sb

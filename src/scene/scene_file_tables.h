@@ -1,0 +1,27 @@
+// The readers of a scene file's tables (scene_file_bake.cpp, scene_file_objects.cpp,
+// scene_file_lights.cpp), each checking every key against docs/scene-format.md; load_scene
+// (scene_file.cpp) calls them.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+
+#include <toml++/toml.h>
+
+#include "core/error.h"
+#include "scene/scene.h"
+
+namespace sb {
+
+// The [bake] table.
+Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::table& table);
+
+// The [[object]] table at `index` (from 0) among the file's objects.
+Expected<ObjectDesc> read_object(const std::filesystem::path& file, const toml::table& table,
+                                 std::size_t index);
+
+// The [[light]] table at `index` (from 0) among the file's lights.
+Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::table& table,
+                               std::size_t index);
+
+}  // namespace sb
