@@ -11,8 +11,8 @@
 #include <optional>
 #include <string>
 
-#include "pipeline/bake.h"
 #include "commands.h"
+#include "pipeline/bake.h"
 #include "pipeline/memory_budget.h"
 #include "pipeline/outputs.h"
 #include "scene/scene.h"

@@ -5,8 +5,8 @@
 
 #include <optional>
 
-#include "pipeline/bake.h"
 #include "commands.h"
+#include "pipeline/bake.h"
 
 namespace sbcli {
 

@@ -1,9 +1,9 @@
-// shadowbake_mesh_reader: the process in which Assimp reads one mesh file (src/scene/mesh_reader.h).
-// Started by read_mesh_file with posix_spawn (never a bare fork of a process whose other threads
-// may hold locks), it reads the file named by argv[1] under a data limit of argv[2] bytes, packs
-// what the project uses (mesh_reader.h gives the layout) and writes it to file descriptor 3.
-// Exit status 0 with the answer written; anything else (a crash, the limit, the parent's kill at
-// its deadline) is read by the parent as Assimp's failure.
+// shadowbake_mesh_reader: the process in which Assimp reads one mesh file
+// (src/scene/mesh_reader.h). Started by read_mesh_file with posix_spawn (never a bare fork of a
+// process whose other threads may hold locks), it reads the file named by argv[1] under a data
+// limit of argv[2] bytes, packs what the project uses (mesh_reader.h gives the layout) and writes
+// it to file descriptor 3. Exit status 0 with the answer written; anything else (a crash, the
+// limit, the parent's kill at its deadline) is read by the parent as Assimp's failure.
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <fmt/format.h>

@@ -1,6 +1,6 @@
 // Error values for bad input. The library never exits the process and never throws across its
 // public functions for bad input: it returns an Expected<T> whose error is one line that names
-// the file, the item and the problem (house style, ../shared/docs/style.md rule 5).
+// the file, the item and the problem (docs/scene-format.md, "Errors").
 #pragma once
 
 #include <cassert>

@@ -65,7 +65,7 @@ struct ReportData {
   bool irradiance = false;                // the scene bakes irradiance (W/m²), else visibility
   MethodRun reference;                    // its error also says when its manifest could not be read
   int reference_samples = 0;              // the reference manifest's samples; 0 when unknown
-  std::vector<MethodSection> methods;      // in the order they were given
+  std::vector<MethodSection> methods;     // in the order they were given
   std::vector<ReceiverReport> receivers;  // the reference manifest's, in its order; none when
                                           // the reference failed
   std::vector<std::string> images;        // every image staged, relative to the report folder

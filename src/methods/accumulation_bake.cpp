@@ -1,6 +1,6 @@
 // The `accumulation` baseline: the accumulation buffer of Heckbert & Herf ("Simulating soft
 // shadows with graphics hardware", CMU-CS-97-104, 1997), as Marschner's notes describe it
-// (../shared/seeds/002_5e812a36a2ca34d3.txt, "Accumulating shadow textures"): the area light is
+// (docs/design.md [S2], "Accumulating shadow textures"): the area light is
 // replaced by a constellation of point lights, "one random set of points ... kept fixed", and the
 // soft shadow texture is the sum of their hard shadow textures.
 //
@@ -35,8 +35,8 @@
 #include <cmath>
 #include <numbers>
 
-#include "methods/baselines.h"
 #include "core/sampling.h"
+#include "methods/baselines.h"
 #include "occluders/shadow_rays.h"
 
 namespace sb {
@@ -92,8 +92,8 @@ LightSample constellation_point(const Light& light, const Constellation& c, int 
 
 }  // namespace
 
-MixedImages bake_accumulation(const TexelSpace& space, const BaselineInputs& in,
-                              MethodStats* stats, std::int64_t* rays_traced) {
+MixedImages bake_accumulation(const TexelSpace& space, const BaselineInputs& in, MethodStats* stats,
+                              std::int64_t* rays_traced) {
   const auto& lights = *in.lights;
   const RayScene& rays = *in.rays;
   const BakeSettings& settings = *in.settings;
@@ -124,7 +124,8 @@ MixedImages bake_accumulation(const TexelSpace& space, const BaselineInputs& in,
             if (!lights[l].reaches(position, normal)) continue;
             batch.clear();
             for (int k = 0; k < samples; ++k)
-              batch.add(origin, constellation_point(lights[l], constellations[l], k, position, normal),
+              batch.add(origin,
+                        constellation_point(lights[l], constellations[l], k, position, normal),
                         offset);
             ++local_pairs;
             local_points += batch.size();
@@ -214,20 +215,23 @@ MethodEntry accumulation_method() {
 }
 
 MethodEntry erosion_method() {
-  return baseline_entry("erosion", {"erosion_factor"}, true,
-                        [](const TexelSpace& space, const BaselineInputs& in, MethodStats* stats,
-                           std::int64_t* rays) { return bake_erosion(space, in, stats, rays); },
-                        shadow_map_memory);
+  return baseline_entry(
+      "erosion", {"erosion_factor"}, true,
+      [](const TexelSpace& space, const BaselineInputs& in, MethodStats* stats,
+         std::int64_t* rays) { return bake_erosion(space, in, stats, rays); },
+      shadow_map_memory);
 }
 
 MethodEntry shadow_map_method(const std::string& name) {
   std::vector<std::string> settings = {"shadow_map"};
   if (name == "pcf") settings.push_back("pcf_radius");
   if (name == "adaptive-pcf") settings.insert(settings.end(), {"samples", "seed"});
-  return baseline_entry(name, settings, false,
-                        [](const TexelSpace& space, const BaselineInputs& in, MethodStats* stats,
-                           std::int64_t*) { return bake_shadow_map_filter(space, in, stats); },
-                        shadow_map_memory);
+  return baseline_entry(
+      name, settings, false,
+      [](const TexelSpace& space, const BaselineInputs& in, MethodStats* stats, std::int64_t*) {
+        return bake_shadow_map_filter(space, in, stats);
+      },
+      shadow_map_memory);
 }
 
 }  // namespace sb

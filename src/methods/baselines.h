@@ -1,8 +1,8 @@
-// The baseline methods users compare shadowbake with (design-notes §7), each in lightmap texel
+// The baseline methods users compare shadowbake with (docs/design.md §7), each in lightmap texel
 // space: a texel's world position and normal play the part a screen pixel plays in the papers.
 //   accumulation                       accumulation_bake.cpp   (Heckbert & Herf)
-//   pcf, pcss, adaptive-pcf, chun-oh   shadow_map_bake.cpp     (Reeves; Fernando; Uralsky; Chun & Oh)
-//   erosion                            erosion_bake.cpp        (Klein, Nischwitz & Obermeier)
+//   pcf, pcss, adaptive-pcf, chun-oh   shadow_map_bake.cpp     (Reeves; Fernando; Uralsky; Chun &
+//   Oh) erosion                            erosion_bake.cpp        (Klein, Nischwitz & Obermeier)
 #pragma once
 
 #include <cstdint>
@@ -12,9 +12,9 @@
 
 #include "core/image.h"
 #include "methods/method.h"
+#include "occluders/ray_scene.h"
 #include "scene/lights.h"
 #include "scene/mesh.h"
-#include "occluders/ray_scene.h"
 #include "scene/scene.h"
 #include "texels/texel_space.h"
 
@@ -34,12 +34,12 @@ struct BaselineInputs {
 
 // Each returns width × height RGB images like bake_reference, lights combined by LightMix.
 MixedImages bake_accumulation(const TexelSpace& space, const BaselineInputs& in, MethodStats* stats,
-                        std::int64_t* rays_traced);
+                              std::int64_t* rays_traced);
 // pcf, pcss, adaptive-pcf and chun-oh, by in.settings->method.
 MixedImages bake_shadow_map_filter(const TexelSpace& space, const BaselineInputs& in,
-                             MethodStats* stats);
+                                   MethodStats* stats);
 MixedImages bake_erosion(const TexelSpace& space, const BaselineInputs& in, MethodStats* stats,
-                   std::int64_t* rays_traced);
+                         std::int64_t* rays_traced);
 
 // The registry's entries (each reads the [bake] keys it lists).
 MethodEntry accumulation_method();

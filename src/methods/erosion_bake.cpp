@@ -1,6 +1,6 @@
 // The `erosion` baseline: contact-hardening soft shadows by erosion (Klein, Nischwitz &
-// Obermeier, ../shared/seeds/000_2fed39bea700fc86.txt), moved from screen space into lightmap
-// texel space (design-notes §7). Per light:
+// Obermeier, docs/design.md [S4]), moved from screen space into lightmap
+// texel space (docs/design.md §7). Per light:
 //  1. Hard shadow: one ray per texel towards the light's centre, asking the first blocker
 //     (RayScene::first_hit), so a shadowed texel knows d_b (light to blocker) and d_r (light to
 //     receiver). Texels the light does not reach, and uncovered texels, are no part of the image.

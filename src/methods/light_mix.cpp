@@ -30,8 +30,7 @@ void LightMix::keep(std::size_t light, std::size_t texel, const Vec3& h0, const 
   }
 }
 
-void LightMix::add(Sum& sum, std::size_t light, std::size_t texel, const Vec3& h0,
-                   const Vec3& v) {
+void LightMix::add(Sum& sum, std::size_t light, std::size_t texel, const Vec3& h0, const Vec3& v) {
   sum.h += h0.cwiseProduct(v);
   sum.h0 += h0;
   keep(light, texel, h0, v);

@@ -1,4 +1,4 @@
-// The ray-traced reference (design-notes §1 and §7): the ground truth every other method is
+// The ray-traced reference (docs/design.md §1 and §7): the ground truth every other method is
 // measured against. For each covered texel and each light, `samples` stratified points on the
 // light, one shadow ray each; the light's visibility is the ratio estimate Σ w·v / Σ w (lights.cpp
 // says why), per colour channel with w scaled by the light's texture at the sample, its

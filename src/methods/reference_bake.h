@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "methods/method.h"
-#include "scene/lights.h"
 #include "occluders/ray_scene.h"
+#include "scene/lights.h"
 #include "texels/texel_space.h"
 
 namespace sb {

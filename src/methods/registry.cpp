@@ -8,10 +8,14 @@ namespace sb {
 
 const std::vector<MethodEntry>& method_registry() {
   static const std::vector<MethodEntry> entries = {
-      convolution_method(),          accumulation_method(),
-      shadow_map_method("pcf"),      shadow_map_method("pcss"),
-      shadow_map_method("adaptive-pcf"), erosion_method(),
-      shadow_map_method("chun-oh"),  reference_method(),
+      convolution_method(),
+      accumulation_method(),
+      shadow_map_method("pcf"),
+      shadow_map_method("pcss"),
+      shadow_map_method("adaptive-pcf"),
+      erosion_method(),
+      shadow_map_method("chun-oh"),
+      reference_method(),
   };
   return entries;
 }

@@ -1,8 +1,8 @@
 // Shadow maps (Williams, "Casting curved shadows on curved surfaces", SIGGRAPH 1978, as used by
-// every filtering method in ../shared/seeds/: Reeves et al.'s PCF in 002_5e812a36a2ca34d3.txt,
-// Uralsky's adaptive PCF in 003_7a748a9f4bb46f52.txt, Fernando's PCSS as summarised in
-// 000_2fed39bea700fc86.txt, Chun & Oh in 004_86e5abee5a8e4c8d.txt): a depth image of the blockers
-// rendered from the light's centre, against which a receiver point's depth is compared.
+// every filtering method of docs/design.md's sources: Reeves et al.'s PCF in [S2], Uralsky's
+// adaptive PCF in [S3], Fernando's PCSS as summarised in [S4], Chun & Oh in [S5]): a depth image of
+// the blockers rendered from the light's centre, against which a receiver point's depth is
+// compared.
 //
 // The z-buffer is written here by hand: the project's libraries trace rays (Embree) or rasterise
 // coverage in UV space (uv_rasterizer.cpp), and none on the CPU rasterises triangles into a

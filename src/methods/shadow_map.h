@@ -1,4 +1,4 @@
-// Shadow maps for the filtering baselines (design-notes §7): a perspective depth image of the
+// Shadow maps for the filtering baselines (docs/design.md §7): a perspective depth image of the
 // blockers seen from a light's centre, the frusta that cover a receiver's lit texels, and the
 // depth test of a receiver point against the image (shadow_map.cpp). The filters that read it
 // (PCF, PCSS, adaptive PCF, Chun–Oh) are in shadow_map_bake.cpp.

@@ -1,24 +1,24 @@
-// The shadow-map filtering baselines (design-notes §7), in lightmap texel space: each lit texel
+// The shadow-map filtering baselines (docs/design.md §7), in lightmap texel space: each lit texel
 // looks itself up in a shadow map rendered from the light's centre (shadow_map.cpp) and filters
 // depth comparisons around that point.
 //
 //   pcf           Reeves, Salesin & Cook, "Rendering antialiased shadows with depth maps",
-//                 SIGGRAPH 1987 (../shared/seeds/002_5e812a36a2ca34d3.txt, "Percentage closer
+//                 SIGGRAPH 1987 (docs/design.md [S2], "Percentage closer
 //                 filtering"): the fraction of comparisons that pass over a fixed footprint of
 //                 radius pcf_radius shadow-map pixels.
 //   pcss          Fernando, "Percentage-closer soft shadows", SIGGRAPH 2005 sketch (summarised in
-//                 ../shared/seeds/000_2fed39bea700fc86.txt §2–3): a blocker search, the average
+//                 docs/design.md [S4] §2–3): a blocker search, the average
 //                 blocker depth d_b, the parallel-planes penumbra w = L·(d_r − d_b)/d_b, PCF over
 //                 a footprint of that size.
-//   adaptive-pcf  Uralsky, GPU Gems 2 ch. 17 (../shared/seeds/003_7a748a9f4bb46f52.txt): jittered
+//   adaptive-pcf  Uralsky, GPU Gems 2 ch. 17 (docs/design.md [S3]): jittered
 //                 stratified samples warped to a disk, 8 estimation samples on its rim first, the
 //                 full set only where they disagree.
 //   chun-oh       Chun & Oh, IEICE Trans. Inf. & Syst. E100-D(3), 2017
-//                 (../shared/seeds/004_86e5abee5a8e4c8d.txt): the PCSS filter area split
+//                 (docs/design.md [S5]): the PCSS filter area split
 //                 quad-tree-wise while the shadow tests' variance E(v) − E(v)² exceeds a threshold
 //                 or the light's image varies, each sub-region lit by its own part of the light.
 //
-// The footprint geometry is the parallel-planes one of design-notes §2, read in the shadow map's
+// The footprint geometry is the parallel-planes one of docs/design.md §2, read in the shadow map's
 // tangent coordinates: the ray from a light point s (metres across the axis from the centre) to
 // a receiver point at depth d_r crosses depth d at tangent t_r + s·(1/d − 1/d_r). So a blocker
 // plane at d_b hides light point s exactly where the map's tap at t_r + k·s is blocked,
@@ -27,16 +27,16 @@
 // with taps outside the light's shape left out), scaled by k.
 //
 // Like the convolution, every method gives the emission-weighted unoccluded fraction V_u, not
-// the reference's irradiance-weighted V (design-notes §1). Lights combine through LightMix.
+// the reference's irradiance-weighted V (docs/design.md §1). Lights combine through LightMix.
 #include <tbb/blocked_range.h>
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <stdexcept>
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
 
 #include "core/sampling.h"
 #include "methods/shadow_map.h"

@@ -1,5 +1,5 @@
-// Blocker clusters (design-notes §5, "blocker subdivision"; Soler & Sillion,
-// ../shared/seeds/001_414ff95054935c53.txt). Splits every blocker mesh into its connected
+// Blocker clusters (docs/design.md §5, "blocker subdivision"; Soler & Sillion,
+// docs/design.md [S1]). Splits every blocker mesh into its connected
 // components and each component into a binary tree of spatially coherent clusters, each with the
 // vertices of its convex hull, so that a cluster's depth range along any direction is exact and
 // cheap; marks the convex components (they cannot shadow themselves); and culls the tree against
@@ -39,9 +39,9 @@ Vec3 to_vec(const Point3& p) { return Vec3(p.x(), p.y(), p.z()); }
 Vec3 to_vec(const TriMesh::Point& p) { return Vec3(p[0], p[1], p[2]); }
 
 // Tolerances, as fractions of the size (bounding-box diagonal) of what is compared.
-// kConvexTolerance: a component's faces against its vertices. Not tighter: meshes stored with six decimals tilt
-// the small faces near a cone's apex by 4e-6 of its size (scenes/showcase/cone.obj), and a dent
-// of 1e-4 of an object's size shadows less than a texel.
+// kConvexTolerance: a component's faces against its vertices. Not tighter: meshes stored with six
+// decimals tilt the small faces near a cone's apex by 4e-6 of its size (scenes/showcase/cone.obj),
+// and a dent of 1e-4 of an object's size shadows less than a texel.
 constexpr double kConvexTolerance = 1e-4;
 constexpr double kShaftTolerance = 1e-6;  // points against the shaft's planes; box thickness
 
@@ -239,8 +239,8 @@ bool component_is_closed(const TriMesh& mesh, const std::vector<int>& faces, dou
   for (int f : faces) {
     for (auto h : mesh.fh_range(mesh.face_handle(f))) ++edge_faces[edge_key(mesh, h, quantum)];
   }
-  return !edge_faces.empty() &&
-         std::all_of(edge_faces.begin(), edge_faces.end(), [](const auto& e) { return e.second == 2; });
+  return !edge_faces.empty() && std::all_of(edge_faces.begin(), edge_faces.end(),
+                                            [](const auto& e) { return e.second == 2; });
 }
 
 }  // namespace

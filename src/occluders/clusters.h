@@ -1,5 +1,5 @@
-// The cluster hierarchy of the scene's blocker geometry (design-notes §5; Soler & Sillion's
-// "blocker subdivision", ../shared/seeds/001_414ff95054935c53.txt), built with CGAL on the
+// The cluster hierarchy of the scene's blocker geometry (docs/design.md §5; Soler & Sillion's
+// "blocker subdivision", docs/design.md [S1]), built with CGAL on the
 // OpenMesh meshes in clusters.cpp, the one translation unit that includes CGAL.
 //
 // Each mesh is split into its connected components; each component into a binary tree of

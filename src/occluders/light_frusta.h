@@ -1,4 +1,4 @@
-// The frusta from a light's centre that cover a set of receiver points (design-notes §3: the
+// The frusta from a light's centre that cover a set of receiver points (docs/design.md §3: the
 // projection direction D is the axis of the frustum from the light to the receiver). One frustum
 // towards the middle of the points' bounding box serves them when every point lies within
 // kMaxFrustumHalfAngleDeg of its axis; otherwise (a light beside or among its receiver) the six

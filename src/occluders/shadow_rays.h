@@ -6,9 +6,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "scene/lights.h"
-#include "occluders/ray_scene.h"
 #include "core/sampling.h"
+#include "occluders/ray_scene.h"
+#include "scene/lights.h"
 #include "texels/texel_space.h"
 
 namespace sb {

@@ -1,4 +1,4 @@
-// The virtual parallel configuration (design-notes §3) and the penumbra error metric (§4).
+// The virtual parallel configuration (docs/design.md §3) and the penumbra error metric (§4).
 //
 // Soler & Sillion project blockers and receiver onto planes perpendicular to a direction D
 // chosen as the axis of the frustum from the light to the receiver; here D runs from the light's

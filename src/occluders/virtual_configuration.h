@@ -1,5 +1,5 @@
 // The virtual parallel configuration of one (light, blockers, receiver) triple, and the penumbra
-// error metric that places its planes (design-notes §3–4; ../shared/seeds/001_414ff95054935c53.txt,
+// error metric that places its planes (docs/design.md §3–4; docs/design.md [S1],
 // "General Configuration" and "Measuring the Error").
 #pragma once
 

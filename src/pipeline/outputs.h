@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/bake.h"
 #include "core/error.h"
+#include "pipeline/bake.h"
 #include "pipeline/output_folder.h"
 #include "scene/scene.h"
 

@@ -1,6 +1,6 @@
 // Area lights: closed-form unoccluded irradiance and sampling.
 //
-// H0 (design-notes §1): for a Lambertian emitter of exitance E, H0(y) = E · F(y) with F the
+// H0 (docs/design.md §1): for a Lambertian emitter of exitance E, H0(y) = E · F(y) with F the
 // point-to-surface form factor, F = (1/π) ∫ cosθ_y dω over the part of the light above y's
 // horizon. For a polygon, Lambert's formula gives F exactly as a sum over edges:
 //   F = (1/2π) Σ_i  acos(â_i · â_{i+1}) · n · normalize(a_i × a_{i+1}).
@@ -9,7 +9,7 @@
 // linear in n); a disk cut by the horizon falls back to an equal-area polygon. A sphere seen from
 // y shows exactly the solid angle of its silhouette disk, so it reuses the disk.
 //
-// Sampling (the reference, design-notes §7): area sampling for rectangles and disks,
+// Sampling (the reference, docs/design.md §7): area sampling for rectangles and disks,
 // cone sampling for spheres. The reference estimates V with the ratio Σ w·v / Σ w over the same
 // samples rather than Σ w·v / (N · H0): both converge to H/H0, but the ratio is always in [0, 1]
 // and its noise is only that of v, not of the weight's variation over the light.

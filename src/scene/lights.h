@@ -1,5 +1,5 @@
 // Area lights as the bake methods see them: emission, closed-form unoccluded irradiance H0
-// (design-notes §1) and stratified sampling for the ray-traced reference.
+// (docs/design.md §1) and stratified sampling for the ray-traced reference.
 #pragma once
 
 #include <filesystem>
@@ -40,12 +40,12 @@ class Light {
   // ones for an untextured light.
   Vec3 tint(const Vec2& local) const;
   // Largest distance across the light seen along `axis`: the length that the penumbra error
-  // metric multiplies (design-notes §4), metres.
+  // metric multiplies (docs/design.md §4), metres.
   double extent_across(const Vec3& axis) const;
   // Half the light's extent along each of two unit directions e1, e2 across the axis of
   // projection (the bounding box of its outline seen along that axis), metres.
   Vec2 half_extents(const Vec3& e1, const Vec3& e2) const;
-  // What the source image of design-notes §2 holds at a point of the plane through the centre
+  // What the source image of docs/design.md §2 holds at a point of the plane through the centre
   // perpendicular to `axis` (given as an offset from the centre): the light's relative emission
   // (per channel, tint times 1) where the line through the point along `axis` meets the light,
   // 0 where it misses. A sphere is a uniform disk of its radius.

@@ -16,7 +16,7 @@ namespace sb {
 enum class Quantity { visibility, irradiance };
 
 // How the occluded fractions O_i of different blocker clusters over one texel combine
-// (design-notes §5): `product` takes V = ∏(1 − O_i), clusters hiding independent parts of the
+// (docs/design.md §5): `product` takes V = ∏(1 − O_i), clusters hiding independent parts of the
 // light; `sum` takes V = 1 − Σ O_i, clusters hiding disjoint parts. docs/methods.md has the
 // measurement that chose the default.
 enum class BlockerCombine { product, sum };

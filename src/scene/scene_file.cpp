@@ -1,7 +1,7 @@
 // The scene file reader: parses the TOML scene format (https://toml.io/en/v1.0.0, via toml++)
 // into a Scene and validates every key against docs/scene-format.md. Like pbrt-v4's scene
 // parser, every problem names the file, the line, the item and the key, and keys the reader does
-// not use are reported rather than ignored (../shared/docs/style.md, rule 5).
+// not use are reported rather than ignored (docs/scene-format.md, "Errors").
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <toml++/toml.h>

@@ -1,6 +1,6 @@
 // Reading the tables of a TOML scene file (https://toml.io/en/v1.0.0, via toml++): typed keys
 // whose problems name the file, the line, the item and the key, and unknown keys reported rather
-// than ignored, like pbrt-v4's scene parser (../shared/docs/style.md, rule 5). The readers of
+// than ignored, like pbrt-v4's scene parser (docs/scene-format.md, "Errors"). The readers of
 // [bake], [[object]] and [[light]] (scene_file_tables.h) are built on it.
 #pragma once
 

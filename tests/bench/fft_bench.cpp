@@ -1,8 +1,8 @@
-// Benchmarks of the FFT convolution (src/methods/convolution/fft_convolution.cpp) against its floor: one bare FFTW
-// r2c + c2r round trip of the same size, planned with FFTW_ESTIMATE (what the convolver uses) and
-// with FFTW_MEASURE (what a long-running program could afford). Convolve adds the padding copy,
-// the spectrum product and the output copy to the round trip; the aim is to stay within 2× of
-// the ESTIMATE round trip.
+// Benchmarks of the FFT convolution (src/methods/convolution/fft_convolution.cpp) against its
+// floor: one bare FFTW r2c + c2r round trip of the same size, planned with FFTW_ESTIMATE (what the
+// convolver uses) and with FFTW_MEASURE (what a long-running program could afford). Convolve adds
+// the padding copy, the spectrum product and the output copy to the round trip; the aim is to stay
+// within 2× of the ESTIMATE round trip.
 //
 // Run: shadowbake_bench --benchmark_filter=Fft\|Convolve --benchmark_repetitions=5
 //      --benchmark_report_aggregates_only=true

@@ -1,5 +1,6 @@
-// How long measuring a lightmap against its reference takes (src/evaluation/image_metrics.cpp): SSIM of one
-// 2048² channel, and a whole three-channel comparison, on smooth deterministic patterns.
+// How long measuring a lightmap against its reference takes (src/evaluation/image_metrics.cpp):
+// SSIM of one 2048² channel, and a whole three-channel comparison, on smooth deterministic
+// patterns.
 //
 // Run: build/shadowbake_bench --benchmark_filter=Ssim\|Compare --benchmark_repetitions=5
 //      --benchmark_report_aggregates_only=true

@@ -6,11 +6,11 @@
 #include <string>
 #include <vector>
 
+#include "occluders/ray_scene.h"
+#include "occluders/shaft_culling.h"
 #include "scene/lights.h"
 #include "scene/mesh.h"
-#include "occluders/ray_scene.h"
 #include "scene/scene.h"
-#include "occluders/shaft_culling.h"
 #include "texels/texel_space.h"
 
 namespace sb {

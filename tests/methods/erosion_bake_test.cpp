@@ -115,7 +115,7 @@ TEST(ErosionBake, PenumbraWidensWithBlockerDistance) {
 
 // Both shadow factors against a 1024-sample reference at 256². Measured: pcf RMSE 0.0210
 // (max 0.066), distance RMSE 0.0398 (max 0.30). Both draw a linear ramp along the sides, where
-// the reference's V = H/H0 is weighted (the V_u/V split of design-notes §1 costs 0.016 here);
+// the reference's V = H/H0 is weighted (the V_u/V split of docs/design.md §1 costs 0.016 here);
 // at the corners the box filter gives the product of two ramps, which is exact for a square
 // light and blocker, while the distance to the nearest edge rounds them (the max error). The
 // tolerances are ~1.4× the measurements. The two factors differ, so the setting is honoured.

@@ -1,5 +1,5 @@
 // The ray-traced reference against closed forms: an unoccluded light over a floor (H0 exact,
-// V = 1) and the parallel-plane configuration of design-notes §2, whose unweighted visible
+// V = 1) and the parallel-plane configuration of docs/design.md §2, whose unweighted visible
 // fraction V_u is an overlap of rectangles and whose weighted V = H/H0 is integrated numerically.
 #include <gtest/gtest.h>
 
@@ -119,7 +119,7 @@ TEST(Reference, ParallelPlanesMatchWeightedClosedForm) {
   // 1024 stratified samples: a penumbra texel's standard error is about 0.005.
   EXPECT_LT(rmse, 0.004);
   EXPECT_LT(max_err, 0.015);
-  // The reference sees the kernel's variation over the light that V_u ignores (design-notes §1).
+  // The reference sees the kernel's variation over the light that V_u ignores (docs/design.md §1).
   EXPECT_GT(rmse_split, 2 * rmse);
   RecordProperty("rmse_vs_weighted", std::to_string(rmse));
   RecordProperty("rmse_unweighted_split", std::to_string(rmse_split));

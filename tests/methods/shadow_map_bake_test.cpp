@@ -404,7 +404,7 @@ TEST(ChunOh, PenumbraColourFollowsTheLightImage) {
 // Each method against the reference (256 samples) on scenes/parallel at 128². Measured (RMSE /
 // max): pcf 0.138 / 0.77 (a hard shadow: its 5-pixel footprint is not the 0.25 m penumbra),
 // pcss 0.008 / 0.05, adaptive-pcf 0.019 / 0.13, chun-oh 0.020 / 0.11; the convolution method
-// gets 0.014, and V_u against V alone (design-notes §1) accounts for 0.015. PCSS's figure
+// gets 0.014, and V_u against V alone (docs/design.md §1) accounts for 0.015. PCSS's figure
 // depends on where its fixed 16 × 16 grid's steps fall against the texels: 0.022 at 256².
 // Tolerances: pcf within [0.10, 0.16], the others ≤ 0.03, max ≤ 0.2.
 TEST(ShadowMapFilters, AgreeWithTheReferenceOnParallelPlanes) {

@@ -1,4 +1,4 @@
-// Tests of the blocker cluster hierarchy and the light–receiver shaft (clusters.cpp, design-notes
+// Tests of the blocker cluster hierarchy and the light–receiver shaft (clusters.cpp, docs/design.md
 // §5): connected components, leaves partitioning the faces, exact depth ranges against brute
 // force, convexity of components, and shaft culling that never drops a face in the shaft.
 #include <gtest/gtest.h>

@@ -13,14 +13,14 @@
 
 #include <tbb/parallel_for.h>
 
+#include "core/sampling.h"
+#include "occluders/ray_scene.h"
+#include "occluders/shadow_rays.h"
+#include "occluders/shaft_culling.h"
 #include "pipeline/bake.h"
 #include "scene/lights.h"
 #include "scene/mesh.h"
-#include "occluders/ray_scene.h"
-#include "core/sampling.h"
 #include "scene/scene.h"
-#include "occluders/shadow_rays.h"
-#include "occluders/shaft_culling.h"
 #include "support/test_scenes.h"
 #include "texels/texel_space.h"
 

@@ -1,13 +1,13 @@
 // Closed-form unoccluded irradiance (Lambert's formula, the disk's closed form, the sphere's
-// silhouette) against brute-force numerical integration of design-notes §1 with v ≡ 1, and the
+// silhouette) against brute-force numerical integration of docs/design.md §1 with v ≡ 1, and the
 // sampling weights against the closed form.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
 
-#include "scene/lights.h"
 #include "core/sampling.h"
+#include "scene/lights.h"
 
 namespace sb {
 namespace {

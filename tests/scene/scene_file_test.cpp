@@ -246,8 +246,9 @@ TEST_F(SceneFile, RejectsUnknownBakeKey) {
 
 TEST_F(SceneFile, RejectsUnknownMethod) {
   const std::string text = "[bake]\nmethod = \"foo\"\n" + object_floor + light_panel;
-  expect_error(text, "method", "[bake]", "unknown method 'foo' (known: convolution, accumulation, pcf, pcss, "
-                                       "adaptive-pcf, erosion, chun-oh, reference)");
+  expect_error(text, "method", "[bake]",
+               "unknown method 'foo' (known: convolution, accumulation, pcf, pcss, "
+               "adaptive-pcf, erosion, chun-oh, reference)");
 }
 
 TEST_F(SceneFile, ReadsAndChecksMethodSettings) {
@@ -271,12 +272,12 @@ TEST_F(SceneFile, ReadsAndChecksMethodSettings) {
   EXPECT_EQ(scene.bake_keys[0].line, 2);
   EXPECT_EQ(scene.bake_keys[8].key, "erosion_factor");
   EXPECT_EQ(scene.bake_keys[8].line, 10);
-  expect_error("[bake]\nerror_texels = 0\n" + object_floor + light_panel, "error_texels",
-               "[bake]", "'error_texels' must be a number > 0");
+  expect_error("[bake]\nerror_texels = 0\n" + object_floor + light_panel, "error_texels", "[bake]",
+               "'error_texels' must be a number > 0");
   expect_error("[bake]\nblocker_combine = \"max\"\n" + object_floor + light_panel,
                "blocker_combine", "[bake]", "'blocker_combine' must be \"product\" or \"sum\"");
-  expect_error("[bake]\nweighting = \"area\"\n" + object_floor + light_panel, "weighting",
-               "[bake]", "'weighting' must be \"irradiance\" or \"emission\"");
+  expect_error("[bake]\nweighting = \"area\"\n" + object_floor + light_panel, "weighting", "[bake]",
+               "'weighting' must be \"irradiance\" or \"emission\"");
   expect_error("[bake]\nerosion_factor = 2\n" + object_floor + light_panel, "erosion_factor",
                "[bake]", "'erosion_factor' must be a string");
   expect_error("[bake]\nlight_parts = 3\n" + object_floor + light_panel, "light_parts", "[bake]",

@@ -1,4 +1,4 @@
-// Closed forms of the parallel-plane configuration of design-notes §2, shared by the tests:
+// Closed forms of the parallel-plane configuration of docs/design.md §2, shared by the tests:
 // a 0.5 m square light at z = 1.5 facing down, a 0.6 m square blocker at z = 0.5 centred at
 // (bx, by), a floor at z = 0 (d_b = 1, d_r = 1.5, α = 2/3). Seen from the floor point (x, y) the
 // blocker hides the light-plane square of half-width 0.3/(1 − α) = 0.9 centred at
@@ -118,13 +118,12 @@ inline double rectangle_weight(double x0, double x1, double y0, double y1, doubl
 
 // V = H/H0 under the 0.5 m square light 1.5 m above the floor, blocker at height h: the light's
 // weight less that of its hidden part, exact.
-inline double square_light_weighted_visibility(double x, double y, double bx, double by,
-                                               double h) {
+inline double square_light_weighted_visibility(double x, double y, double bx, double by, double h) {
   const HiddenSquare s = parallel_hidden_square(x, y, bx, by, h);
   const double total = rectangle_weight(-0.25, 0.25, -0.25, 0.25, x, y, 1.5);
-  const double hidden = rectangle_weight(std::max(-0.25, s.cx - s.half), std::min(0.25, s.cx + s.half),
-                                         std::max(-0.25, s.cy - s.half), std::min(0.25, s.cy + s.half),
-                                         x, y, 1.5);
+  const double hidden =
+      rectangle_weight(std::max(-0.25, s.cx - s.half), std::min(0.25, s.cx + s.half),
+                       std::max(-0.25, s.cy - s.half), std::min(0.25, s.cy + s.half), x, y, 1.5);
   return 1.0 - hidden / total;
 }
 
@@ -150,7 +149,8 @@ inline double disk_light_weighted_visibility(double x, double y, double bx, doub
     const double A = (sx - x) * (sx - x) + d * d;
     total += column(A, -half - y, half - y) * dx;
     if (std::abs(sx - s.cx) < s.half)
-      hidden += column(A, std::max(-half, s.cy - s.half) - y, std::min(half, s.cy + s.half) - y) * dx;
+      hidden +=
+          column(A, std::max(-half, s.cy - s.half) - y, std::min(half, s.cy + s.half) - y) * dx;
   }
   return 1.0 - hidden / total;
 }

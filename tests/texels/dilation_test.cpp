@@ -1,5 +1,5 @@
-// Tests of dilate (src/texels/dilation.cpp): ring-by-ring growth from covered texels, the margin limit,
-// and independence from scan order.
+// Tests of dilate (src/texels/dilation.cpp): ring-by-ring growth from covered texels, the margin
+// limit, and independence from scan order.
 #include <gtest/gtest.h>
 
 #include <cstddef>

@@ -1,7 +1,7 @@
-// The blocker image (design-notes §2–3; ../shared/seeds/001_414ff95054935c53.txt, "Transforming
+// The blocker image (docs/design.md §2–3; docs/design.md [S1], "Transforming
 // into Parallel Configuration"): the blockers seen from the light's centre, as a coverage image
 // P on the blocker plane. Coverage rather than a binary point sample per pixel, because the
-// convolution turns a staircase in P into a staircase in every penumbra (design-notes §2
+// convolution turns a staircase in P into a staircase in every penumbra (docs/design.md §2
 // measured it); 4 × 4 samples per pixel, as an OR of 16-bit masks so that overlapping triangles
 // (the front and back of a closed mesh) count once.
 #include "methods/convolution/blocker_image.h"

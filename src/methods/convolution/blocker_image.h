@@ -1,4 +1,4 @@
-// The blocker image of design-notes §2–3: blocker geometry projected from the light's centre onto
+// The blocker image of docs/design.md §2–3: blocker geometry projected from the light's centre onto
 // the blocker plane, as anti-aliased coverage on a regular grid (blocker_image.cpp).
 #pragma once
 
@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "core/geometry.h"
-#include "scene/mesh.h"
 #include "occluders/virtual_configuration.h"
+#include "scene/mesh.h"
 
 namespace sb {
 

@@ -44,28 +44,31 @@ std::vector<std::uint8_t> buried_texels(const TexelSpace& space, const Mesh& rec
       const Bounds3& box = boxes[c];
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, space.texels.size(), 4096),
                         [&](const auto& r) {
-        for (std::size_t t = r.begin(); t != r.end(); ++t) {
-          const Texel& tx = space.texels[t];
-          if (buried[t]) continue;
-          if (own && clusters.face_component[m][std::size_t(tx.face)] == int(c)) continue;
-          const Vec3 p = tx.position.cast<double>();
-          if (((p - box.lo).array() < -tolerance).any() || ((p - box.hi).array() > tolerance).any())
-            continue;
-          const Vec3 normal = tx.geometric_normal.cast<double>();
-          bool inside = true;
-          for (const auto& [n, offset] : planes[c]) {
-            // A face lying against the receiver's surface (a box's bottom on the floor) holds
-            // the texels on it; any other face must have the texel strictly behind it: a texel
-            // on a side's plane sees out through that side, as in the reference.
-            const bool against = n.dot(normal) < -kAgainst;
-            if (n.dot(p) > offset + (against ? tolerance : -tolerance)) {
-              inside = false;
-              break;
-            }
-          }
-          buried[t] = inside;
-        }
-      });
+                          for (std::size_t t = r.begin(); t != r.end(); ++t) {
+                            const Texel& tx = space.texels[t];
+                            if (buried[t]) continue;
+                            if (own && clusters.face_component[m][std::size_t(tx.face)] == int(c))
+                              continue;
+                            const Vec3 p = tx.position.cast<double>();
+                            if (((p - box.lo).array() < -tolerance).any() ||
+                                ((p - box.hi).array() > tolerance).any())
+                              continue;
+                            const Vec3 normal = tx.geometric_normal.cast<double>();
+                            bool inside = true;
+                            for (const auto& [n, offset] : planes[c]) {
+                              // A face lying against the receiver's surface (a box's bottom on the
+                              // floor) holds the texels on it; any other face must have the texel
+                              // strictly behind it: a texel on a side's plane sees out through that
+                              // side, as in the reference.
+                              const bool against = n.dot(normal) < -kAgainst;
+                              if (n.dot(p) > offset + (against ? tolerance : -tolerance)) {
+                                inside = false;
+                                break;
+                              }
+                            }
+                            buried[t] = inside;
+                          }
+                        });
     }
   }
   return buried;

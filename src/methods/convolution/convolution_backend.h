@@ -33,8 +33,7 @@ class ConvolutionBackend {
   // Spectrum of `kernel` (kw × kh floats, row-major, both odd; its centre pixel (kw/2, kh/2) is
   // the origin) for transforms of size tw × th (tw >= kw, th >= kh); may be cached.
   virtual std::shared_ptr<const KernelSpectrum> kernel_spectrum(const std::vector<float>& kernel,
-                                                                int kw, int kh, int tw,
-                                                                int th) = 0;
+                                                                int kw, int kh, int tw, int th) = 0;
 
   // out(x, y) = Σ_u kernel(u) · image((x, y) − u), with the image taken as 0 outside its
   // w × h pixels, for the whole w × h output, in a transform of the spectra's size (at least

@@ -1,6 +1,6 @@
 // Soft shadow textures by convolution (Soler & Sillion, "Fast Calculation of Soft Shadow Textures
-// Using Convolution", SIGGRAPH 1998; ../shared/seeds/001_414ff95054935c53.txt; the mathematics in
-// design-notes §2–4).
+// Using Convolution", SIGGRAPH 1998; docs/design.md [S1]; the mathematics in
+// docs/design.md §2–4).
 //
 // For each receiver, plan_convolution (convolution_plan.cpp) chooses the hierarchy of (light part,
 // blocker cluster, receiver part) triples. Each leaf triple renders its source kernel
@@ -38,10 +38,10 @@
 // is convolved at its own plane: sections exactly, slabs within their penumbra error.
 //
 // V is the irradiance-weighted visibility of the reference to first order across the light
-// (design-notes §6): the weight cos·cos/distance² of the light's points seen from a texel is
+// (docs/design.md §6): the weight cos·cos/distance² of the light's points seen from a texel is
 // expanded about the centre, and the kernel's two first moments, convolved with the same image,
 // give the correction (two more convolutions per leaf; ConvolutionInputs::weighted). Without it
-// V is the emission-weighted V_u of design-notes §1.
+// V is the emission-weighted V_u of docs/design.md §1.
 #include "methods/convolution/convolution_bake.h"
 
 #include <tbb/blocked_range.h>

@@ -5,12 +5,12 @@
 #include <string>
 #include <vector>
 
-#include "methods/convolution/pair_report.h"
 #include "methods/convolution/convolution_plan.h"
+#include "methods/convolution/pair_report.h"
+#include "occluders/virtual_configuration.h"
 #include "scene/lights.h"
 #include "scene/mesh.h"
 #include "texels/texel_space.h"
-#include "occluders/virtual_configuration.h"
 
 namespace sb {
 
@@ -20,7 +20,7 @@ struct ConvolutionInputs {
   PlanInputs plan;
   Quantity quantity = Quantity::visibility;
   BlockerCombine combine = BlockerCombine::sum;
-  // Weight the occluded fraction by irradiance to first order across the light (design-notes
+  // Weight the occluded fraction by irradiance to first order across the light (docs/design.md
   // §6: two more convolutions per leaf), so that V is the irradiance-weighted visibility the
   // reference computes rather than the emission-weighted V_u.
   bool weighted = true;

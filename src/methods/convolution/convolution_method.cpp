@@ -48,10 +48,9 @@ nlohmann::ordered_json pair_json(const PairReport& p) {
 }
 
 std::string pair_text(const PairReport& p) {
-  std::string s =
-      fmt::format("{} <- {}{}{}: D = ({:.3f}, {:.3f}, {:.3f}), {} lit texels", p.receiver, p.light,
-                  p.part.empty() ? "" : " face ", p.part, p.axis[0], p.axis[1], p.axis[2],
-                  p.lit_texels);
+  std::string s = fmt::format("{} <- {}{}{}: D = ({:.3f}, {:.3f}, {:.3f}), {} lit texels",
+                              p.receiver, p.light, p.part.empty() ? "" : " face ", p.part,
+                              p.axis[0], p.axis[1], p.axis[2], p.lit_texels);
   if (p.outside_texels > 0)
     s += fmt::format(" ({} beside the light, left unshadowed)", p.outside_texels);
   s += "\n";
@@ -172,33 +171,33 @@ class ConvolutionMethod final : public Method {
 }  // namespace
 
 MethodEntry convolution_method() {
-  return {"convolution",
-          {"error_texels", "max_image", "max_triples", "light_parts", "trace", "convolve",
-           "trace_error_texels", "blocker_combine", "weighting", "samples", "seed"},
-          [](const BakeSettings& s) {
-            // The planner's clusters serve the convolution (and the buried-texel test); with
-            // convolve = false and rays, no leaf is planned.
-            return MethodNeeds{.rays = s.trace, .clusters = s.convolve || !s.trace, .shafts = true};
-          },
-          [](const Scene& scene) {
-            // Parts of a light: at least light_parts; a sphere light's receiver may be seen
-            // through up to six cube faces, each a frame of its own.
-            const BakeSettings& b = scene.bake;
-            const double texels = double(b.resolution) * double(b.resolution);
-            const double parts = double(scene.lights.size()) * std::max(b.light_parts, 1);
-            return std::vector<MemoryItem>{
-                {"convolution texel arrays",
-                 texels * (kConvolutionBytesPerTexel +
-                           kConvolutionBytesPerTexelAndLightPart * parts)}};
-          },
-          [](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {
-            const BakeSettings& s = context.scene->bake;
-            if (!s.convolve && !s.trace)
-              return scene_error(context.scene->file.string() +
-                                 ": [bake]: convolve = false needs trace = true (with neither, "
-                                 "nothing would compute the shadows)");
-            return std::unique_ptr<Method>(std::make_unique<ConvolutionMethod>(context));
-          }};
+  return {
+      "convolution",
+      {"error_texels", "max_image", "max_triples", "light_parts", "trace", "convolve",
+       "trace_error_texels", "blocker_combine", "weighting", "samples", "seed"},
+      [](const BakeSettings& s) {
+        // The planner's clusters serve the convolution (and the buried-texel test); with
+        // convolve = false and rays, no leaf is planned.
+        return MethodNeeds{.rays = s.trace, .clusters = s.convolve || !s.trace, .shafts = true};
+      },
+      [](const Scene& scene) {
+        // Parts of a light: at least light_parts; a sphere light's receiver may be seen
+        // through up to six cube faces, each a frame of its own.
+        const BakeSettings& b = scene.bake;
+        const double texels = double(b.resolution) * double(b.resolution);
+        const double parts = double(scene.lights.size()) * std::max(b.light_parts, 1);
+        return std::vector<MemoryItem>{
+            {"convolution texel arrays",
+             texels * (kConvolutionBytesPerTexel + kConvolutionBytesPerTexelAndLightPart * parts)}};
+      },
+      [](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {
+        const BakeSettings& s = context.scene->bake;
+        if (!s.convolve && !s.trace)
+          return scene_error(context.scene->file.string() +
+                             ": [bake]: convolve = false needs trace = true (with neither, "
+                             "nothing would compute the shadows)");
+        return std::unique_ptr<Method>(std::make_unique<ConvolutionMethod>(context));
+      }};
 }
 
 }  // namespace sb

@@ -1,5 +1,5 @@
 // The error-driven hierarchy of (light part, blocker cluster, receiver part) triples
-// (design-notes §4–5; ../shared/seeds/001_414ff95054935c53.txt, "Measuring the Error" and
+// (docs/design.md §4–5; docs/design.md [S1], "Measuring the Error" and
 // "Subdivision"). One virtual configuration per triple gets every penumbra width wrong by at
 // most ε = L·(ρ_hi − ρ_lo)/2, ρ = r/d over the triple's blocker depths d and receiver depths r.
 // Splitting the blockers by depth narrows d, splitting the receiver by depth narrows r,
@@ -21,7 +21,7 @@
 //   receiver points seen along the triple's view (source_image.cpp) and sheared elsewhere, an
 //   error counted with ε (Triple::view_error) that blocker-space and light splits reduce.
 // - ε counts in receiver texels up to penumbrae kRelativeSpan texels wide and relative to the
-//   penumbra beyond (design-notes §4 allows either): contact shadows get thin slabs, wide soft
+//   penumbra beyond (docs/design.md §4 allows either): contact shadows get thin slabs, wide soft
 //   penumbrae do not spend the budget on invisible width errors.
 // - The blockers of a triple are clipped to a slab of depth; a texel takes a slab's shadow in
 //   proportion to how much of the slab's geometry lies in front of it (bake_convolution), so
@@ -168,7 +168,7 @@ ConvolutionPlan plan_halves(const ConvolutionPlan& base, const PlanInputs& in,
 }
 
 // Plans one light part within `budget` leaves; when the target is missed, tries the part's two
-// halves (a source subdivision, design-notes §5) and keeps the plan with the smaller worst ε.
+// halves (a source subdivision, docs/design.md §5) and keeps the plan with the smaller worst ε.
 // Where blockers are cut into depth slabs, the part is split into at least `light_parts` pieces
 // whatever ε says (the slabs' plane error, which ε does not measure, scales with the light's
 // size; one plane per blocker has none). Below that count the halves are planned first: if they

@@ -1,5 +1,5 @@
-// The error-driven hierarchy of the convolution method (design-notes §4–5; Soler & Sillion's
-// blocker, receiver and source subdivision, ../shared/seeds/001_414ff95054935c53.txt): for one
+// The error-driven hierarchy of the convolution method (docs/design.md §4–5; Soler & Sillion's
+// blocker, receiver and source subdivision, docs/design.md [S1]): for one
 // receiver, the (light part, blocker cluster, receiver part) triples whose convolutions together
 // give its soft shadows, each with its virtual configuration, penumbra error ε and image size.
 // Built by plan_convolution (convolution_plan.cpp) without convolving anything, so that

@@ -1,4 +1,4 @@
-// FFT convolution of a blocker image with a source kernel (design-notes §2: the occluded
+// FFT convolution of a blocker image with a source kernel (docs/design.md §2: the occluded
 // fraction is the scaled, mirrored source image convolved with the blocker image). Computes
 // out(x) = Σ_u K(u) · image(x − u) as the product of two spectra, with FFTW's single-precision
 // real-to-complex and complex-to-real 2D transforms (Frigo & Johnson, "The Design and
@@ -6,10 +6,10 @@
 // circular; callers pad to get the linear convolution (see fft_convolution.h).
 //
 // Threading: FFTW's planner is process-global and not thread-safe, so plans are made once per
-// (tw, th, FFTW threads) and convolver under a mutex shared by all convolvers, and cached; execution is thread-safe, so convolve() runs
-// the cached plans through the new-array interface on the calling thread's own arrays. Those come
-// from fftwf_malloc, like the arrays the plans were made on, because a plan may only be executed on
-// arrays with the alignment it was planned for.
+// (tw, th, FFTW threads) and convolver under a mutex shared by all convolvers, and cached;
+// execution is thread-safe, so convolve() runs the cached plans through the new-array interface on
+// the calling thread's own arrays. Those come from fftwf_malloc, like the arrays the plans were
+// made on, because a plan may only be executed on arrays with the alignment it was planned for.
 #include "methods/convolution/fft_convolution.h"
 
 #include <fftw3.h>

@@ -1,5 +1,5 @@
 // Linear 2D convolution of a blocker image with a source kernel through FFTW's real transforms
-// (single precision). design-notes §2: the occluded fraction is the source image, scaled and
+// (single precision). docs/design.md §2: the occluded fraction is the source image, scaled and
 // mirrored, convolved with the blocker image; the FFT turns that into a pointwise product of
 // spectra. FFTW's types stay in fft_convolution.cpp.
 #pragma once

@@ -1,5 +1,5 @@
-// One leaf's convolution (Soler & Sillion 1998, ../shared/seeds/001_414ff95054935c53.txt;
-// design-notes §2–4): the source kernel (source_image), the blocker images (blocker_image: the
+// One leaf's convolution (Soler & Sillion 1998, docs/design.md [S1];
+// docs/design.md §2–4): the source kernel (source_image), the blocker images (blocker_image: the
 // cluster's share of the nearest layer, its whole image, a convex solid's section) and their FFT
 // convolutions, on the leaf's grid or on a window per island of its blockers (leaf_windows).
 #include "methods/convolution/leaf_convolution.h"

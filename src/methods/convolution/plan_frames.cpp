@@ -1,4 +1,4 @@
-// Frames, texel groups and root triples of a convolution plan (design-notes §3): which frustum
+// Frames, texel groups and root triples of a convolution plan (docs/design.md §3): which frustum
 // from a light part's centre serves which receiver texels, which texels share their blockers,
 // and which blocker faces lie in the shaft between the light and each group. convolution_plan.cpp
 // refines the roots made here.
@@ -158,9 +158,9 @@ std::vector<FaceRef> group_faces(const ConvolutionPlan& plan, const PlanInputs& 
 
 // Frames, groups and root triples for one light part, appended to `plan`. A planar group (a
 // floor, one face plane of a bracket) is seen along its plane's normal: every texel then lies at
-// the same depth, the receiver plane of design-notes §2 is the group's own plane, and blockers
+// the same depth, the receiver plane of docs/design.md §2 is the group's own plane, and blockers
 // clipped to depth <= that plane are exactly those on the light's side of it. The other groups
-// share one frustum from the light's centre towards the middle of their texels (design-notes §3)
+// share one frustum from the light's centre towards the middle of their texels (docs/design.md §3)
 // when it holds them all within kMaxFrustumHalfAngleDeg; otherwise (a light beside or among its
 // receiver) the six faces of a cube around the light, each its own frustum.
 void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part) {

@@ -1,5 +1,5 @@
-// The refinement of a convolution plan's roots (design-notes §5;
-// ../shared/seeds/001_414ff95054935c53.txt, "Subdivision"): while the worst leaf's ε exceeds the
+// The refinement of a convolution plan's roots (docs/design.md §5;
+// docs/design.md [S1], "Subdivision"): while the worst leaf's ε exceeds the
 // target and the budget allows, the leaf is split where ε falls most per unit of estimated work,
 // by blocker depth, blocker space or receiver depth.
 #include "methods/convolution/plan_refinement.h"

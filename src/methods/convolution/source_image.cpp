@@ -1,5 +1,5 @@
-// The convolution kernel: the source image scaled and mirrored (design-notes §2;
-// ../shared/seeds/001_414ff95054935c53.txt, "Proof that Convolution is Appropriate").
+// The convolution kernel: the source image scaled and mirrored (docs/design.md §2;
+// docs/design.md [S1], "Proof that Convolution is Appropriate").
 //
 // Seen from a receiver point X at depth r and tangent t (from the light's centre), a light point
 // at lateral offset s and depth z (both from the light's centre, in the frame) is hidden by the

@@ -1,12 +1,12 @@
-// The source image of design-notes §2, scaled and mirrored into the convolution kernel
+// The source image of docs/design.md §2, scaled and mirrored into the convolution kernel
 // (source_image.cpp).
 #pragma once
 
 #include <array>
 #include <vector>
 
-#include "scene/lights.h"
 #include "occluders/virtual_configuration.h"
+#include "scene/lights.h"
 
 namespace sb {
 
@@ -15,7 +15,7 @@ struct SourceKernel {
   // Per colour channel, normalised to sum 1 (all zero for a channel the light does not emit).
   std::array<std::vector<float>, 3> channels;
   bool grey = true;  // the three channels are equal: one convolution serves them all
-  // First moments for the irradiance weighting (design-notes §6), grey rectangles and disks
+  // First moments for the irradiance weighting (docs/design.md §6), grey rectangles and disks
   // only (empty otherwise): the emission times the light point's offset along the light's
   // right and up axes (metres), normalised by the same sum as `channels`; and the kernel's
   // centroid along those axes.

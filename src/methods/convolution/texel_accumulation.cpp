@@ -1,4 +1,4 @@
-// Adding convolved leaves into receiver texels (texel_accumulation.h; design-notes §6 for the
+// Adding convolved leaves into receiver texels (texel_accumulation.h; docs/design.md §6 for the
 // irradiance weighting's first-order correction).
 #include "methods/convolution/texel_accumulation.h"
 

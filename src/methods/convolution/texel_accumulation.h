@@ -17,7 +17,7 @@ namespace sb {
 
 // The irradiance weight w = cos θ_light · cos θ_receiver / distance² of the light's points seen
 // from each texel, to first order across the light: the gradient of ln w at the light's centre
-// along its right and up axes, per metre (design-notes §6). Zero where the light's centre lies
+// along its right and up axes, per metre (docs/design.md §6). Zero where the light's centre lies
 // on or below the texel's horizon or the texel on or behind the light's plane (cosines under
 // 1e-3), where a first-order weight would mislead.
 std::vector<Vec2> weight_gradients(const PlanFrame& fr, const TexelSpace& space,

@@ -38,8 +38,7 @@ struct TracedConvolutionStats {
 Expected<MixedImages> bake_traced_convolution(const TexelSpace& space,
                                               const TracedConvolutionInputs& in,
                                               std::vector<PairReport>* reports,
-                                              ConvolutionPlan* plan,
-                                              TracedConvolutionStats* stats);
+                                              ConvolutionPlan* plan, TracedConvolutionStats* stats);
 
 // The registry's entry: the convolution and its settings (error_texels, max_image, max_triples,
 // light_parts, trace, convolve, trace_error_texels, blocker_combine, weighting, samples, seed).

@@ -1,5 +1,5 @@
-// Evaluating one triple of the convolution plan (design-notes §4–5;
-// ../shared/seeds/001_414ff95054935c53.txt, "Measuring the Error"): its blockers projected and
+// Evaluating one triple of the convolution plan (docs/design.md §4–5;
+// docs/design.md [S1], "Measuring the Error"): its blockers projected and
 // clipped to its slab, its footprint on the receiver, the virtual configuration of its depths,
 // its penumbra error ε (in receiver texels, or relative to wide penumbrae), and the image sizes
 // and estimated cost of convolving it.
@@ -18,7 +18,7 @@ namespace {
 
 // Penumbra errors count in texels up to penumbrae this many texels wide, and relative to the
 // penumbra beyond: a width error of one texel is visible at a contact shadow, while a penumbra
-// 100 texels wide may be off by a few texels unseen. (design-notes §4: "compare it with the texel
+// 100 texels wide may be off by a few texels unseen. (docs/design.md §4: "compare it with the texel
 // size, or with the penumbra width, for a relative error".)
 constexpr double kRelativeSpan = 16.0;
 // Image pixels across a leaf's narrowest penumbra, where that is wider than one texel per pixel.
@@ -130,7 +130,7 @@ void evaluate_triple(const ConvolutionPlan& plan, const PlanInputs& in, Triple& 
   t.penumbra_error_texels = scale > 0 ? (t.config.penumbra_error + t.view_error) / scale : 0;
 
   // Image resolution: one pixel per receiver texel at the receiver plane, coarser only where the
-  // narrowest penumbra spans kPenumbraPixels pixels anyway (design-notes §5, "texture
+  // narrowest penumbra spans kPenumbraPixels pixels anyway (docs/design.md §5, "texture
   // resolution"); then within max_image, flagging any loss of detail.
   const double r_star = t.config.receiver_plane;
   const double detail = std::max(plan.texel, t.smallest_penumbra / kPenumbraPixels);

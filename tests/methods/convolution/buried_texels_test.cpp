@@ -6,9 +6,9 @@
 #include <cmath>
 #include <numbers>
 
-#include "pipeline/bake.h"
 #include "methods/convolution/buried_texels.h"
 #include "occluders/clusters.h"
+#include "pipeline/bake.h"
 #include "support/test_scenes.h"
 
 namespace sb {
@@ -88,7 +88,8 @@ TEST(BuriedTexels, FloorUnderTheBoxAndTheConeOnly) {
 
 TEST(BuriedTexels, NoneOfTheReceiversOwnTexels) {
   const ShowcaseTexels s = showcase_texels(128, "box");
-  const auto buried = buried_texels(s.space, *s.receiver, s.loaded.blockers, s.loaded.clusters, 1e-5);
+  const auto buried =
+      buried_texels(s.space, *s.receiver, s.loaded.blockers, s.loaded.clusters, 1e-5);
   std::size_t count = 0;
   for (auto b : buried) count += b;
   EXPECT_EQ(count, 0u) << "of " << buried.size() << " texels of the box";

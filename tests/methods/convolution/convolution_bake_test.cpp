@@ -46,10 +46,10 @@ Errors image_errors(const Image& a, const Image& b, int c = 0) {
   return image_errors::errors(a, b, {}, {.channel = c});
 }
 
-// Exact case (design-notes §2): a square light, a parallel square blocker, at three distance
+// Exact case (docs/design.md §2): a square light, a parallel square blocker, at three distance
 // ratios and off-centre; 512². With weighting = "emission" the bake computes V_u, which the
 // convolution gets exactly: against its closed form within 0.002 RMSE (pixel-scale rasterising
-// only). The default irradiance weighting (design-notes §6) is first order across the light: its
+// only). The default irradiance weighting (docs/design.md §6) is first order across the light: its
 // V = H/H0 against the exact closed form, within 0.004 RMSE (the second-order remainder grows
 // with the penumbra, largest with the blocker nearest the light).
 TEST(ConvolutionBake, ParallelSquareLightMatchesClosedForm) {
@@ -102,7 +102,7 @@ TEST(ConvolutionBake, ParallelDiskLightMatchesClosedForm) {
 }
 
 // Against the reference, the emission-weighted convolution (V_u) differs by the V_u / V split of
-// design-notes §1 (plus the reference's own noise), and by no more; the default irradiance
+// docs/design.md §1 (plus the reference's own noise), and by no more; the default irradiance
 // weighting removes most of the split.
 TEST(ConvolutionBake, AgreesWithReferenceWithinTheWeightingSplit) {
   Scene conv = load("parallel", 256, "convolution");

@@ -195,8 +195,7 @@ TEST(ConvolutionPlan, ConvexSolidsGetTheirSections) {
 // reference on the three subdivision scenes, with the tolerance set from the measured values
 // (table 0.0061, posts 0.0236, bracket floor 0.0263 and bracket 0.0140 at 128², with convex
 // solids counted by Euler's formula, light parts weighted by irradiance and texels buried under
-// the legs and posts dark) plus a margin; when first written they were 0.016, 0.041, 0.057 and
-// 0.035.
+// the legs and posts dark) plus a margin.
 TEST(ConvolutionPlan, SubdivisionScenesAgainstReference) {
   struct Case {
     const char* scene;

@@ -1,6 +1,6 @@
-// Tests of FftConvolver (src/methods/convolution/fft_convolution.cpp) against a direct convolution: linear with
-// enough padding, circular at the border without it, the kernel's centre and direction, the
-// spectrum cache, fast transform sizes, and calls from several threads at once.
+// Tests of FftConvolver (src/methods/convolution/fft_convolution.cpp) against a direct convolution:
+// linear with enough padding, circular at the border without it, the kernel's centre and direction,
+// the spectrum cache, fast transform sizes, and calls from several threads at once.
 #include <gtest/gtest.h>
 #include <tbb/parallel_for.h>
 
@@ -61,8 +61,8 @@ std::vector<float> direct_convolution(const std::vector<float>& image, int w, in
 }
 
 std::vector<float> fft_convolution(const std::vector<float>& image, int w, int h,
-                                   const std::vector<float>& kernel, int kw, int kh, int tw,
-                                   int th, int threads = 0) {
+                                   const std::vector<float>& kernel, int kw, int kh, int tw, int th,
+                                   int threads = 0) {
   FftConvolver convolver;
   if (threads > 0) convolver.set_threads(threads);
   const auto spectrum = convolver.kernel_spectrum(kernel, kw, kh, tw, th);
