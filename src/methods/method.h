@@ -57,7 +57,9 @@ struct BakeContext {
   int threads = 1;                        // worker threads the bake runs on
   double memory_for_images = 0;  // bytes the budget leaves a method's images beyond the estimate
   bool keep_per_light = false;   // MethodResult::images.per_light wanted
-  std::atomic<std::int64_t>* texels_done = nullptr;  // progress counter, may be null
+  // Progress within a receiver, for methods that report it as they go (the pipeline counts each
+  // receiver's texels done when the method returns): a counter, and a callback with it.
+  std::atomic<std::int64_t>* texels_done = nullptr;  // may be null
   ProgressFn progress;                               // may be empty
 };
 

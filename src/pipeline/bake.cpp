@@ -219,8 +219,12 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     input.mesh = &meshes[receivers[r]];
     input.object = &obj;
     input.stream = receivers[r];
+    const std::int64_t done_before = texels_done.load();
     auto baked = (*method)->bake(input);
     if (!baked) return baked.error();
+    // The receiver's texels are done, whatever the method counted on the way.
+    texels_done = done_before + std::int64_t(spaces[r].texels.size());
+    if (context.progress) context.progress(double(texels_done.load()));
     out.image = std::move(baked->images.image);
     out.per_light = std::move(baked->images.per_light);
     out.report = std::move(baked->report);

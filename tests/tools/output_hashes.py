@@ -17,6 +17,7 @@ import hashlib
 import json
 import os
 import pathlib
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -50,7 +51,7 @@ def main():
         for scene in scenes:
             for method in args.methods:
                 out = pathlib.Path(tmp) / "out"
-                subprocess.run(["rm", "-rf", str(out)], check=True)
+                shutil.rmtree(out, ignore_errors=True)
                 proc = subprocess.run(
                     [str(exe), "bake", scene, "-o", str(out), "--method", method, "-q",
                      "--resolution", str(args.resolution), "--samples", str(args.samples),

@@ -156,10 +156,6 @@ class ConvolutionMethod final : public Method {
       }
     }
     report.details = std::move(pairs);
-    if (context_.texels_done) {
-      const auto done = (*context_.texels_done += std::int64_t(receiver.space->texels.size()));
-      if (context_.progress) context_.progress(double(done));
-    }
     return result;
   }
 
