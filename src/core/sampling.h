@@ -1,6 +1,7 @@
 // Deterministic random numbers and stratified sample sets for the sampling methods.
-// Every texel draws from its own stream, seeded from (seed, light, texel), so results do not
-// depend on the number of threads or the order they run in.
+// Every texel draws from its own stream, seeded from (seed, receiver, light, texel), so results
+// do not depend on the number of threads or the order they run in; a light's key is its name
+// (Light::stream), so they do not depend on the other lights either.
 #pragma once
 
 #include <cstdint>

@@ -54,10 +54,9 @@ struct Constellation {
   std::vector<Vec3> sphere_points, sphere_normals;
 };
 
-Constellation make_constellation(const Light& light, int samples, std::uint64_t seed,
-                                 std::size_t index) {
+Constellation make_constellation(const Light& light, int samples, std::uint64_t seed) {
   Constellation c;
-  Rng rng(stream_seed(seed, kAccumulationStream, index));
+  Rng rng(stream_seed(seed, kAccumulationStream, light.stream()));
   stratified_samples(samples, rng, c.strata);
   if (light.shape() == LightShape::sphere) {
     const double radius = light.desc().radius;
@@ -103,7 +102,7 @@ MixedImages bake_accumulation(const TexelSpace& space, const BaselineInputs& in,
   // Seeded by the light alone (not in.stream): every receiver sees the same hard shadows.
   std::vector<Constellation> constellations;
   for (std::size_t l = 0; l < lights.size(); ++l)
-    constellations.push_back(make_constellation(lights[l], samples, settings.seed, l));
+    constellations.push_back(make_constellation(lights[l], samples, settings.seed));
 
   LightMix mix(space, lights, settings.quantity, LightMix::Order::texel_major, in.keep_per_light);
   std::atomic<std::int64_t> traced{0}, contributing{0}, pairs{0};

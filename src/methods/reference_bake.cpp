@@ -33,7 +33,7 @@ MixedImages bake_reference(const TexelSpace& space, const ReferenceInputs& in,
                           const Vec3 h0 = mix.unoccluded(l, t);
                           if (h0.maxCoeff() <= 0) continue;
                           Vec3 v;
-                          if (!estimate_visibility(texel, l, lights[l], rays, in.samples, in.seed,
+                          if (!estimate_visibility(texel, lights[l], rays, in.samples, in.seed,
                                                    in.stream, space.width, batch, strata, &v))
                             continue;
                           local_rays += batch.size();

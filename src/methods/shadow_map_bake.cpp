@@ -483,7 +483,7 @@ MixedImages bake_shadow_map_filter(const TexelSpace& space, const BaselineInputs
               if (filter == Filter::pcss) {
                 visibility[p] = Vec3::Constant(pcss(map, r, horizon, outline, k, c));
               } else if (filter == Filter::adaptive) {
-                Rng rng(stream_seed(settings.seed, (in.stream << 32) ^ l,
+                Rng rng(stream_seed(settings.seed, stream_seed(in.stream, light.stream()),
                                     std::uint64_t(texel.y) * space.width + texel.x));
                 visibility[p] = Vec3::Constant(adaptive_pcf(
                     map, r, horizon, outline.disk_radius, outline.disk_radius * k / map.pixel, grid,

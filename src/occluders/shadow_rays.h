@@ -65,44 +65,43 @@ class ShadowRays {
   Vec3 weight_sum_ = Vec3::Zero();
 };
 
-// The reference's samples of light `l` at one texel (reference_bake.cpp), into `batch`: `samples`
-// stratified points, from the texel's own random stream (seed, receiver stream, light, pixel),
+// The reference's samples of `light` at one texel (reference_bake.cpp), into `batch`: `samples`
+// stratified points, from the texel's own random stream (seed, receiver stream, the light's
+// stream (Light::stream, from its name), pixel),
 // one shadow ray each from the lifted shadow origin; points below the texel's horizon or on the
 // light's back add none.
-inline void add_reference_samples(const Texel& texel, std::size_t l, const Light& light,
-                                  const RayScene& rays, int samples, std::uint64_t seed,
-                                  std::uint64_t stream, int width, ShadowRays& batch,
-                                  std::vector<Vec2>& strata) {
+inline void add_reference_samples(const Texel& texel, const Light& light, const RayScene& rays,
+                                  int samples, std::uint64_t seed, std::uint64_t stream, int width,
+                                  ShadowRays& batch, std::vector<Vec2>& strata) {
   const double offset = rays.surface_offset();
   const Vec3 position = texel.position.cast<double>();
   const Vec3 normal = texel.normal.cast<double>();
   const Vec3 origin =
       texel.shadow_origin.cast<double>() + offset * texel.geometric_normal.cast<double>();
-  Rng rng(stream_seed(seed, (stream << 32) ^ l, std::uint64_t(texel.y) * width + texel.x));
+  Rng rng(stream_seed(seed, stream_seed(stream, light.stream()),
+                      std::uint64_t(texel.y) * width + texel.x));
   stratified_samples(samples, rng, strata);
   batch.clear();
   for (int s = 0; s < samples; ++s)
     batch.add(origin, light.sample(position, normal, strata[s]), offset);
 }
 
-// The reference's estimate of light `l`'s visibility at one texel, traced from those samples.
+// The reference's estimate of `light`'s visibility at one texel, traced from those samples.
 // False when no point contributes. Any method that traces a texel this way gets the reference's
 // value at that many samples, bit for bit.
-inline bool estimate_visibility(const Texel& texel, std::size_t l, const Light& light,
-                                const RayScene& rays, int samples, std::uint64_t seed,
-                                std::uint64_t stream, int width, ShadowRays& batch,
-                                std::vector<Vec2>& strata, Vec3* v) {
-  add_reference_samples(texel, l, light, rays, samples, seed, stream, width, batch, strata);
+inline bool estimate_visibility(const Texel& texel, const Light& light, const RayScene& rays,
+                                int samples, std::uint64_t seed, std::uint64_t stream, int width,
+                                ShadowRays& batch, std::vector<Vec2>& strata, Vec3* v) {
+  add_reference_samples(texel, light, rays, samples, seed, stream, width, batch, strata);
   return batch.visible_fraction(rays, v);
 }
 
 // Whether estimate_visibility would find a contributing point among the same samples, without
 // tracing: false where every sample lies below the texel's horizon or on the light's back.
-inline bool any_sample_contributes(const Texel& texel, std::size_t l, const Light& light,
-                                   const RayScene& rays, int samples, std::uint64_t seed,
-                                   std::uint64_t stream, int width, ShadowRays& batch,
-                                   std::vector<Vec2>& strata) {
-  add_reference_samples(texel, l, light, rays, samples, seed, stream, width, batch, strata);
+inline bool any_sample_contributes(const Texel& texel, const Light& light, const RayScene& rays,
+                                   int samples, std::uint64_t seed, std::uint64_t stream, int width,
+                                   ShadowRays& batch, std::vector<Vec2>& strata) {
+  add_reference_samples(texel, light, rays, samples, seed, stream, width, batch, strata);
   return batch.size() > 0;
 }
 

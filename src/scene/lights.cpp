@@ -138,6 +138,9 @@ Light::Light(const LightDesc& desc, std::shared_ptr<const Image> texture)
     up_ = (desc_.up - desc_.up.dot(desc_.normal) * desc_.normal).normalized();
     right_ = up_.cross(desc_.normal).normalized();
   }
+  // FNV-1a over the name's bytes: stable across runs, builds and platforms.
+  stream_ = 0xcbf29ce484222325ull;
+  for (const unsigned char c : desc_.name) stream_ = (stream_ ^ c) * 0x100000001b3ull;
   exitance_ = desc_.color * (desc_.power / area());
   if (texture_) exitance_ = exitance_.cwiseProduct(texture_mean(*texture_));
 }

@@ -2,6 +2,7 @@
 // (docs/design.md §1) and stratified sampling for the ray-traced reference.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <vector>
@@ -28,6 +29,10 @@ class Light {
   explicit Light(const LightDesc& desc, std::shared_ptr<const Image> texture = nullptr);
 
   const LightDesc& desc() const { return desc_; }
+  // The light's own random streams' key, from its name alone: a light is sampled the same way
+  // whatever other lights the scene holds and in whatever order, so its per-light output equals
+  // a bake of the scene with that light alone (docs/cli.md, per-light outputs).
+  std::uint64_t stream() const { return stream_; }
   LightShape shape() const { return desc_.shape; }
   Vec3 centre() const { return desc_.position; }
   // Emitting surface area in m² (a sphere's whole surface; a rectangle or disk's one side).
@@ -77,6 +82,7 @@ class Light {
  private:
   LightDesc desc_;
   Vec3 right_, up_;
+  std::uint64_t stream_ = 0;
   Vec3 exitance_;
   std::shared_ptr<const Image> texture_;
 };

@@ -71,6 +71,28 @@ TEST_P(PerLight, EachLightsImageIsThatLightAlone) {
   }
 }
 
+// Light l's per-light visibility is what the scene gives with light l alone in it (the others
+// removed, so light l may stand at another index): to float rounding, for every method.
+TEST_P(PerLight, EachLightsVisibilityIsTheSceneWithThatLightAlone) {
+  Scene scene = load("showcase", 32, GetParam());
+  scene.bake.samples = 8;
+  scene.bake.shadow_map = 256;
+  ASSERT_EQ(scene.lights.size(), 2u);
+  const BakeResult all = bake_or_fail(scene, true);
+  for (std::size_t l = 0; l < scene.lights.size(); ++l) {
+    Scene alone = scene;
+    alone.lights = {scene.lights[l]};
+    const BakeResult one = bake_or_fail(alone, false);
+    ASSERT_EQ(one.receivers.size(), all.receivers.size());
+    for (std::size_t r = 0; r < all.receivers.size(); ++r) {
+      const ReceiverBake& rb = all.receivers[r];
+      ASSERT_EQ(rb.per_light.size(), scene.lights.size()) << rb.name;
+      EXPECT_LE(worst_difference(rb.per_light[l], one.receivers[r].image, rb.covered), 1e-6)
+          << rb.name << ", light " << scene.lights[l].name;
+    }
+  }
+}
+
 // Keeping the per-light images changes nothing in the combined one.
 TEST_P(PerLight, KeepingThemLeavesTheMixAlone) {
   Scene scene = load("showcase", 32, GetParam());

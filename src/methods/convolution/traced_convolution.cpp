@@ -148,14 +148,14 @@ Expected<MixedImages> bake_traced_convolution(const TexelSpace& space,
           // samples may all fall there, and it then leaves the light out: so does this method,
           // so that the two agree to the texel (no ray is traced for it).
           if (in.rays && partly_below_horizon(lights[l], p, normal) &&
-              !any_sample_contributes(tx, l, lights[l], *in.rays, in.samples, in.seed, in.stream,
+              !any_sample_contributes(tx, lights[l], *in.rays, in.samples, in.seed, in.stream,
                                       space.width, batch, strata))
             continue;
         } else if (in.rays && trace[l][t]) {
           Vec3 traced_v;
           ++local_traced;
           // As the reference does: a light none of whose samples contributes is left out.
-          if (!estimate_visibility(tx, l, lights[l], *in.rays, in.samples, in.seed, in.stream,
+          if (!estimate_visibility(tx, lights[l], *in.rays, in.samples, in.seed, in.stream,
                                    space.width, batch, strata, &traced_v))
             continue;
           v = traced_v;
