@@ -59,6 +59,10 @@ struct BakeArgs {
   std::string out_dir;
   std::optional<std::string> method, quantity;
   std::optional<int> resolution, samples;
+  std::optional<double> texels_per_metre;
+  std::optional<std::string> encoding;
+  std::optional<int> atlas_size, atlas_padding;
+  bool per_light = false, shadowmask = false, gltf = false, no_atlas = false;
   std::optional<std::uint64_t> seed;
   std::optional<double> error_texels;
   std::optional<std::uint64_t> max_memory;
@@ -89,7 +93,22 @@ int run_bake(const BakeArgs& args) {
   if (args.quantity)
     settings.quantity =
         *args.quantity == "irradiance" ? sb::Quantity::irradiance : sb::Quantity::visibility;
-  if (args.resolution) settings.resolution = *args.resolution;
+  if (args.resolution) {
+    settings.resolution = *args.resolution;
+    settings.texels_per_metre = 0;
+  }
+  if (args.texels_per_metre) settings.texels_per_metre = *args.texels_per_metre;
+  sb::OutputSettings& output = scene->output;
+  if (args.encoding) output.encoding = *sb::parse_encoding(*args.encoding);
+  output.per_light |= args.per_light;
+  output.shadowmask |= args.shadowmask;
+  output.gltf |= args.gltf;
+  if (args.atlas_size || args.atlas_padding) {
+    if (!output.atlas) output.atlas = sb::AtlasSettings{};
+    if (args.atlas_size) output.atlas->size = *args.atlas_size;
+    if (args.atlas_padding) output.atlas->padding = *args.atlas_padding;
+  }
+  if (args.no_atlas) output.atlas.reset();
   if (args.samples) settings.samples = *args.samples;
   if (args.seed) settings.seed = *args.seed;
   if (args.error_texels) settings.error_texels = *args.error_texels;
@@ -102,6 +121,7 @@ int run_bake(const BakeArgs& args) {
   if (sb::Status names = sb::check_output_names(*scene); !names) return fail(names.error());
   auto folder = sb::OutputFolder::open(args.out_dir);
   if (!folder) return fail(folder.error());
+  // With an atlas, the first atlas's names (how many there are is known after the bake).
   if (sb::Status targets = folder->check_targets(sb::output_names(*scene)); !targets)
     return fail(targets.error());
 
@@ -128,13 +148,18 @@ int run_bake(const BakeArgs& args) {
 
   if (!args.quiet) {
     for (const auto& r : result->receivers) {
-      fmt::print("  {:<16} {}/{}.exr, .png  ({} texels, {:.2f} s)\n", r.name, args.out_dir, r.name,
+      fmt::print("  {:<16} {}² ({} texels covered, {:.2f} s)\n", r.name, r.image.width,
                  r.covered_texels, r.seconds);
     }
+    const std::string size = settings.texels_per_metre > 0
+                                 ? fmt::format("{:.4g} texels per metre", settings.texels_per_metre)
+                                 : fmt::format("{}²", settings.resolution);
+    const std::string atlases =
+        result->atlas ? fmt::format(", {} atlas(es)", result->atlas->sizes.size()) : "";
     fmt::print(
-        "baked {} receiver(s) with '{}' at {}² into {}/ (manifest.json): load {:.2f} s, bake "
+        "baked {} receiver(s) with '{}' at {}{} into {}/ (manifest.json): load {:.2f} s, bake "
         "{:.2f} s, write {:.2f} s, total {:.2f} s\n",
-        result->receivers.size(), settings.method, settings.resolution, args.out_dir,
+        result->receivers.size(), settings.method, size, atlases, args.out_dir,
         result->load_seconds, result->bake_seconds, write_seconds, total_seconds);
   }
   return ok;
@@ -150,6 +175,9 @@ Runner add_bake_command(CLI::App& app) {
     std::int64_t seed = 0;
     double error_texels = 1;
     std::string max_memory;
+    double texels_per_metre = 0;
+    std::string encoding;
+    int atlas_size = 0, atlas_padding = 0;
   };
   auto o = std::make_shared<Options>();
   auto* bake = app.add_subcommand("bake", "bake every receiver of a scene into OUTDIR");
@@ -163,6 +191,27 @@ Runner add_bake_command(CLI::App& app) {
                            ->check(CLI::IsMember({"visibility", "irradiance"}));
   auto* resolution_opt = bake->add_option("--resolution", o->resolution, "texels per side")
                              ->check(CLI::Range(1, 16384));
+  auto* density_opt =
+      bake->add_option("--texels-per-metre", o->texels_per_metre,
+                       "size each lightmap by its surface: texels per metre (overrides [bake])")
+          ->check(CLI::Range(1e-6, 1e6));
+  resolution_opt->excludes(density_opt);
+  auto* encoding_opt = bake->add_option("--encoding", o->encoding,
+                                        "lightmap files: linear-exr, half-exr, png, rgbm-png")
+                           ->check(CLI::IsMember({"linear-exr", "half-exr", "png", "rgbm-png"}));
+  bake->add_flag("--per-light", o->args.per_light, "also write each light's own image");
+  bake->add_flag("--shadowmask", o->args.shadowmask,
+                 "also write shadow masks: up to four lights in R, G, B, A");
+  bake->add_flag("--gltf", o->args.gltf, "also write scene.glb with the lightmaps bound");
+  auto* atlas_opt =
+      bake->add_option("--atlas", o->atlas_size, "pack the lightmaps into atlases of this size")
+          ->check(CLI::Range(64, 16384));
+  auto* padding_opt =
+      bake->add_option("--atlas-padding", o->atlas_padding, "texels around each atlas rectangle")
+          ->check(CLI::Range(1, 256));
+  auto* no_atlas_opt = bake->add_flag("--no-atlas", o->args.no_atlas,
+                                      "one set of files per receiver, whatever [output] says");
+  no_atlas_opt->excludes(atlas_opt)->excludes(padding_opt);
   auto* samples_opt = bake->add_option("--samples", o->samples, "light samples per texel")
                           ->check(CLI::Range(1, 1 << 20));
   auto* seed_opt =
@@ -199,6 +248,10 @@ Runner add_bake_command(CLI::App& app) {
     if (*method_opt) o->args.method = o->method;
     if (*quantity_opt) o->args.quantity = o->quantity;
     if (*resolution_opt) o->args.resolution = o->resolution;
+    if (*density_opt) o->args.texels_per_metre = o->texels_per_metre;
+    if (*encoding_opt) o->args.encoding = o->encoding;
+    if (*atlas_opt) o->args.atlas_size = o->atlas_size;
+    if (*padding_opt) o->args.atlas_padding = o->atlas_padding;
     if (*samples_opt) o->args.samples = o->samples;
     if (*seed_opt) o->args.seed = std::uint64_t(o->seed);
     if (*memory_opt) {

@@ -139,8 +139,11 @@ sb::MethodRun bake_method(const ReportArgs& args, const std::string& method,
   fs::remove_all(run.folder, ec);
   fs::create_directories(runs, ec);
 
-  std::vector<std::string> child_args = {"bake",     args.scene, "-o",     run.folder.string(),
-                                         "--method", method,     "--quiet"};
+  // Each receiver's own lightmap as float EXR, whatever the scene's [output] says: the report
+  // compares receivers texel by texel.
+  std::vector<std::string> child_args = {"bake",       args.scene,  "-o",      run.folder.string(),
+                                         "--method",   method,      "--quiet", "--no-atlas",
+                                         "--encoding", "linear-exr"};
   if (args.resolution) {
     child_args.push_back("--resolution");
     child_args.push_back(std::to_string(*args.resolution));

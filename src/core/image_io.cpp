@@ -1,5 +1,6 @@
 #include "core/image_io.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 #include <OpenImageIO/strutil.h>
 #include <fcntl.h>
@@ -81,6 +82,39 @@ void remove_quietly(const fs::path& path) {
 
 }  // namespace
 
+namespace {
+
+// The 8-bit values write_image stores: value·255 rounded, clamped to [0, 255], NaN as 0.
+std::vector<std::uint8_t> to_bytes(const Image& image) {
+  std::vector<std::uint8_t> bytes(image.pixels.size());
+  std::transform(image.pixels.begin(), image.pixels.end(), bytes.begin(), [](float v) {
+    const float c = std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
+    return std::uint8_t(std::lround(c * 255.0f));
+  });
+  return bytes;
+}
+
+}  // namespace
+
+Expected<std::vector<std::uint8_t>> png_bytes(const Image& image, const std::string& what) {
+  QuietStderr quiet;
+  std::vector<unsigned char> buffer;
+  OIIO::Filesystem::IOVecOutput proxy(buffer);
+  auto out = OIIO::ImageOutput::create("png");
+  if (!out) return output_error(what + ": cannot encode PNG: " + OIIO::geterror());
+  OIIO::ImageSpec spec(image.width, image.height, image.channels, OIIO::TypeDesc::UINT8);
+  spec.attribute("DateTime", "");
+  spec.attribute("oiio:UnassociatedAlpha", 1);
+  if (!out->set_ioproxy(&proxy) || !out->open("memory.png", spec)) {
+    return output_error(what + ": cannot encode PNG: " + out->geterror());
+  }
+  const std::vector<std::uint8_t> bytes = to_bytes(image);
+  bool ok = out->write_image(OIIO::TypeDesc::UINT8, bytes.data());
+  ok = out->close() && ok;
+  if (!ok) return output_error(what + ": cannot encode PNG: " + out->geterror());
+  return std::vector<std::uint8_t>(buffer.begin(), buffer.end());
+}
+
 Status write_image(const fs::path& path, const Image& image, PixelFormat format) {
   QuietStderr quiet;
   const fs::path tmp = temporary_sibling(path);
@@ -89,9 +123,14 @@ Status write_image(const fs::path& path, const Image& image, PixelFormat format)
   if (!out) {
     return output_error(path.string() + ": cannot write images of this type: " + OIIO::geterror());
   }
-  const auto type = format == PixelFormat::float32 ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8;
+  const auto type = format == PixelFormat::float32   ? OIIO::TypeDesc::FLOAT
+                    : format == PixelFormat::float16 ? OIIO::TypeDesc::HALF
+                                                     : OIIO::TypeDesc::UINT8;
   OIIO::ImageSpec spec(image.width, image.height, image.channels, type);
-  if (format == PixelFormat::float32) spec.attribute("compression", "zip");
+  if (format != PixelFormat::uint8) spec.attribute("compression", "zip");
+  // A fourth channel is data (RGBM's multiplier, a shadow mask's fourth light), not an alpha
+  // the colour was multiplied by: stored as given, never divided by it.
+  spec.attribute("oiio:UnassociatedAlpha", 1);
   // OIIO stamps EXR files with the current time unless DateTime is set; an empty one writes
   // none, so the same bake gives the same bytes.
   spec.attribute("DateTime", "");
@@ -101,14 +140,11 @@ Status write_image(const fs::path& path, const Image& image, PixelFormat format)
     return output_error(path.string() + ": cannot write: " + why);
   }
   bool ok;
-  if (format == PixelFormat::float32) {
+  if (format != PixelFormat::uint8) {
+    // OIIO converts the floats to half itself.
     ok = out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data());
   } else {
-    std::vector<std::uint8_t> bytes(image.pixels.size());
-    std::transform(image.pixels.begin(), image.pixels.end(), bytes.begin(), [](float v) {
-      const float c = std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
-      return std::uint8_t(std::lround(c * 255.0f));
-    });
+    const std::vector<std::uint8_t> bytes = to_bytes(image);
     ok = out->write_image(OIIO::TypeDesc::UINT8, bytes.data());
   }
   ok = out->close() && ok;
@@ -137,7 +173,11 @@ Expected<Image> read_image(const fs::path& path, bool linearise, std::uint64_t m
                                                    "socket)"));
   }
   QuietStderr quiet;
-  auto in = OIIO::ImageInput::open(path.string());
+  // A fourth channel comes back as stored: OIIO would otherwise multiply the colour of a PNG by
+  // its alpha, which for RGBM or a shadow mask is data.
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  auto in = OIIO::ImageInput::open(path.string(), &config);
   if (!in) return input_error(path.string() + ": cannot read image: " + one_line(OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();
   const double bytes = double(spec.width) * spec.height * spec.nchannels * sizeof(float);

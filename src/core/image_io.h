@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "core/error.h"
@@ -13,11 +14,15 @@
 
 namespace sb {
 
-enum class PixelFormat { float32, uint8 };
+enum class PixelFormat { float32, float16, uint8 };
 
 // Writes `image` to `path` (format from the extension) with pixels stored as `format`; uint8
 // clamps to [0, 1] and rounds value·255 (no transfer curve: encode first if one is wanted).
 Status write_image(const std::filesystem::path& path, const Image& image, PixelFormat format);
+
+// The bytes of `image` as an 8-bit PNG file (uint8 as write_image stores it), made in memory
+// (for files that embed images, such as a glTF binary). Errors name `what`.
+Expected<std::vector<std::uint8_t>> png_bytes(const Image& image, const std::string& what);
 
 // Reads any OIIO-readable image as float, keeping its channel count. With `linearise`, values
 // of an image whose colour space OIIO reports as sRGB (8-bit PNG, JPEG, ...) are decoded to

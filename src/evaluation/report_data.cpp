@@ -87,7 +87,7 @@ class ImageStager {
       return write_image(folder_.staged(relative), tone_map_irradiance(exr, white_),
                          PixelFormat::uint8);
     }
-    return copy_into_staging(bake_folder / entry.files.png, folder_.staged(relative));
+    return copy_into_staging(bake_folder / entry.files->preview->file, folder_.staged(relative));
   }
 
   Status stage_image(const Image& image, const std::string& relative) {
@@ -147,8 +147,14 @@ Expected<ReceiverReport> compare_receiver(const ManifestReceiver& entry, const M
   ReceiverReport receiver;
   receiver.name = entry.name;
   receiver.cells.resize(methods.size());
-  auto ref_image = read_image(reference.folder / entry.files.exr);
-  auto coverage = read_image(reference.folder / entry.files.coverage);
+  if (!entry.files || !entry.files->preview) {
+    receiver.error = (reference.folder / kManifestFile).string() + ": receiver '" + entry.name +
+                     "' has no float lightmap of its own (an atlas, or an 8-bit encoding)";
+    for (auto& cell : receiver.cells) cell.error = "no reference: " + receiver.error;
+    return receiver;
+  }
+  auto ref_image = read_image(reference.folder / entry.files->lightmap.file);
+  auto coverage = read_image(reference.folder / entry.files->coverage.file);
   if (!ref_image || !coverage) {
     receiver.error = !ref_image ? ref_image.error().message : coverage.error().message;
     for (auto& cell : receiver.cells) cell.error = "no reference: " + receiver.error;
@@ -186,7 +192,12 @@ Expected<ReceiverReport> compare_receiver(const ManifestReceiver& entry, const M
       cell.predicted_metres = own["penumbra_error"].value("metres", 0.0);
       cell.predicted_texels = own["penumbra_error"].value("texels", 0.0);
     }
-    const fs::path exr = run.folder / run_entry->files.exr;
+    if (!run_entry->files || !run_entry->files->preview) {
+      cell.error = (run.folder / kManifestFile).string() + ": receiver '" + receiver.name +
+                   "' has no float lightmap of its own";
+      continue;
+    }
+    const fs::path exr = run.folder / run_entry->files->lightmap.file;
     auto image = read_image(exr);
     if (!image) {
       cell.error = image.error().message;

@@ -40,18 +40,17 @@ class BaselineMethod final : public Method {
 
 // Shadow-map baselines hold a depth map (float) per light and cube face at shadow_map², and,
 // running light by light, every light's V per texel until the lights are mixed (LightMix).
-std::vector<MemoryItem> shadow_map_memory(const Scene& scene) {
+std::vector<MemoryItem> shadow_map_memory(const Scene& scene, double texels) {
   const BakeSettings& b = scene.bake;
   const double lights = double(scene.lights.size());
   const double map = double(b.shadow_map) * double(b.shadow_map) * 4;
-  const double texels = double(b.resolution) * double(b.resolution);
   return {{"shadow maps", map * lights * 6},
           {"per-light visibility", texels * lights * (sizeof(Vec3f) + 1)}};
 }
 
 MethodEntry baseline_entry(std::string name, std::vector<std::string> settings, bool rays,
                            BaselineMethod::Bake bake,
-                           std::function<std::vector<MemoryItem>(const Scene&)> memory) {
+                           std::function<std::vector<MemoryItem>(const Scene&, double)> memory) {
   return {std::move(name), std::move(settings),
           [rays](const BakeSettings&) { return MethodNeeds{.rays = rays}; }, std::move(memory),
           [bake](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {

@@ -29,7 +29,7 @@ struct BaselineInputs {
   const Mesh* receiver = nullptr;
   const BakeSettings* settings = nullptr;  // method, quantity, samples, seed, shadow_map, ...
   std::uint64_t stream = 0;                // the receiver's index, for its own random streams
-  bool keep_per_light = false;             // MixedImages::per_light wanted
+  KeepPerLight keep_per_light;             // per-light images wanted (MixedImages)
 };
 
 // Each returns width × height RGB images like bake_reference, lights combined by LightMix.

@@ -7,15 +7,19 @@
 namespace sb {
 
 LightMix::LightMix(const TexelSpace& space, const std::vector<Light>& lights, Quantity quantity,
-                   Order order, bool keep_per_light)
-    : space_(space), lights_(lights), quantity_(quantity), keep_per_light_(keep_per_light) {
+                   Order order, KeepPerLight keep)
+    : space_(space), lights_(lights), quantity_(quantity), keep_(keep) {
   out_.image = Image(space.width, space.height, 3, 0.0f);
   if (order == Order::light_major) {
     set_values_.assign(lights.size(), std::vector<Vec3f>(space.texels.size(), Vec3f::Zero()));
     set_flags_.assign(lights.size(), std::vector<std::uint8_t>(space.texels.size(), 0));
   }
-  if (keep_per_light_)
-    out_.per_light.assign(lights.size(), Image(space.width, space.height, 3, 0.0f));
+  if (keep_.values) out_.per_light.assign(lights.size(), Image(space.width, space.height, 3, 0.0f));
+  if (keep_.visibility) {
+    Image unreached(space.width, space.height, 2, 0.0f);
+    for (std::size_t i = 0; i < unreached.pixels.size(); i += 2) unreached.pixels[i] = 1.0f;
+    out_.per_light_visibility.assign(lights.size(), unreached);
+  }
 }
 
 Vec3 LightMix::unoccluded(std::size_t light, std::size_t texel) const {
@@ -24,12 +28,21 @@ Vec3 LightMix::unoccluded(std::size_t light, std::size_t texel) const {
 }
 
 void LightMix::keep(std::size_t light, std::size_t texel, const Vec3& h0, const Vec3& v) {
-  if (!keep_per_light_) return;
+  if (!keep_.any()) return;
   const Texel& t = space_.texels[texel];
-  float* px = out_.per_light[light].at(t.x, t.y);
-  for (int c = 0; c < 3; ++c) {
-    const double value = quantity_ == Quantity::irradiance ? h0[c] * v[c] : (h0[c] > 0 ? v[c] : 0);
-    px[c] = float(value);
+  if (keep_.values) {
+    float* px = out_.per_light[light].at(t.x, t.y);
+    for (int c = 0; c < 3; ++c) {
+      const double value =
+          quantity_ == Quantity::irradiance ? h0[c] * v[c] : (h0[c] > 0 ? v[c] : 0);
+      px[c] = float(value);
+    }
+  }
+  const double weight = h0.sum();
+  if (keep_.visibility && weight > 0) {
+    float* px = out_.per_light_visibility[light].at(t.x, t.y);
+    px[0] = float(h0.dot(v) / weight);
+    px[1] = 1.0f;
   }
 }
 

@@ -17,12 +17,23 @@
 
 namespace sb {
 
-// A method's values for one receiver: the combined image and, when kept, one image per light
-// (light l's V_l, or H0_l·V_l for irradiance, at the texels where it counts; 0 elsewhere), each
-// width × height RGB, uncovered texels 0.
+// Which per-light images a mix keeps beside the combined one.
+struct KeepPerLight {
+  bool values = false;      // MixedImages::per_light
+  bool visibility = false;  // MixedImages::per_light_visibility
+  bool any() const { return values || visibility; }
+};
+
+// A method's values for one receiver: the combined image and, when kept, per light
+//  - per_light: light l's V_l, or H0_l·V_l for irradiance, at the texels where it counts, 0
+//    elsewhere; width × height RGB, uncovered texels 0;
+//  - per_light_visibility: two channels, light l's visibility (its H0-weighted mean over colour
+//    channels, Σ_c H0_c·V_c / Σ_c H0_c) and 1 where it counts at the texel; (1, 0) elsewhere,
+//    uncovered texels included (what a shadow mask holds, lightmaps/shadowmask.h).
 struct MixedImages {
   Image image;
-  std::vector<Image> per_light;  // empty unless the mix was made with keep_per_light
+  std::vector<Image> per_light;             // empty unless kept
+  std::vector<Image> per_light_visibility;  // empty unless kept
 };
 
 class LightMix {
@@ -31,7 +42,7 @@ class LightMix {
   // light by light (set, then finish combines; it holds every light's V until then).
   enum class Order { texel_major, light_major };
   LightMix(const TexelSpace& space, const std::vector<Light>& lights, Quantity quantity,
-           Order order, bool keep_per_light);
+           Order order, KeepPerLight keep);
 
   // H0_l at texel t (per channel, W/m²): a light whose H0 is 0 everywhere need not be estimated.
   Vec3 unoccluded(std::size_t light, std::size_t texel) const;
@@ -56,7 +67,7 @@ class LightMix {
   const TexelSpace& space_;
   const std::vector<Light>& lights_;
   Quantity quantity_;
-  bool keep_per_light_;
+  KeepPerLight keep_;
   MixedImages out_;
   // Light-major methods' values until finish(): per light, V per texel and whether it was set;
   // empty for texel-major ones.

@@ -56,7 +56,7 @@ struct BakeContext {
   const ShaftCuller* shafts = nullptr;    // built when needs().shafts
   int threads = 1;                        // worker threads the bake runs on
   double memory_for_images = 0;  // bytes the budget leaves a method's images beyond the estimate
-  bool keep_per_light = false;   // MethodResult::images.per_light wanted
+  KeepPerLight keep_per_light;   // per-light images wanted (MixedImages)
   // Progress within a receiver, for methods that report it as they go (the pipeline counts each
   // receiver's texels done when the method returns): a counter, and a callback with it.
   std::atomic<std::int64_t>* texels_done = nullptr;  // may be null
@@ -104,9 +104,10 @@ struct MethodEntry {
   // max_memory); others given in the scene are reported as ignored.
   std::vector<std::string> settings;
   std::function<MethodNeeds(const BakeSettings&)> needs;
-  // Its own large arrays for a bake of `scene`, beyond texel space and the lightmaps (counted by
-  // pipeline/memory_budget.cpp), estimated before anything is allocated; may be empty.
-  std::function<std::vector<MemoryItem>(const Scene&)> memory;
+  // Its own large arrays for a bake of `scene` whose largest receiver has `texels` texels, beyond
+  // texel space and the lightmaps (counted by pipeline/memory_budget.cpp), estimated before
+  // anything is allocated; may be empty.
+  std::function<std::vector<MemoryItem>(const Scene&, double texels)> memory;
   // Checks the settings (errors name the scene file and [bake]) and makes the method.
   std::function<Expected<std::unique_ptr<Method>>(const BakeContext&)> make;
 };

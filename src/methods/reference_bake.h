@@ -20,8 +20,8 @@ struct ReferenceInputs {
   std::uint64_t seed = 0;
   std::uint64_t stream = 0;  // distinguishes receivers so each has its own random streams
   std::atomic<std::int64_t>* texels_done = nullptr;  // progress counter, may be null
-  ProgressFn progress;  // called with texels_done after each chunk, may be empty
-  bool keep_per_light = false;
+  ProgressFn progress;          // called with texels_done after each chunk, may be empty
+  KeepPerLight keep_per_light;  // per-light images wanted (MixedImages)
 };
 
 // Returns width × height RGB images (LightMix's rule: per covered texel V = Σ_l H_l / Σ_l H0_l or

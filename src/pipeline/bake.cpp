@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "core/stopwatch.h"
+#include "lightmaps/shadowmask.h"
 #include "methods/convolution/fft_convolution.h"
 #include "methods/convolution/traced_convolution.h"
 #include "methods/method.h"
@@ -23,6 +24,7 @@
 #include "pipeline/memory_budget.h"
 #include "scene/lights.h"
 #include "scene/mesh.h"
+#include "texels/lightmap_sizes.h"
 #include "texels/texel_space.h"
 
 namespace sb {
@@ -101,12 +103,18 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     return scene_error(scene.file.string() + ": [bake]: unknown method '" + scene.bake.method +
                        "' (known: " + known + ")");
   }
-  const std::vector<MemoryItem> estimate = bake_memory_estimate(scene);
-  if (Status fits = check_memory(scene, estimate, memory_budget(scene.bake),
-                                 "lower 'resolution' (--resolution) or raise max_memory "
-                                 "(--max-memory)");
-      !fits)
-    return fits.error();
+  const std::string advice =
+      scene.bake.texels_per_metre > 0
+          ? "lower 'texels_per_metre' (--texels-per-metre) or raise max_memory (--max-memory)"
+          : "lower 'resolution' (--resolution) or raise max_memory (--max-memory)";
+  // With a resolution the sides are known before the meshes are read, and the budget is checked
+  // first; with a density, once they are read.
+  std::vector<MemoryItem> estimate;
+  if (const std::vector<int> sides = sides_from_settings(scene); !sides.empty()) {
+    estimate = bake_memory_estimate(scene, sides);
+    if (Status fits = check_memory(scene, estimate, memory_budget(scene.bake), advice); !fits)
+      return fits.error();
+  }
   const auto thread_limit = limit_threads(options);
 
   BakeResult result;
@@ -115,6 +123,13 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   auto loaded = load_meshes(scene, &result.warnings);
   if (!loaded) return loaded.error();
   const std::vector<Mesh>& meshes = *loaded;
+  const std::vector<int> sides = lightmap_sides(scene, meshes, &result.warnings);
+  if (estimate.empty()) {
+    estimate = bake_memory_estimate(scene, sides);
+    if (Status fits = check_memory(scene, estimate, memory_budget(scene.bake), advice); !fits)
+      return fits.error();
+  }
+  if (scene.output.atlas) result.atlas = pack_atlases(sides, *scene.output.atlas);
   const std::vector<const Mesh*> blockers = blocker_meshes(scene, meshes);
   // What the method asks for, built once and shared by every receiver.
   const MethodNeeds needs = entry->needs(scene.bake);
@@ -136,7 +151,6 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
 
   // The bake proper, timed from here: texel space, the method, dilation.
   const auto bake_start = std::chrono::steady_clock::now();
-  const int res = scene.bake.resolution;
   std::vector<std::size_t> receivers;
   std::vector<TexelSpace> spaces;
   std::vector<double> raster_seconds;
@@ -146,6 +160,7 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     const ObjectDesc& obj = scene.objects[i];
     if (!obj.receiver) continue;
     const auto start = std::chrono::steady_clock::now();
+    const int res = sides[receivers.size()];
     receivers.push_back(i);
     spaces.push_back(rasterise_texels(meshes[i], res, res));
     raster_seconds.push_back(seconds_since(start));
@@ -200,6 +215,8 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   // What the budget leaves the method's images, beyond what the estimate above counted.
   context.memory_for_images = double(memory_budget(scene.bake)) - total_bytes(estimate);
   context.keep_per_light = options.keep_per_light;
+  context.keep_per_light.values |= scene.output.per_light;
+  context.keep_per_light.visibility |= scene.output.shadowmask;
   context.texels_done = &texels_done;
   if (options.progress && total_texels > 0) {
     context.progress = [&](double done) { options.progress(done / double(total_texels)); };
@@ -227,6 +244,9 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     if (context.progress) context.progress(double(texels_done.load()));
     out.image = std::move(baked->images.image);
     out.per_light = std::move(baked->images.per_light);
+    out.per_light_visibility = std::move(baked->images.per_light_visibility);
+    for (std::size_t l = 0; l < out.per_light_visibility.size(); ++l)
+      apply_shadowmask_range(out.per_light_visibility[l], lights[l], spaces[r]);
     out.report = std::move(baked->report);
     result.shadow_rays += baked->rays;
     for (std::string& w : out.report.warnings) result.warnings.push_back(std::move(w));
@@ -235,12 +255,24 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     const auto dilate_start = std::chrono::steady_clock::now();
     dilate(out.image, spaces[r].covered, scene.bake.margin);
     for (Image& image : out.per_light) dilate(image, spaces[r].covered, scene.bake.margin);
+    for (Image& image : out.per_light_visibility)
+      dilate(image, spaces[r].covered, scene.bake.margin);
     out.seconds_dilate = seconds_since(dilate_start);
     out.covered_texels = std::int64_t(spaces[r].texels.size());
     out.uv = layouts[r];
     out.covered = spaces[r].covered;
+    if (scene.output.gltf)
+      out.gltf_mesh = std::make_shared<const GltfMesh>(gltf_mesh(meshes[receivers[r]]));
     out.seconds = raster_seconds[r] + seconds_since(start);
     result.receivers.push_back(std::move(out));
+  }
+  if (scene.output.shadowmask) {
+    LightOverlaps overlaps(lights.size());
+    for (const ReceiverBake& r : result.receivers)
+      add_overlaps(r.per_light_visibility, r.covered, overlaps);
+    ShadowmaskChannels channels = assign_shadowmask_channels(overlaps, scene.lights, scene.file);
+    result.shadowmask_channels = std::move(channels.channel);
+    for (std::string& w : channels.warnings) result.warnings.push_back(std::move(w));
   }
   result.bake_seconds = seconds_since(bake_start);
   if (options.progress) options.progress(1.0);
@@ -248,14 +280,18 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
 }
 
 Expected<std::vector<std::string>> plan(const Scene& scene, const BakeOptions& options) {
-  if (Status fits = check_memory(scene, bake_memory_estimate(scene), memory_budget(scene.bake),
-                                 "lower 'resolution' (--resolution) or raise max_memory");
-      !fits)
-    return fits.error();
+  if (const std::vector<int> sides = sides_from_settings(scene); !sides.empty()) {
+    if (Status fits =
+            check_memory(scene, bake_memory_estimate(scene, sides), memory_budget(scene.bake),
+                         "lower 'resolution' (--resolution) or raise max_memory");
+        !fits)
+      return fits.error();
+  }
   const auto thread_limit = limit_threads(options);
   auto loaded = load_meshes(scene, nullptr);
   if (!loaded) return loaded.error();
   const std::vector<Mesh>& meshes = *loaded;
+  const std::vector<int> sides = lightmap_sides(scene, meshes, nullptr);
   const ClusterTree clusters = build_clusters(blocker_meshes(scene, meshes));
   auto lights = make_lights(scene.lights, scene.file);
   if (!lights) return lights.error();
@@ -268,8 +304,8 @@ Expected<std::vector<std::string>> plan(const Scene& scene, const BakeOptions& o
   std::vector<std::string> out;
   for (std::size_t i = 0; i < meshes.size(); ++i) {
     if (!scene.objects[i].receiver) continue;
-    const TexelSpace space =
-        rasterise_texels(meshes[i], scene.bake.resolution, scene.bake.resolution);
+    const int side = sides[out.size()];
+    const TexelSpace space = rasterise_texels(meshes[i], side, side);
     out.push_back(describe_plan(plan_convolution(space, plan_inputs(context, &meshes[i], &fft))));
   }
   return out;

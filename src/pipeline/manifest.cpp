@@ -2,6 +2,8 @@
 // type, so that a reader meets either a whole manifest or a one-line error naming the key.
 #include "pipeline/manifest.h"
 
+#include "lightmaps/shadowmask.h"
+
 #include <fstream>
 #include <limits>
 #include <set>
@@ -17,8 +19,8 @@ using json = nlohmann::ordered_json;
 // The receiver keys the schema names; any other key is one of the method's own entries.
 const std::set<std::string, std::less<>>& receiver_schema_keys() {
   static const std::set<std::string, std::less<>> keys = {
-      "name",    "files",          "uv_channel", "resolution", "method",      "quantity",
-      "samples", "covered_texels", "uv_layout",  "seconds",    "method_stats"};
+      "name",     "files",   "atlas",          "uv_channel", "resolution", "method",
+      "quantity", "samples", "covered_texels", "uv_layout",  "seconds",    "method_stats"};
   return keys;
 }
 
@@ -79,6 +81,15 @@ class FieldReader {
     if (status_ && !parse_enum(text, {Quantity::visibility, Quantity::irradiance}, out))
       fail(key, "\"visibility\" or \"irradiance\"");
   }
+  void read(const char* key, Encoding& out) {
+    std::string text;
+    read(key, text);
+    if (status_ &&
+        !parse_enum(text,
+                    {Encoding::linear_exr, Encoding::half_exr, Encoding::png, Encoding::rgbm_png},
+                    out))
+      fail(key, "\"linear-exr\", \"half-exr\", \"png\" or \"rgbm-png\"");
+  }
   void read(const char* key, LightShape& out) {
     std::string text;
     read(key, text);
@@ -124,10 +135,104 @@ class FieldReader {
   Status& status_;
 };
 
+json file_to_json(const ManifestFile& f) {
+  return {{"file", f.file},
+          {"encoding", to_string(f.encoding)},
+          {"transfer", f.transfer},
+          {"scale", f.scale}};
+}
+
+json files_to_json(const ManifestFiles& files) {
+  json out = {{"lightmap", file_to_json(files.lightmap)}};
+  if (files.preview) out["preview"] = file_to_json(*files.preview);
+  out["coverage"] = file_to_json(files.coverage);
+  if (!files.per_light.empty()) {
+    json& lights = out["per_light"] = json::object();
+    for (const auto& [light, file] : files.per_light) lights[light] = file_to_json(file);
+  }
+  if (files.shadowmask) out["shadowmask"] = file_to_json(*files.shadowmask);
+  return out;
+}
+
+void read_file_entry(const json& entry, const std::string& where, const std::string& path,
+                     ManifestFile& f, Status& status) {
+  FieldReader fields(entry, where, path, status);
+  fields.read("file", f.file);
+  fields.read("encoding", f.encoding);
+  fields.read("transfer", f.transfer);
+  fields.read("scale", f.scale);
+}
+
+void read_files(FieldReader& parent, const char* key, const std::string& where,
+                ManifestFiles& files, Status& status) {
+  const json* entry = parent.object(key);
+  if (!entry) return;
+  const std::string path = parent.path_of(std::string(key) + ".");
+  FieldReader fields(*entry, where, path, status);
+  if (const json* f = fields.object("lightmap"))
+    read_file_entry(*f, where, path + "lightmap.", files.lightmap, status);
+  if (status && entry->contains("preview")) {
+    if (const json* f = fields.object("preview"))
+      read_file_entry(*f, where, path + "preview.", files.preview.emplace(), status);
+  }
+  if (const json* f = fields.object("coverage"))
+    read_file_entry(*f, where, path + "coverage.", files.coverage, status);
+  if (status && entry->contains("per_light")) {
+    if (const json* lights = fields.object("per_light")) {
+      for (const auto& [light, value] : lights->items()) {
+        if (!status) break;
+        auto& [name, file] = files.per_light.emplace_back(light, ManifestFile{});
+        FieldReader light_fields(*lights, where, path + "per_light.", status);
+        if (const json* f = light_fields.object(name.c_str()))
+          read_file_entry(*f, where, path + "per_light." + name + ".", file, status);
+      }
+    }
+  }
+  if (status && entry->contains("shadowmask")) {
+    if (const json* f = fields.object("shadowmask"))
+      read_file_entry(*f, where, path + "shadowmask.", files.shadowmask.emplace(), status);
+  }
+}
+
+// The [output] settings as the manifest records them.
+json output_to_json(const OutputSettings& o) {
+  json out = {{"encoding", to_string(o.encoding)},
+              {"per_light", o.per_light},
+              {"shadowmask", o.shadowmask},
+              {"shadowmask_encoding", to_string(o.shadowmask_encoding)}};
+  if (o.atlas) out["atlas"] = {{"size", o.atlas->size}, {"padding", o.atlas->padding}};
+  out["gltf"] = o.gltf;
+  return out;
+}
+
+void read_output(FieldReader& parent, const std::string& where, OutputSettings& o, Status& status) {
+  const json* entry = parent.object("output");
+  if (!entry) return;
+  FieldReader fields(*entry, where, "output.", status);
+  fields.read("encoding", o.encoding);
+  fields.read("per_light", o.per_light);
+  fields.read("shadowmask", o.shadowmask);
+  fields.read("shadowmask_encoding", o.shadowmask_encoding);
+  if (status && entry->contains("atlas")) {
+    if (const json* atlas = fields.object("atlas")) {
+      FieldReader atlas_fields(*atlas, where, "output.atlas.", status);
+      AtlasSettings& a = o.atlas.emplace();
+      atlas_fields.read("size", a.size);
+      atlas_fields.read("padding", a.padding);
+    }
+  }
+  fields.read("gltf", o.gltf);
+}
+
 json receiver_to_json(const ManifestReceiver& r) {
-  json out = {
-      {"name", r.name},
-      {"files", {{"exr", r.files.exr}, {"png", r.files.png}, {"coverage", r.files.coverage}}},
+  json out = {{"name", r.name}};
+  if (r.files) out["files"] = files_to_json(*r.files);
+  if (r.atlas) {
+    const ManifestAtlasPlacement& a = *r.atlas;
+    out["atlas"] = {
+        {"index", a.index}, {"rect", {a.x, a.y, a.side, a.side}}, {"scale_offset", a.scale_offset}};
+  }
+  out.update(json{
       {"uv_channel", r.uv_channel},
       {"resolution", {r.width, r.height}},
       {"method", r.method},
@@ -142,7 +247,7 @@ json receiver_to_json(const ManifestReceiver& r) {
         {"texels_near_other_charts", r.uv_layout.texels_near_other_charts},
         {"margin", r.uv_layout.margin}}},
       {"seconds", r.seconds},
-  };
+  });
   if (!r.method_stats.empty()) {
     json& stats = out["method_stats"] = json::object();
     for (const auto& [key, value] : r.method_stats) stats[key] = value;
@@ -155,11 +260,36 @@ void read_receiver(const json& entry, const std::string& where, const std::strin
                    ManifestReceiver& r, Status& status) {
   FieldReader fields(entry, where, path, status);
   fields.read("name", r.name);
-  if (const json* files = fields.object("files")) {
-    FieldReader file_fields(*files, where, fields.path_of("files."), status);
-    file_fields.read("exr", r.files.exr);
-    file_fields.read("png", r.files.png);
-    file_fields.read("coverage", r.files.coverage);
+  if (status && !entry.contains("atlas"))
+    read_files(fields, "files", where, r.files.emplace(), status);
+  if (status && entry.contains("atlas")) {
+    if (const json* atlas = fields.object("atlas")) {
+      ManifestAtlasPlacement& a = r.atlas.emplace();
+      FieldReader atlas_fields(*atlas, where, fields.path_of("atlas."), status);
+      atlas_fields.read("index", a.index);
+      const json* rect = atlas_fields.array("rect");
+      const json* scale_offset = atlas_fields.array("scale_offset");
+      const auto all = [](const json& array, std::size_t size,
+                          bool (json::*is_kind)() const noexcept) {
+        if (array.size() != size) return false;
+        for (const auto& v : array)
+          if (!(v.*is_kind)()) return false;
+        return true;
+      };
+      if (rect && scale_offset) {
+        if (!all(*rect, 4, &json::is_number_integer) || !all(*scale_offset, 4, &json::is_number)) {
+          status = input_error(where + ": " + fields.path_of("atlas") +
+                               " in the bake's manifest needs rect [x, y, w, h] and "
+                               "scale_offset [sx, sy, ox, oy]");
+          return;
+        }
+        a.x = (*rect)[0].get<int>();
+        a.y = (*rect)[1].get<int>();
+        a.side = (*rect)[2].get<int>();
+        for (int i = 0; i < 4; ++i)
+          a.scale_offset[std::size_t(i)] = (*scale_offset)[i].get<double>();
+      }
+    }
   }
   fields.read("uv_channel", r.uv_channel);
   if (const json* resolution = fields.array("resolution")) {
@@ -209,15 +339,30 @@ json manifest_to_json(const Manifest& m) {
   out["method"] = m.method;
   out["quantity"] = to_string(m.quantity);
   out["resolution"] = m.resolution;
+  if (m.texels_per_metre) out["texels_per_metre"] = *m.texels_per_metre;
   out["samples"] = m.samples;
   out["seed"] = m.seed;
   out["margin"] = m.margin;
   if (m.trace) out["trace"] = *m.trace;
   if (m.convolve) out["convolve"] = *m.convolve;
+  out["output"] = output_to_json(m.output);
   out["lights"] = json::array();
-  for (const auto& l : m.lights)
-    out["lights"].push_back({{"name", l.name}, {"shape", to_string(l.shape)}});
+  for (const auto& l : m.lights) {
+    json light = {{"name", l.name}, {"shape", to_string(l.shape)}};
+    if (l.shadowmask_channel) {
+      light["shadowmask_channel"] = *l.shadowmask_channel >= 0
+                                        ? json(shadowmask_channel_name(*l.shadowmask_channel))
+                                        : json(nullptr);
+    }
+    out["lights"].push_back(std::move(light));
+  }
   if (m.png_white_point) out["png_white_point"] = *m.png_white_point;
+  if (!m.atlases.empty()) {
+    json& atlases = out["atlases"] = json::array();
+    for (const ManifestAtlas& a : m.atlases)
+      atlases.push_back({{"index", a.index}, {"size", a.size}, {"files", files_to_json(a.files)}});
+  }
+  if (m.gltf) out["gltf"] = *m.gltf;
   out["receivers"] = json::array();
   for (const auto& r : m.receivers) out["receivers"].push_back(receiver_to_json(r));
   out["warnings"] = m.warnings;
@@ -240,11 +385,13 @@ Expected<Manifest> manifest_from_json(const json& json_manifest, const std::stri
   fields.read("method", m.method);
   fields.read("quantity", m.quantity);
   fields.read("resolution", m.resolution);
+  fields.read_optional("texels_per_metre", m.texels_per_metre);
   fields.read("samples", m.samples);
   fields.read("seed", m.seed);
   fields.read("margin", m.margin);
   fields.read_optional("trace", m.trace);
   fields.read_optional("convolve", m.convolve);
+  read_output(fields, where, m.output, status);
   if (const json* lights = fields.array("lights")) {
     for (std::size_t i = 0; status && i < lights->size(); ++i) {
       const std::string path = "lights[" + std::to_string(i) + "]";
@@ -256,9 +403,39 @@ Expected<Manifest> manifest_from_json(const json& json_manifest, const std::stri
       FieldReader light_fields((*lights)[i], where, path + ".", status);
       light_fields.read("name", light.name);
       light_fields.read("shape", light.shape);
+      if (status && (*lights)[i].contains("shadowmask_channel")) {
+        const json& channel = (*lights)[i]["shadowmask_channel"];
+        int c = -1;
+        for (int k = 0; k < kShadowmaskChannels && !channel.is_null(); ++k)
+          if (channel == shadowmask_channel_name(k)) c = k;
+        if (!channel.is_null() && c < 0) {
+          status = input_error(where + ": " + path +
+                               ".shadowmask_channel in the bake's manifest is not \"R\", \"G\", "
+                               "\"B\", \"A\" or null");
+          break;
+        }
+        light.shadowmask_channel = c;
+      }
     }
   }
   fields.read_optional("png_white_point", m.png_white_point);
+  if (status && json_manifest.contains("atlases")) {
+    if (const json* atlases = fields.array("atlases")) {
+      for (std::size_t i = 0; status && i < atlases->size(); ++i) {
+        const std::string path = "atlases[" + std::to_string(i) + "]";
+        if (!(*atlases)[i].is_object()) {
+          status = input_error(where + ": " + path + " in the bake's manifest is not an object");
+          break;
+        }
+        ManifestAtlas& atlas = m.atlases.emplace_back();
+        FieldReader atlas_fields((*atlases)[i], where, path + ".", status);
+        atlas_fields.read("index", atlas.index);
+        atlas_fields.read("size", atlas.size);
+        read_files(atlas_fields, "files", where, atlas.files, status);
+      }
+    }
+  }
+  fields.read_optional("gltf", m.gltf);
   const json& receivers = json_manifest["receivers"];
   for (std::size_t i = 0; status && i < receivers.size(); ++i) {
     const std::string path = "receivers[" + std::to_string(i) + "]";

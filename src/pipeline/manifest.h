@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -24,13 +25,40 @@ inline constexpr const char* kManifestFile = "manifest.json";
 struct ManifestLight {
   std::string name;
   LightShape shape = LightShape::rectangle;
+  // With [output] shadowmask: its channel (0–3: R, G, B, A) or −1 (left out: "none").
+  std::optional<int> shadowmask_channel;
 };
 
-// A receiver's files, relative to the bake's folder.
+// One file and how to decode it (docs/cli.md, "Encodings"): the quantity a texel stands for is
+// scale · transfer⁻¹(decoded value); "reinhard-srgb" (an irradiance preview) is not inverted.
+struct ManifestFile {
+  std::string file;  // relative to the bake's folder
+  Encoding encoding = Encoding::linear_exr;
+  std::string transfer = "linear";  // "linear" or "reinhard-srgb"
+  double scale = 1;
+};
+
+// One set of files: a receiver's, or an atlas's.
 struct ManifestFiles {
-  std::string exr;       // the lightmap, linear float RGB
-  std::string png;       // its 8-bit preview
-  std::string coverage;  // 1 where a triangle covers the texel
+  ManifestFile lightmap;                // the lightmap ([output] encoding)
+  std::optional<ManifestFile> preview;  // an 8-bit preview, beside an EXR lightmap
+  ManifestFile coverage;                // 1 where a triangle covers the texel (PNG)
+  std::vector<std::pair<std::string, ManifestFile>> per_light;  // light name → its file
+  std::optional<ManifestFile> shadowmask;  // RGBA: the lights' channels (ManifestLight)
+};
+
+// A receiver's place in an atlas: its image's first texel (x, y; row 0 at the top), its side,
+// and Unity's lightmapScaleOffset: atlas uv = uv · (sx, sy) + (ox, oy), UVs with v up.
+struct ManifestAtlasPlacement {
+  int index = 0;
+  int x = 0, y = 0, side = 0;
+  std::array<double, 4> scale_offset{};
+};
+
+struct ManifestAtlas {
+  int index = 0;
+  int size = 0;  // texels per side
+  ManifestFiles files;
 };
 
 // The receiver's lightmap UV layout checks (UvLayoutReport, texels/uv_checks.h).
@@ -43,7 +71,8 @@ struct ManifestUvLayout {
 
 struct ManifestReceiver {
   std::string name;
-  ManifestFiles files;
+  std::optional<ManifestFiles> files;           // its own files (no atlas)
+  std::optional<ManifestAtlasPlacement> atlas;  // or its place in an atlas
   int uv_channel = 0;
   int width = 0, height = 0;  // texels ("resolution": [width, height])
   std::string method;
@@ -64,11 +93,15 @@ struct Manifest {
   std::string method;
   Quantity quantity = Quantity::visibility;
   int resolution = 0, samples = 0;
+  std::optional<double> texels_per_metre;  // when the lightmaps were sized by density
   std::uint64_t seed = 0;
   int margin = 0;
   std::optional<bool> trace, convolve;  // the convolution's switches; only for it
+  OutputSettings output;                // [output] as the bake ran
   std::vector<ManifestLight> lights;
   std::optional<double> png_white_point;  // irradiance only: W/m² the previews map to white
+  std::vector<ManifestAtlas> atlases;     // with [output] atlas
+  std::optional<std::string> gltf;        // the glTF binary, with [output] gltf
   std::vector<ManifestReceiver> receivers;
   std::vector<std::string> warnings;
   double load_seconds = 0, bake_seconds = 0;

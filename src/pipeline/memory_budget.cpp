@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "methods/method.h"
+#include "texels/lightmap_sizes.h"
 #include "texels/texel_space.h"
 
 namespace sb {
@@ -18,9 +19,15 @@ namespace {
 constexpr double kRasterBytesPerTexel = 1 + 4 + sizeof(Texel);
 // A receiver's result until it is written: RGB float lightmap and the coverage byte.
 constexpr double kResultBytesPerTexel = 3 * 4 + 1;
-// Writing one receiver: the preview's tone-mapped copy (RGB float), its 8-bit bytes and the
-// coverage mask as float and bytes (outputs.cpp, image_io.cpp).
+// Writing one receiver or atlas: the preview's tone-mapped copy (RGB float), its 8-bit bytes
+// and the coverage mask as float and bytes (outputs.cpp, image_io.cpp); an atlas's image is
+// composed first (RGB float).
 constexpr double kWriteBytesPerTexel = 3 * 4 + 3 + 4 + 1;
+constexpr double kAtlasBytesPerTexel = 3 * 4;
+// Kept per receiver, texel and light until written: its value (RGB float), or what its shadow
+// mask needs (visibility and influence, 2 floats).
+constexpr double kPerLightValueBytesPerTexel = 3 * 4;
+constexpr double kPerLightMaskBytesPerTexel = 2 * 4;
 
 }  // namespace
 
@@ -34,18 +41,38 @@ double total_bytes(const std::vector<MemoryItem>& items) {
   return total;
 }
 
-std::vector<MemoryItem> bake_memory_estimate(const Scene& scene) {
+std::vector<int> sides_from_settings(const Scene& scene) {
+  if (scene.bake.texels_per_metre > 0) return {};
+  const int side = std::min(scene.bake.resolution, largest_lightmap_side(scene));
+  std::vector<int> sides;
+  for (const auto& obj : scene.objects)
+    if (obj.receiver) sides.push_back(side);
+  return sides;
+}
+
+std::vector<MemoryItem> bake_memory_estimate(const Scene& scene, const std::vector<int>& sides) {
   const BakeSettings& b = scene.bake;
-  const double texels = double(b.resolution) * double(b.resolution);
-  int receivers = 0;
-  for (const auto& obj : scene.objects) receivers += obj.receiver ? 1 : 0;
+  double largest = 0, all = 0;
+  for (const int side : sides) {
+    const double texels = double(side) * double(side);
+    largest = std::max(largest, texels);
+    all += texels;
+  }
+  // What a file written at once holds: the largest receiver's, or an atlas.
+  const double written =
+      scene.output.atlas ? double(scene.output.atlas->size) * scene.output.atlas->size : largest;
+  const double lights = double(scene.lights.size());
+  const double per_light_bytes = (scene.output.per_light ? kPerLightValueBytesPerTexel : 0) +
+                                 (scene.output.shadowmask ? kPerLightMaskBytesPerTexel : 0);
   std::vector<MemoryItem> items;
-  items.push_back({"texel space", texels * kRasterBytesPerTexel});
-  items.push_back({"lightmaps", texels * kResultBytesPerTexel * receivers});
-  items.push_back({"writing", texels * kWriteBytesPerTexel});
+  items.push_back({"texel space", largest * kRasterBytesPerTexel});
+  items.push_back({"lightmaps", all * kResultBytesPerTexel});
+  if (per_light_bytes > 0) items.push_back({"per-light images", all * lights * per_light_bytes});
+  items.push_back({"writing", written * (kWriteBytesPerTexel +
+                                         (scene.output.atlas ? kAtlasBytesPerTexel : 0))});
   // The method's own arrays and maps (its registry entry says what they are).
   if (const MethodEntry* method = find_method(b.method); method && method->memory) {
-    for (MemoryItem& item : method->memory(scene)) items.push_back(std::move(item));
+    for (MemoryItem& item : method->memory(scene, largest)) items.push_back(std::move(item));
   }
   return items;
 }

@@ -17,11 +17,16 @@ namespace sb {
 
 double total_bytes(const std::vector<MemoryItem>& items);
 
-// The bake's memory that depends on its settings, not its meshes: texel space of the largest
-// receiver at `resolution`² (every texel covered, the upper bound), every receiver's lightmap and
-// coverage kept until they are written, the images written, and the method's own per-texel
-// arrays and maps.
-std::vector<MemoryItem> bake_memory_estimate(const Scene& scene);
+// The receivers' lightmap sides, in scene order, where the settings alone give them: every one
+// `resolution` (clamped to an atlas); empty with texels_per_metre, where they follow from the
+// meshes (texels/lightmap_sizes.h).
+std::vector<int> sides_from_settings(const Scene& scene);
+
+// The bake's memory for receivers of these `sides`: texel space of the largest receiver (every
+// texel covered, the upper bound), every receiver's lightmap, coverage and per-light images
+// ([output] per_light, shadowmask) kept until they are written, the images written (an atlas at
+// a time with an atlas), and the method's own per-texel arrays and maps.
+std::vector<MemoryItem> bake_memory_estimate(const Scene& scene, const std::vector<int>& sides);
 
 // An error when the items need more than `budget` bytes: "<scene file>: [bake] max_memory: the
 // bake needs about 21.4 GiB (texel space 16 GiB, ...), more than max_memory = 17.9 GiB; <advice>".

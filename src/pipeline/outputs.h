@@ -1,5 +1,7 @@
-// The files a bake leaves for a pipeline: per receiver <name>.exr (linear float RGB) and
-// <name>.png (8-bit preview), and manifest.json describing them (docs/cli.md).
+// The files a bake leaves for a pipeline (docs/cli.md): per receiver, or per atlas with
+// [output] atlas, a lightmap in the chosen encoding, an 8-bit preview beside an EXR, a coverage
+// mask, and as asked each light's own image and a shadow mask; a glTF binary of the receivers
+// with their lightmaps bound; and manifest.json describing every file.
 #pragma once
 
 #include <filesystem>
@@ -13,12 +15,21 @@
 
 namespace sb {
 
-// The files a bake of `scene` writes, in the order they are published (manifest.json last).
-std::vector<std::string> output_names(const Scene& scene);
+// The glTF binary's name in the output folder.
+inline constexpr const char* kGltfFile = "scene.glb";
 
-// Refuses a scene whose receivers' output files would collide (compared without case, as on the
-// file systems outputs travel to): object `a.coverage` writes `a.coverage.png`, which is object
-// `a`'s coverage mask. The error names the scene file, the line and both objects.
+// The stem of atlas `index`'s files: lightmap_<index>.
+std::string atlas_stem(int index);
+
+// The files a bake of `scene` writes, in the order they are published (manifest.json last);
+// with an atlas, those of `atlases` atlases (their number is known once the meshes are read).
+std::vector<std::string> output_names(const Scene& scene, int atlases = 1);
+
+// Refuses a scene whose output files would collide (compared without case, as on the file
+// systems outputs travel to): object `a.coverage` writes `a.coverage.png`, which is object `a`'s
+// coverage mask; light `coverage`'s per-light PNG is every receiver's coverage mask. And, with
+// per_light, a light whose name cannot be part of a file name. The error names the scene file,
+// the line and the items.
 Status check_output_names(const Scene& scene);
 
 // Writes every output into `folder`'s staging folder and publishes them together

@@ -26,9 +26,12 @@ struct MeshTraits : public OpenMesh::DefaultTraits {
 using TriMesh = OpenMesh::TriMesh_ArrayKernelT<MeshTraits>;
 
 struct Mesh {
-  std::string name;            // the object's name
-  TriMesh mesh;                // world space; vertex texcoords are the lightmap UVs
-  bool has_uv = false;         // false when the mesh has no UV set at the object's uv channel
+  std::string name;     // the object's name
+  TriMesh mesh;         // world space; vertex texcoords are the lightmap UVs
+  bool has_uv = false;  // false when the mesh has no UV set at the object's uv channel
+  // Per vertex, a receiver's UV channel 0 when its lightmap UVs are another channel (its texture
+  // UVs, which a glTF of the bake carries beside the lightmap UVs); empty otherwise.
+  std::vector<Vec2> texture_uv;
   int skipped_degenerate = 0;  // zero-area triangles dropped on import
 };
 

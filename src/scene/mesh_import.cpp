@@ -56,6 +56,7 @@ struct ImportedVertex {
   Vec3 position;
   Vec3 normal;  // unit, or zero when the file's normal is unusable (fixed after face normals)
   Vec2 uv = Vec2::Zero();
+  Vec2 texture_uv = Vec2::Zero();  // channel 0, kept for outputs that carry the mesh (glTF)
 };
 
 class ErrorPrefix {
@@ -114,9 +115,10 @@ std::string format_vec(const Vec3& v) {
 
 // Adds triangle (a, b, c) to mesh. OpenMesh's add_face refuses a face that would make a vertex or
 // an edge non-manifold (and prints why); the checks below are its own, done first to keep it
-// quiet. A refused face is added on three fresh copies of its vertices.
+// quiet. A refused face is added on three fresh copies of its vertices (and of their texture UVs,
+// when `texture_uv` holds them).
 void add_triangle(TriMesh& mesh, TriMesh::VertexHandle a, TriMesh::VertexHandle b,
-                  TriMesh::VertexHandle c) {
+                  TriMesh::VertexHandle c, std::vector<Vec2>& texture_uv) {
   const TriMesh::VertexHandle corners[3] = {a, b, c};
   bool manifold = true;
   for (int i = 0; i < 3 && manifold; ++i) {
@@ -138,6 +140,7 @@ void add_triangle(TriMesh& mesh, TriMesh::VertexHandle a, TriMesh::VertexHandle 
     copies[i] = mesh.add_vertex(point);
     mesh.set_normal(copies[i], normal);
     mesh.set_texcoord2D(copies[i], uv);
+    if (!texture_uv.empty()) texture_uv.push_back(texture_uv[std::size_t(corners[i].idx())]);
   }
   mesh.add_face(copies[0], copies[1], copies[2]);
 }
@@ -209,6 +212,12 @@ Expected<Mesh> build_mesh(const RawMeshFile& file, const ObjectDesc& obj, const 
     }
   }
 
+  // A receiver's texture UVs (channel 0), when its lightmap UVs are another channel and every
+  // part has them: a glTF of the bake carries them as TEXCOORD_0.
+  bool keep_texture_uv = obj.receiver && obj.uv_channel != 0;
+  for (const RawMeshPart& part : file.parts)
+    keep_texture_uv = keep_texture_uv && !part.uvs[0].empty();
+
   // Vertices in world space, all parts concatenated. UVs are copied only when every part has
   // the channel, so has_uv says what the texcoords hold.
   const Mat3 linear = obj.transform.linear();
@@ -249,6 +258,11 @@ Expected<Mesh> build_mesh(const RawMeshFile& file, const ObjectDesc& obj, const 
           uvs_finite = false;
         }
       }
+      if (keep_texture_uv) {
+        const float* t = &part.uvs[0][3 * i];
+        v.texture_uv = Vec2(t[0], t[1]);
+        keep_texture_uv = v.texture_uv.allFinite();
+      }
       vertices.push_back(v);
     }
   }
@@ -284,6 +298,7 @@ Expected<Mesh> build_mesh(const RawMeshFile& file, const ObjectDesc& obj, const 
           mesh.add_vertex(TriMesh::Point(v.position.x(), v.position.y(), v.position.z()));
       mesh.set_normal(handle[index], TriMesh::Normal(v.normal.x(), v.normal.y(), v.normal.z()));
       mesh.set_texcoord2D(handle[index], TriMesh::TexCoord2D(v.uv.x(), v.uv.y()));
+      if (keep_texture_uv) result.texture_uv.push_back(v.texture_uv);
     }
     return handle[index];
   };
@@ -307,7 +322,7 @@ Expected<Mesh> build_mesh(const RawMeshFile& file, const ObjectDesc& obj, const 
         ++result.skipped_degenerate;
         continue;
       }
-      add_triangle(mesh, vertex(index[0]), vertex(index[1]), vertex(index[2]));
+      add_triangle(mesh, vertex(index[0]), vertex(index[1]), vertex(index[2]), result.texture_uv);
     }
   }
   if (mesh.n_faces() == 0) {

@@ -5,7 +5,10 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <limits>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/error.h"
@@ -33,6 +36,9 @@ const std::vector<std::string>& known_methods();
 
 struct BakeSettings {
   int resolution = 512;  // texels per side of each receiver's lightmap
+  // When > 0, each receiver's lightmap side instead follows from its surface area: this many
+  // texels per metre of its surface (texels/lightmap_sizes.h), times its lightmap_scale.
+  double texels_per_metre = 0;
   std::string method = "convolution";
   Quantity quantity = Quantity::visibility;
   int samples = 256;       // light samples per texel, for sampling methods
@@ -74,6 +80,9 @@ struct ObjectDesc {
   // then written black, with a warning).
   bool allow_uncovered = false;
   Affine3 transform = Affine3::Identity();  // scale, then rotate (X, Y, Z), then translate
+  // With [bake] texels_per_metre: this object's density relative to the scene's (Unity's "Scale
+  // In Lightmap"); 1 otherwise.
+  double lightmap_scale = 1.0;
   int line = 0;  // line of the [[object]] table in the scene file, for errors
 };
 
@@ -91,7 +100,35 @@ struct LightDesc {
   Vec3 color = Vec3(1, 1, 1);     // per-channel scale of the emitted power
   double power = 0;               // watts (for colour (1,1,1) and a white texture)
   std::filesystem::path texture;  // optional emission image over a rectangle or disk; resolved
+  // The shadow mask's reach (metres from the light's surface): beyond it the light's channel may
+  // be given to another light (lightmaps/shadowmask.h). Infinite: wherever the light reaches.
+  // The bake itself does not cut the light off.
+  double shadowmask_range = std::numeric_limits<double>::infinity();
   int line = 0;
+};
+
+// How a lightmap's values are stored in a file (lightmaps/encodings.h, docs/cli.md).
+enum class Encoding {
+  linear_exr,  // 32-bit float OpenEXR, linear
+  half_exr,    // 16-bit float OpenEXR, linear
+  png,         // 8-bit PNG, linear, value = byte / 255 · scale
+  rgbm_png     // 8-bit RGBA PNG, RGBM as Unity decodes it: value = 34.49 · (A/255)^2.2 · RGB/255
+};
+
+// [output] atlas: receivers packed into shared square textures (texels/atlas_packing.h).
+struct AtlasSettings {
+  int size = 2048;  // texels per side of an atlas
+  int padding = 2;  // texels around each receiver's rectangle that only it fills
+};
+
+// The [output] table: what files a bake writes beside manifest.json.
+struct OutputSettings {
+  Encoding encoding = Encoding::linear_exr;  // the lightmaps and the per-light images
+  bool per_light = false;   // <object>.<light>.<ext>: each light's own V (or H0·V)
+  bool shadowmask = false;  // <object>.shadowmask.<ext>: up to four lights' V in R, G, B, A
+  Encoding shadowmask_encoding = Encoding::png;  // png, linear-exr or half-exr
+  std::optional<AtlasSettings> atlas;            // receivers packed into atlases
+  bool gltf = false;                             // scene.glb with every receiver, lightmap bound
 };
 
 // A [bake] key the scene file sets, and its line: keys the chosen method does not read are
@@ -104,6 +141,7 @@ struct SettingGiven {
 struct Scene {
   std::filesystem::path file;  // the scene file, as given
   BakeSettings bake;
+  OutputSettings output;
   std::vector<SettingGiven> bake_keys;  // in file order
   std::vector<ObjectDesc> objects;
   std::vector<LightDesc> lights;
@@ -119,5 +157,8 @@ Affine3 object_transform(const Vec3& translate, const Vec3& rotate_deg, const Ve
 
 const char* to_string(Quantity q);
 const char* to_string(LightShape s);
+const char* to_string(Encoding e);  // as the scene file writes it: "linear-exr", ...
+// An encoding as the scene file and the CLI name it, or nullopt.
+std::optional<Encoding> parse_encoding(std::string_view text);
 
 }  // namespace sb

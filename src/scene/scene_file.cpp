@@ -151,7 +151,7 @@ Expected<Scene> load_scene(const std::filesystem::path& file) {
 
   Scene scene;
   scene.file = file;
-  const std::vector<std::string_view> top_level_keys = {"bake", "object", "light"};
+  const std::vector<std::string_view> top_level_keys = {"bake", "output", "object", "light"};
   if (const toml::key* key = first_unknown_key(root, top_level_keys)) {
     return located_error(file, key->source().begin.line, "top level",
                          fmt::format("unknown key {} (known: {})", single_quoted(key->str()),
@@ -175,6 +175,15 @@ Expected<Scene> load_scene(const std::filesystem::path& file) {
       std::stable_sort(
           scene.bake_keys.begin(), scene.bake_keys.end(),
           [](const SettingGiven& a, const SettingGiven& b) { return a.line < b.line; });
+    } else if (key == "output") {
+      const toml::table* output = node.as_table();
+      if (!output) {
+        return located_error(file, key.source().begin.line, "top level",
+                             "'output' must be a table, written [output]");
+      }
+      Expected<OutputSettings> settings = read_output(file, *output);
+      if (!settings) return settings.error();
+      scene.output = *settings;
     } else {
       auto tables = tables_of(file, key, node);
       if (!tables) return tables.error();

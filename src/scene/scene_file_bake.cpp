@@ -9,13 +9,38 @@ namespace sb {
 
 Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::table& table) {
   TableReader r(file, table, "[bake]");
-  r.check_known_keys({"resolution", "method", "quantity", "samples", "margin", "seed", "max_memory",
-                      "error_texels", "max_image", "max_triples", "light_parts", "trace",
-                      "convolve", "trace_error_texels", "blocker_combine", "weighting",
-                      "shadow_map", "pcf_radius", "erosion_factor"});
+  r.check_known_keys({"resolution",
+                      "texels_per_metre",
+                      "method",
+                      "quantity",
+                      "samples",
+                      "margin",
+                      "seed",
+                      "max_memory",
+                      "error_texels",
+                      "max_image",
+                      "max_triples",
+                      "light_parts",
+                      "trace",
+                      "convolve",
+                      "trace_error_texels",
+                      "blocker_combine",
+                      "weighting",
+                      "shadow_map",
+                      "pcf_radius",
+                      "erosion_factor"});
   BakeSettings bake;
   const int int_max = std::numeric_limits<int>::max();
   if (auto v = r.integer("resolution", 1, 16384)) bake.resolution = static_cast<int>(*v);
+  if (auto v = r.number("texels_per_metre", "a number > 0 (texels per metre of surface)",
+                        [](double x) { return std::isfinite(x) && x > 0 && x <= 1e6; })) {
+    if (r.find("resolution")) {
+      r.fail("texels_per_metre",
+             "give 'resolution' (texels per side of every lightmap) or 'texels_per_metre' (each "
+             "lightmap sized by its surface area), not both");
+    }
+    bake.texels_per_metre = *v;
+  }
   if (auto v = r.string("method")) {
     const auto& known = known_methods();
     if (std::find(known.begin(), known.end(), *v) == known.end()) {

@@ -37,8 +37,8 @@ Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::ta
       }
     }
   }
-  r.check_known_keys(
-      {"name", "shape", "position", "normal", "up", "size", "radius", "color", "power", "texture"});
+  r.check_known_keys({"name", "shape", "position", "normal", "up", "size", "radius", "color",
+                      "power", "texture", "shadowmask_range"});
   if (r.require("shape")) {
     if (auto shape = r.string("shape")) {
       if (*shape == "rectangle") {
@@ -145,6 +145,8 @@ Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::ta
   } else if (r.find("texture")) {
     if (auto texture = existing_file(r, file, "texture", "texture image")) light.texture = *texture;
   }
+  if (auto v = r.number("shadowmask_range", "a number > 0 (metres)", is_positive))
+    light.shadowmask_range = *v;
   if (r.failed()) return r.error();
   return light;
 }

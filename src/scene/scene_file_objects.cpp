@@ -37,7 +37,7 @@ Expected<ObjectDesc> read_object(const std::filesystem::path& file, const toml::
     }
   }
   r.check_known_keys({"name", "mesh", "receiver", "blocker", "uv", "allow_uncovered", "translate",
-                      "rotate_deg", "scale"});
+                      "rotate_deg", "scale", "lightmap_scale"});
   r.require("mesh");
   if (auto mesh = existing_file(r, file, "mesh", "mesh file")) obj.mesh = *mesh;
   if (auto v = r.boolean("receiver")) obj.receiver = *v;
@@ -53,6 +53,7 @@ Expected<ObjectDesc> read_object(const std::filesystem::path& file, const toml::
                         return std::isfinite(x) && x != 0;
                       }).value_or(Vec3::Ones());
   obj.transform = object_transform(translate, rotate_deg, scale);
+  if (auto v = r.number("lightmap_scale", "a number > 0", is_positive)) obj.lightmap_scale = *v;
   if (r.failed()) return r.error();
   return obj;
 }

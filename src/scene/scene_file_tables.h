@@ -5,6 +5,8 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <optional>
+#include <string_view>
 
 #include <toml++/toml.h>
 
@@ -15,6 +17,9 @@ namespace sb {
 
 // The [bake] table.
 Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::table& table);
+
+// The [output] table.
+Expected<OutputSettings> read_output(const std::filesystem::path& file, const toml::table& table);
 
 // The [[object]] table at `index` (from 0) among the file's objects.
 Expected<ObjectDesc> read_object(const std::filesystem::path& file, const toml::table& table,

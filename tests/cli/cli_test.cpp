@@ -98,9 +98,12 @@ TEST_F(Cli, BakesFilesAndManifest) {
   ASSERT_EQ(manifest->receivers.size(), 1u);
   const sb::ManifestReceiver& floor = manifest->receivers[0];
   EXPECT_EQ(floor.name, "floor");
-  EXPECT_EQ(floor.files.exr, "floor.exr");
-  EXPECT_EQ(floor.files.png, "floor.png");
-  EXPECT_EQ(floor.files.coverage, "floor.coverage.png");
+  ASSERT_TRUE(floor.files);
+  EXPECT_EQ(floor.files->lightmap.file, "floor.exr");
+  EXPECT_EQ(floor.files->lightmap.encoding, sb::Encoding::linear_exr);
+  ASSERT_TRUE(floor.files->preview);
+  EXPECT_EQ(floor.files->preview->file, "floor.png");
+  EXPECT_EQ(floor.files->coverage.file, "floor.coverage.png");
   EXPECT_EQ(floor.uv_channel, 0);
   EXPECT_EQ(floor.width, 32);
   EXPECT_EQ(floor.height, 32);

@@ -84,7 +84,10 @@ void write_bake(const fs::path& folder, const std::string& method, float value) 
   manifest.bake_seconds = 0.5;
   sb::ManifestReceiver& floor = manifest.receivers.emplace_back();
   floor.name = "floor";
-  floor.files = {"floor.exr", "floor.png", "floor.coverage.png"};
+  floor.files.emplace();
+  floor.files->lightmap = {"floor.exr", sb::Encoding::linear_exr};
+  floor.files->preview = sb::ManifestFile{"floor.png", sb::Encoding::png};
+  floor.files->coverage = {"floor.coverage.png", sb::Encoding::png};
   floor.width = floor.height = 8;
   floor.method = method;
   floor.samples = 64;

@@ -16,7 +16,7 @@ using test_scenes::load;
 
 BakeResult bake_or_fail(const Scene& scene, bool keep_per_light) {
   BakeOptions options;
-  options.keep_per_light = keep_per_light;
+  options.keep_per_light.values = keep_per_light;
   auto result = bake(scene, options);
   EXPECT_TRUE(result) << result.error().message;
   if (!result) throw std::runtime_error(result.error().message);

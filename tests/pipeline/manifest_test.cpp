@@ -30,11 +30,14 @@ Manifest full_manifest() {
   m.margin = 4;
   m.trace = true;
   m.convolve = false;
-  m.lights = {{"panel", LightShape::rectangle}, {"bulb", LightShape::sphere}};
+  m.lights = {{"panel", LightShape::rectangle, 0}, {"bulb", LightShape::sphere, -1}};
   m.png_white_point = 12.5;
   ManifestReceiver& r = m.receivers.emplace_back();
   r.name = "floor";
-  r.files = {"floor.exr", "floor.png", "floor.coverage.png"};
+  r.files.emplace();
+  r.files->lightmap = {"floor.exr", Encoding::linear_exr};
+  r.files->preview = ManifestFile{"floor.png", Encoding::png};
+  r.files->coverage = {"floor.coverage.png", Encoding::png};
   r.uv_channel = 1;
   r.width = 64;
   r.height = 32;
@@ -83,7 +86,8 @@ TEST(Manifest, RoundTripsEveryKey) {
   EXPECT_EQ(read->convolve, false);
   ASSERT_EQ(read->receivers.size(), 1u);
   const ManifestReceiver& r = read->receivers[0];
-  EXPECT_EQ(r.files.coverage, "floor.coverage.png");
+  ASSERT_TRUE(r.files);
+  EXPECT_EQ(r.files->coverage.file, "floor.coverage.png");
   EXPECT_EQ(r.width, 64);
   EXPECT_EQ(r.height, 32);
   EXPECT_EQ(r.uv_layout.texels_near_other_charts, 11);
@@ -94,10 +98,11 @@ TEST(Manifest, RoundTripsEveryKey) {
 
 TEST(Manifest, KeepsTheFilesKeyOrder) {
   const json j = manifest_to_json(full_manifest());
-  EXPECT_EQ(keys(j), (std::vector<std::string>{
-                         "shadowbake", "scene", "method", "quantity", "resolution", "samples",
-                         "seed", "margin", "trace", "convolve", "lights", "png_white_point",
-                         "receivers", "warnings", "load_seconds", "bake_seconds", "shadow_rays"}));
+  EXPECT_EQ(keys(j),
+            (std::vector<std::string>{"shadowbake", "scene", "method", "quantity", "resolution",
+                                      "samples", "seed", "margin", "trace", "convolve", "output",
+                                      "lights", "png_white_point", "receivers", "warnings",
+                                      "load_seconds", "bake_seconds", "shadow_rays"}));
   // The method's own entries follow method_stats.
   EXPECT_EQ(keys(j["receivers"][0]),
             (std::vector<std::string>{"name", "files", "uv_channel", "resolution", "method",
@@ -139,9 +144,9 @@ TEST(Manifest, RejectsMissingOrMistypedKeys) {
   EXPECT_EQ(error_of(j.dump()), "m.json: no bake_seconds in the bake's manifest");
 
   j = manifest_to_json(full_manifest());
-  j["receivers"][0]["files"]["exr"] = 3;
+  j["receivers"][0]["files"]["lightmap"]["file"] = 3;
   EXPECT_EQ(error_of(j.dump()),
-            "m.json: receivers[0].files.exr in the bake's manifest is not a string");
+            "m.json: receivers[0].files.lightmap.file in the bake's manifest is not a string");
 
   j = manifest_to_json(full_manifest());
   j["quantity"] = "brightness";

@@ -222,7 +222,7 @@ TEST_F(SceneFile, RejectsUnknownKey) {
   expect_error(text, "recever", "object 'floor'", "unknown key 'recever'");
   EXPECT_NE(error_of(text).find("(known: name, mesh, receiver, blocker, uv, allow_uncovered, "
                                 "translate, "
-                                "rotate_deg, scale)"),
+                                "rotate_deg, scale, lightmap_scale)"),
             std::string::npos);
 }
 

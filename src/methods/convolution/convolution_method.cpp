@@ -176,11 +176,10 @@ MethodEntry convolution_method() {
         // convolve = false and rays, no leaf is planned.
         return MethodNeeds{.rays = s.trace, .clusters = s.convolve || !s.trace, .shafts = true};
       },
-      [](const Scene& scene) {
+      [](const Scene& scene, double texels) {
         // Parts of a light: at least light_parts; a sphere light's receiver may be seen
         // through up to six cube faces, each a frame of its own.
         const BakeSettings& b = scene.bake;
-        const double texels = double(b.resolution) * double(b.resolution);
         const double parts = double(scene.lights.size()) * std::max(b.light_parts, 1);
         return std::vector<MemoryItem>{
             {"convolution texel arrays",

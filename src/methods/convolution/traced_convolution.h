@@ -25,7 +25,7 @@ struct TracedConvolutionInputs {
   int samples = 64;                     // rays per light per traced texel
   double trace_error_texels = 1.0;      // leaves' ε above this are traced
   std::uint64_t seed = 0, stream = 0;   // as the reference's, so a traced texel matches it
-  bool keep_per_light = false;          // MixedImages::per_light wanted
+  KeepPerLight keep_per_light;          // per-light images wanted (MixedImages)
 };
 
 // What the method did with the receiver's (light, texel) pairs the lights reach.
