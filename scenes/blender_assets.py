@@ -334,15 +334,19 @@ def toml_vector(values):
 
 
 def write_scene_toml(path, comment, objects, lights, resolution=512, method="reference",
-                     samples=64):
+                     samples=64, texels_per_metre=None, output=()):
     """Writes a scene file. objects: dicts with name, mesh and optionally receiver, blocker, uv
     (default 1; None for a blocker without lightmap UVs, which then gets no uv key); every object gets rotate_deg = [90, 0, 0], which stands the Y-up
     .glb back up in the Z-up scene. lights: dicts with name, shape and the shape's keys
-    (position, normal, up, size, radius, color, power), written in that order."""
+    (position, normal, up, size, radius, color, power, shadowmask_range), written in that order.
+    texels_per_metre replaces resolution when given; output: lines of an [output] table."""
     lines = [line.rstrip() for line in comment.strip("\n").split("\n")]
     out = [("# " + line if line else "#") for line in lines]
-    out += ["", "[bake]", f"resolution = {resolution}", f'method = "{method}"',
-            f"samples = {samples}"]
+    size = (f"texels_per_metre = {toml_number(texels_per_metre)}" if texels_per_metre
+            else f"resolution = {resolution}")
+    out += ["", "[bake]", size, f'method = "{method}"', f"samples = {samples}"]
+    if output:
+        out += ["", "[output]"] + list(output)
     for obj in objects:
         out += ["", "[[object]]", f'name = "{obj["name"]}"', f'mesh = "{obj["mesh"]}"']
         receiver = obj.get("receiver", True)
@@ -363,5 +367,7 @@ def write_scene_toml(path, comment, objects, lights, resolution=512, method="ref
         if "color" in light:
             out.append(f"color = {toml_vector(light['color'])}")
         out.append(f"power = {toml_number(light['power'])}")
+        if "shadowmask_range" in light:
+            out.append(f"shadowmask_range = {toml_number(light['shadowmask_range'])}")
     with open(path, "w") as f:
         f.write("\n".join(out) + "\n")

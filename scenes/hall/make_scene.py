@@ -138,3 +138,39 @@ table_1 and a sphere 0.3 m above the floor.""",
     [{"name": obj.name, "mesh": obj.name + ".glb", "receiver": obj.name in receivers}
      for obj in objects],
     lights)
+
+# The hall as a level for an engine: every object a receiver, each lightmap sized by its surface
+# (40 texels per metre), packed into 2048² atlases, with per-light images, shadow masks and a
+# glTF binary. Each light's shadow mask reaches only as far as its shadowmask_range, so lights far
+# apart share a channel.
+ranges = {"ceiling_panel_1": 3.5, "ceiling_panel_2": 3.5, "ceiling_panel_3": 3.0,
+          "downlight": 2.5, "sconce_north": 2.5, "sconce_west": 2.5, "wall_panel_east": 3.0,
+          "pendant": 2.0, "floor_glow": 2.0}
+ba.write_scene_toml(
+    os.path.join(here, "scene_level.toml"),
+    """written by scenes/hall/make_scene.py (Blender); edit that script, not this file.
+The hall of scene.toml as a level for an engine: all 26 objects are receivers, each lightmap
+sized by its surface at 40 texels per metre and packed into 2048 x 2048 atlases (2 texels of
+padding), with each light's own visibility, RGBA shadow masks (each light's channel reaches its
+shadowmask_range, metres from its centre) and scene.glb with the atlases bound (MOZ_lightmap).""",
+    [{"name": obj.name, "mesh": obj.name + ".glb"} for obj in objects],
+    [dict(light, shadowmask_range=ranges[light["name"]]) for light in lights],
+    samples=16, texels_per_metre=40,
+    output=["atlas = { size = 2048, padding = 2 }", "per_light = true", "shadowmask = true",
+            "gltf = true"])
+
+# Six lights whose light meets everywhere on the floor: a shadow mask holds four of them, and the
+# bake says which two it leaves out.
+six = [light for light in lights if light["name"] in (
+    "ceiling_panel_1", "ceiling_panel_2", "ceiling_panel_3", "downlight", "sconce_north",
+    "sconce_west")]
+ba.write_scene_toml(
+    os.path.join(here, "scene_six_lights.toml"),
+    """written by scenes/hall/make_scene.py (Blender); edit that script, not this file.
+The hall of scene.toml (its 12 receivers) under six of its lights, the three ceiling panels, the
+downlight and the two sconces, all of which reach the floor: shadow masks hold four of them (R,
+G, B, A, in scene order), and the bake warns that the two sconces are left out.""",
+    [{"name": obj.name, "mesh": obj.name + ".glb", "receiver": obj.name in receivers}
+     for obj in objects],
+    six, resolution=256, samples=16,
+    output=["shadowmask = true", "per_light = true"])

@@ -201,6 +201,33 @@ case("resolution_16384", {"scene.toml": scene([obj("floor", "quad.obj")]).replac
 case("names_collide", {"scene.toml": scene([obj("a", "quad.obj"), obj("a.coverage", "quad.obj")]),
                        "quad.obj": QUAD_OBJ}, 3, "is also a file of object 'a'")
 
+# [output] and the lightmap sizes.
+def with_output(output, bake="", lights=LIGHT):
+    return scene([obj("floor", "quad.obj")], bake=bake, lights=lights) + "\n[output]\n" + output + "\n"
+
+
+case("output_unknown_key", {"scene.toml": with_output("shadowmasks = true"), "quad.obj": QUAD_OBJ},
+     3, "[output]: unknown key 'shadowmasks'")
+case("output_bad_encoding", {"scene.toml": with_output('encoding = "jpeg"'), "quad.obj": QUAD_OBJ},
+     3, "'encoding' must be \"linear-exr\", \"half-exr\", \"png\" or \"rgbm-png\", got \"jpeg\"")
+case("output_atlas_no_padding", {"scene.toml": with_output("atlas = { size = 1024, padding = 0 }"),
+                                 "quad.obj": QUAD_OBJ}, 3, "'padding' must be an integer from 1 to 256")
+case("output_mask_rgbm", {"scene.toml": with_output('shadowmask_encoding = "rgbm-png"'),
+                          "quad.obj": QUAD_OBJ}, 3, "'shadowmask_encoding' must be")
+case("resolution_and_density", {"scene.toml": scene([obj("floor", "quad.obj")], bake="texels_per_metre = 20"),
+                                "quad.obj": QUAD_OBJ}, 3, "not both")
+case("per_light_bad_name", {"scene.toml": with_output("per_light = true",
+                                                      lights=LIGHT.replace('"panel"', '"panel 1"')),
+                            "quad.obj": QUAD_OBJ}, 3, "light 'panel 1': [output] per_light names a file")
+case("per_light_collides", {"scene.toml": with_output('per_light = true\nencoding = "png"',
+                                                      lights=LIGHT.replace('"panel"', '"coverage"')),
+                            "quad.obj": QUAD_OBJ}, 3, "its output file 'floor.coverage.png' is also a file of")
+case("bad_shadowmask_range", {"scene.toml": scene([obj("floor", "quad.obj")],
+                                                  lights=LIGHT + "shadowmask_range = -1\n"),
+                              "quad.obj": QUAD_OBJ}, 3, "'shadowmask_range' must be a number > 0")
+case("bad_lightmap_scale", {"scene.toml": scene([obj("floor", "quad.obj", lightmap_scale="0")]),
+                            "quad.obj": QUAD_OBJ}, 3, "'lightmap_scale' must be a number > 0")
+
 # Meshes.
 case("mesh_missing", {"scene.toml": scene([obj("floor", "nowhere.obj")])}, 3, "not found")
 case("mesh_is_folder", {"scene.toml": scene([obj("floor", "folder.obj")]),

@@ -124,6 +124,37 @@ TEST_F(Cli, BakesFilesAndManifest) {
   EXPECT_NEAR(png->at(1, 1)[0], exr->at(1, 1)[0], 1.0 / 255 + 1e-6);
 }
 
+TEST_F(Cli, OutputFlagsWriteAtlasesMasksPerLightImagesAndGltf) {
+  write("scene.toml", scene());
+  const fs::path out = dir_ / "out";
+  const CliRun r = run("bake " + (dir_ / "scene.toml").string() + " -o " + out.string() +
+                       " --method reference --texels-per-metre 12 --atlas 256 --atlas-padding 3 "
+                       "--shadowmask --per-light --gltf --encoding png");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(listing(out),
+            (std::vector<std::string>{"lightmap_0.coverage.png", "lightmap_0.panel.png",
+                                      "lightmap_0.png", "lightmap_0.shadowmask.png",
+                                      "manifest.json", "scene.glb"}));
+  const auto manifest = sb::read_manifest(out);
+  ASSERT_TRUE(manifest) << manifest.error().message;
+  EXPECT_EQ(manifest->texels_per_metre, 12.0);
+  ASSERT_EQ(manifest->atlases.size(), 1u);
+  EXPECT_EQ(manifest->atlases[0].files.lightmap.encoding, sb::Encoding::png);
+  ASSERT_TRUE(manifest->receivers[0].atlas);
+  // The 2 × 2 m floor over the unit square at 12 texels per metre: 24 texels a side, 3 texels
+  // of padding, in the smallest power-of-two atlas that holds 30: 32.
+  EXPECT_EQ(manifest->receivers[0].atlas->side, 24);
+  EXPECT_EQ(manifest->receivers[0].atlas->x, 3);
+  EXPECT_EQ(manifest->atlases[0].size, 32);
+  EXPECT_EQ(manifest->lights[0].shadowmask_channel, 0);
+  ASSERT_TRUE(manifest->gltf);
+
+  // A resolution and a density at once is a usage error.
+  const CliRun both = run("bake " + (dir_ / "scene.toml").string() + " -o " + out.string() +
+                          " --resolution 64 --texels-per-metre 12");
+  EXPECT_EQ(both.code, 2) << both.err;
+}
+
 TEST_F(Cli, SameSceneSameSeedSameBytes) {
   write("scene.toml", scene("method = \"reference\"\n"));
   const std::string s = (dir_ / "scene.toml").string();

@@ -541,5 +541,51 @@ TEST(Transform, RotatesAboutXThenYThenZ) {
   EXPECT_TRUE(full.translation().isApprox(Vec3(4, 5, 6)));
 }
 
+TEST_F(SceneFile, ReadsTheOutputTableAndTheDensityKeys) {
+  const std::string text =
+      "[bake]\ntexels_per_metre = 32\n[output]\nencoding = \"rgbm-png\"\n"
+      "per_light = true\nshadowmask = true\nshadowmask_encoding = \"half-exr\"\n"
+      "atlas = { size = 1024, padding = 3 }\ngltf = true\n" +
+      object_floor + "lightmap_scale = 0.5\n" + light_panel + "shadowmask_range = 4.5\n";
+  const Scene scene = load_ok(text);
+  EXPECT_EQ(scene.bake.texels_per_metre, 32);
+  EXPECT_EQ(scene.objects[0].lightmap_scale, 0.5);
+  EXPECT_EQ(scene.lights[0].shadowmask_range, 4.5);
+  const OutputSettings& o = scene.output;
+  EXPECT_EQ(o.encoding, Encoding::rgbm_png);
+  EXPECT_TRUE(o.per_light);
+  EXPECT_TRUE(o.shadowmask);
+  EXPECT_EQ(o.shadowmask_encoding, Encoding::half_exr);
+  ASSERT_TRUE(o.atlas);
+  EXPECT_EQ(o.atlas->size, 1024);
+  EXPECT_EQ(o.atlas->padding, 3);
+  EXPECT_TRUE(o.gltf);
+
+  // Defaults: one EXR per receiver, nothing else; `atlas = true` takes the default atlas, and
+  // [output.atlas] is the same table.
+  const Scene plain = load_ok(object_floor + light_panel);
+  EXPECT_EQ(plain.output.encoding, Encoding::linear_exr);
+  EXPECT_FALSE(plain.output.atlas || plain.output.per_light || plain.output.shadowmask ||
+               plain.output.gltf);
+  EXPECT_TRUE(std::isinf(plain.lights[0].shadowmask_range));
+  EXPECT_EQ(load_ok("[output]\natlas = true\n" + object_floor + light_panel).output.atlas->size,
+            2048);
+  EXPECT_EQ(load_ok("[output.atlas]\nsize = 512\n" + object_floor + light_panel).output.atlas->size,
+            512);
+}
+
+TEST_F(SceneFile, RejectsBadOutputKeys) {
+  expect_error("[output]\natlas = { size = 1024, paddng = 2 }\n" + object_floor + light_panel,
+               "paddng", "[output] atlas", "unknown key 'paddng' (known: size, padding)");
+  expect_error("[output]\natlas = 2048\n" + object_floor + light_panel, "atlas = 2048", "[output]",
+               "'atlas' must be a table such as { size = 2048, padding = 2 }, or true");
+  expect_error("[output]\ngltf = \"yes\"\n" + object_floor + light_panel, "gltf", "[output]",
+               "'gltf' must be true or false");
+  expect_error("output = 3\n" + object_floor + light_panel, "output = 3", "top level",
+               "'output' must be a table, written [output]");
+  expect_error("[bake]\ntexels_per_metre = 0\n" + object_floor + light_panel, "texels_per_metre",
+               "[bake]", "'texels_per_metre' must be a number > 0");
+}
+
 }  // namespace
 }  // namespace sb

@@ -78,38 +78,61 @@ function describeTexture(t) {
   };
 }
 
-// Places the camera along `dir` from the bounding box's centre, as close as it can be with all
-// eight corners of the box inside 92% of the frame.
-function fitCamera(camera, box, dir) {
-  const centre = box.getCenter(new THREE.Vector3());
-  const radius = box.getSize(new THREE.Vector3()).length() / 2;
+// Looks along -dir and frames the given world-space points: the camera's target is moved
+// sideways and the camera moved along dir until the points' projection is centred and fills 92%
+// of the frame in its tighter direction.
+function fitCamera(camera, pointsWorld, dir) {
+  const box = new THREE.Box3().setFromPoints(pointsWorld);
+  const target = box.getCenter(new THREE.Vector3());
+  const radius = Math.max(box.getSize(new THREE.Vector3()).length() / 2, 1e-6);
   const d = new THREE.Vector3(...dir).normalize();
-  const corners = [];
-  for (let i = 0; i < 8; i++) {
-    corners.push(new THREE.Vector3(i & 1 ? box.max.x : box.min.x, i & 2 ? box.max.y : box.min.y,
-      i & 4 ? box.max.z : box.min.z));
-  }
   const tanV = Math.tan(THREE.MathUtils.degToRad(camera.fov / 2)) * 0.92;
-  const tanH = tanV * camera.aspect;
-  const fits = (dist) => {
-    camera.position.copy(centre).addScaledVector(d, dist);
-    camera.lookAt(centre);
+  const tanH = Math.tan(THREE.MathUtils.degToRad(camera.fov / 2)) * camera.aspect * 0.92;
+  const place = (dist) => {
+    camera.position.copy(target).addScaledVector(d, dist);
+    camera.lookAt(target);
     camera.updateMatrixWorld(true);
-    const view = camera.matrixWorldInverse;
-    return corners.every((c) => {
-      const p = c.clone().applyMatrix4(view);
-      const depth = -p.z;
-      return depth > camera.near && Math.abs(p.x) <= depth * tanH && Math.abs(p.y) <= depth * tanV;
-    });
   };
-  let lo = radius * 0.05, hi = radius * 50;
-  for (let i = 0; i < 60; i++) {
-    const mid = (lo + hi) / 2;
-    if (fits(mid)) hi = mid; else lo = mid;
+  // The points' extent in the frame, in units of the 92% frame's half-size (NDC-like).
+  const extent = () => {
+    const view = camera.matrixWorldInverse;
+    const e = { minX: Infinity, maxX: -Infinity, minY: Infinity, maxY: -Infinity, behind: false };
+    const p = new THREE.Vector3();
+    for (const w of pointsWorld) {
+      p.copy(w).applyMatrix4(view);
+      const depth = -p.z;
+      if (depth <= radius * 1e-3) { e.behind = true; continue; }
+      const x = p.x / (depth * tanH), y = p.y / (depth * tanV);
+      e.minX = Math.min(e.minX, x); e.maxX = Math.max(e.maxX, x);
+      e.minY = Math.min(e.minY, y); e.maxY = Math.max(e.maxY, y);
+    }
+    return e;
+  };
+  const fits = (dist) => {
+    place(dist);
+    const e = extent();
+    return !e.behind && e.minX >= -1 && e.maxX <= 1 && e.minY >= -1 && e.maxY <= 1;
+  };
+  const fitDistance = () => {
+    let lo = radius * 0.01, hi = radius * 100;
+    for (let i = 0; i < 50; i++) {
+      const mid = (lo + hi) / 2;
+      if (fits(mid)) hi = mid; else lo = mid;
+    }
+    place(hi);
+    return hi;
+  };
+  let dist = fitDistance();
+  for (let iter = 0; iter < 10; iter++) {
+    const e = extent();
+    const cx = (e.minX + e.maxX) / 2, cy = (e.minY + e.maxY) / 2;
+    const right = new THREE.Vector3().setFromMatrixColumn(camera.matrixWorld, 0);
+    const up = new THREE.Vector3().setFromMatrixColumn(camera.matrixWorld, 1);
+    target.addScaledVector(right, cx * dist * tanH).addScaledVector(up, cy * dist * tanV);
+    dist = fitDistance();
   }
-  fits(hi);
-  camera.near = Math.max(hi - radius * 1.5, radius * 0.01);
-  camera.far = hi + radius * 1.5;
+  camera.near = Math.max(dist - radius * 2, radius * 0.01);
+  camera.far = dist + radius * 2;
   camera.updateProjectionMatrix();
 }
 
@@ -223,8 +246,14 @@ async function main() {
   if (meshes.length === 0) return fail('the glTF has no meshes');
 
   const camera = new THREE.PerspectiveCamera(40, WIDTH / HEIGHT, 0.01, 1000);
-  const box = new THREE.Box3().setFromObject(gltf.scene);
-  fitCamera(camera, box, VIEW);
+  const vertices = [];
+  for (const mesh of meshes) {
+    const pos = mesh.geometry.attributes.position;
+    for (let i = 0; i < pos.count; i++) {
+      vertices.push(new THREE.Vector3().fromBufferAttribute(pos, i).applyMatrix4(mesh.matrixWorld));
+    }
+  }
+  fitCamera(camera, vertices, VIEW);
 
   renderer.render(scene, camera);
   gl.finish();

@@ -37,9 +37,10 @@ async function main() {
   console.log(
     `${file}: ${issues.numErrors} error(s), ${issues.numWarnings} warning(s), ` +
     `${issues.numInfos} info(s), ${issues.numHints} hint(s) ` +
-    `[${version}${generator}; ${info.meshCount ?? '?'} mesh(es), ` +
-    `${info.materialCount ?? '?'} material(s), ${info.drawCallCount ?? '?'} draw call(s), ` +
-    `${info.totalTriangleCount ?? '?'} triangle(s); validator ${report.validatorVersion}]`);
+    `[${version}${generator}; ${info.drawCallCount ?? '?'} draw call(s), ` +
+    `${info.materialCount ?? '?'} material(s), ${info.totalVertexCount ?? '?'} vertices, ` +
+    `${info.totalTriangleCount ?? '?'} triangle(s), ${info.maxUVs ?? '?'} UV set(s); ` +
+    `validator ${report.validatorVersion}]`);
 
   for (const m of messages) {
     if (m.severity === 0) {
