@@ -131,10 +131,9 @@ TEST_F(Cli, OutputFlagsWriteAtlasesMasksPerLightImagesAndGltf) {
                        " --method reference --texels-per-metre 12 --atlas 256 --atlas-padding 3 "
                        "--shadowmask --per-light --gltf --encoding png");
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(listing(out),
-            (std::vector<std::string>{"lightmap_0.coverage.png", "lightmap_0.panel.png",
-                                      "lightmap_0.png", "lightmap_0.shadowmask.png",
-                                      "manifest.json", "scene.glb"}));
+  EXPECT_EQ(listing(out), (std::vector<std::string>{
+                              "lightmap_0.coverage.png", "lightmap_0.panel.png", "lightmap_0.png",
+                              "lightmap_0.shadowmask.png", "manifest.json", "scene.glb"}));
   const auto manifest = sb::read_manifest(out);
   ASSERT_TRUE(manifest) << manifest.error().message;
   EXPECT_EQ(manifest->texels_per_metre, 12.0);
