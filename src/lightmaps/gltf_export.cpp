@@ -100,7 +100,7 @@ void push_y_up(std::vector<float>& out, double x, double y, double z) {
 
 }  // namespace
 
-GltfMesh gltf_mesh(const Mesh& mesh) {
+GltfMesh gltf_mesh(const Mesh& mesh, bool with_uvs) {
   GltfMesh out;
   const TriMesh& m = mesh.mesh;
   const bool own_texture_uv = mesh.texture_uv.size() == m.n_vertices();
@@ -114,6 +114,7 @@ GltfMesh gltf_mesh(const Mesh& mesh) {
     const float nx = float(n[0]), ny = float(n[2]), nz = float(-n[1]);
     const float norm = std::sqrt(nx * nx + ny * ny + nz * nz);
     out.normals.insert(out.normals.end(), {nx / norm, ny / norm, nz / norm});
+    if (!mesh.has_uv || !with_uvs) continue;
     const auto& uv = m.texcoord2D(v);
     out.texcoord1.insert(out.texcoord1.end(), {float(uv[0]), float(1.0 - uv[1])});
     const Vec2 t = own_texture_uv ? mesh.texture_uv[std::size_t(v.idx())] : Vec2(uv[0], uv[1]);
@@ -124,7 +125,7 @@ GltfMesh gltf_mesh(const Mesh& mesh) {
   return out;
 }
 
-Expected<std::vector<std::uint8_t>> glb_bytes(const std::vector<GltfReceiver>& receivers,
+Expected<std::vector<std::uint8_t>> glb_bytes(const std::vector<GltfObject>& objects,
                                               const std::vector<GltfTexture>& textures,
                                               const std::string& quantity,
                                               const std::string& generator) {
@@ -137,41 +138,50 @@ Expected<std::vector<std::uint8_t>> glb_bytes(const std::vector<GltfReceiver>& r
     images.push_back({{"name", t.name}, {"mimeType", "image/png"}, {"bufferView", view}});
     gltf_textures.push_back({{"sampler", 0}, {"source", int(images.size()) - 1}});
   }
-  for (std::size_t r = 0; r < receivers.size(); ++r) {
-    const GltfReceiver& rec = receivers[r];
-    if (!rec.mesh || rec.texture < 0 || std::size_t(rec.texture) >= textures.size())
-      return output_error("glTF: receiver '" + rec.name + "' has no mesh or texture");
-    const GltfMesh& m = *rec.mesh;
+  for (std::size_t r = 0; r < objects.size(); ++r) {
+    const GltfObject& object = objects[r];
+    if (!object.mesh) return output_error("glTF: object '" + object.name + "' has no mesh");
+    const GltfMesh& m = *object.mesh;
+    const bool uvs = !m.texcoord1.empty();
+    if (object.lightmap && (!uvs || object.lightmap->texture < 0 ||
+                            std::size_t(object.lightmap->texture) >= textures.size()))
+      return output_error("glTF: receiver '" + object.name + "' has no lightmap UVs or texture");
     Json attributes = {{"POSITION", bin.floats(m.positions, 3, "VEC3")},
-                       {"NORMAL", bin.floats(m.normals, 3, "VEC3")},
-                       {"TEXCOORD_0", bin.floats(m.texcoord0, 2, "VEC2")},
-                       {"TEXCOORD_1", bin.floats(m.texcoord1, 2, "VEC2")}};
-    const int indices = bin.indices(m.indices);
-    Json lightmap = {{"index", rec.texture}, {"texCoord", 1}, {"intensity", rec.intensity}};
-    if (rec.transform) {
-      const auto& t = *rec.transform;
-      lightmap["extensions"]["KHR_texture_transform"] = {{"offset", {t[2], t[3]}},
-                                                         {"scale", {t[0], t[1]}}};
-      transformed = true;
+                       {"NORMAL", bin.floats(m.normals, 3, "VEC3")}};
+    if (uvs) {
+      attributes["TEXCOORD_0"] = bin.floats(m.texcoord0, 2, "VEC2");
+      attributes["TEXCOORD_1"] = bin.floats(m.texcoord1, 2, "VEC2");
     }
-    materials.push_back({{"name", rec.name},
-                         {"pbrMetallicRoughness",
-                          {{"baseColorFactor", {1.0, 1.0, 1.0, 1.0}},
-                           {"metallicFactor", 0.0},
-                           {"roughnessFactor", 1.0}}},
-                         {"extensions", {{"MOZ_lightmap", lightmap}}}});
-    meshes.push_back({{"name", rec.name},
+    const int indices = bin.indices(m.indices);
+    Json material = {{"name", object.name},
+                     {"pbrMetallicRoughness",
+                      {{"baseColorFactor", {1.0, 1.0, 1.0, 1.0}},
+                       {"metallicFactor", 0.0},
+                       {"roughnessFactor", 1.0}}}};
+    if (object.lightmap) {
+      const GltfLightmap& l = *object.lightmap;
+      Json lightmap = {{"index", l.texture}, {"texCoord", 1}, {"intensity", l.intensity}};
+      if (l.transform) {
+        const auto& t = *l.transform;
+        lightmap["extensions"]["KHR_texture_transform"] = {{"offset", {t[2], t[3]}},
+                                                           {"scale", {t[0], t[1]}}};
+        transformed = true;
+      }
+      material["extensions"] = {{"MOZ_lightmap", lightmap}};
+    }
+    materials.push_back(std::move(material));
+    meshes.push_back({{"name", object.name},
                       {"primitives",
                        {{{"attributes", attributes},
                          {"indices", indices},
                          {"material", int(r)},
                          {"mode", kTriangles}}}}});
-    nodes.push_back({{"name", rec.name}, {"mesh", int(r)}});
+    nodes.push_back({{"name", object.name}, {"mesh", int(r)}});
   }
   bin.align();
 
   Json scene_nodes = Json::array();
-  for (std::size_t i = 0; i < receivers.size(); ++i) scene_nodes.push_back(int(i));
+  for (std::size_t i = 0; i < objects.size(); ++i) scene_nodes.push_back(int(i));
   Json extensions_used = {"MOZ_lightmap"};
   if (transformed) extensions_used.push_back("KHR_texture_transform");
   Json gltf = {{"asset",

@@ -25,10 +25,11 @@ struct GltfMesh {
   std::vector<float> positions;  // x, y, z per vertex
   std::vector<float> normals;    // unit, per vertex
   std::vector<float> texcoord0;  // the texture UVs (Mesh::texture_uv), or the lightmap UVs
-  std::vector<float> texcoord1;  // the lightmap UVs
+  std::vector<float> texcoord1;  // the lightmap UVs; both empty for a mesh without UVs
   std::vector<std::uint32_t> indices;
 };
-GltfMesh gltf_mesh(const Mesh& mesh);
+// `with_uvs` false (a blocker's mesh): positions, normals and triangles only.
+GltfMesh gltf_mesh(const Mesh& mesh, bool with_uvs = true);
 
 // One lightmap texture: PNG bytes (8-bit, linear values over its intensity).
 struct GltfTexture {
@@ -36,9 +37,8 @@ struct GltfTexture {
   std::vector<std::uint8_t> png;
 };
 
-struct GltfReceiver {
-  std::string name;
-  const GltfMesh* mesh = nullptr;
+// A receiver's lightmap: which texture, and where in it.
+struct GltfLightmap {
   int texture = 0;       // index into the textures
   double intensity = 1;  // MOZ_lightmap intensity: the value a texel of 1.0 stands for
   // KHR_texture_transform of the lightmap (glTF's v-down UVs): {scale_u, scale_v, offset_u,
@@ -46,11 +46,19 @@ struct GltfReceiver {
   std::optional<std::array<double, 4>> transform;
 };
 
-// The .glb file's bytes: a node, mesh and material per receiver (white, rough, not metallic),
-// the textures embedded, a clamp-to-edge linear sampler (no mip-maps, whose lower levels would
-// mix an atlas's neighbours). `quantity` ("visibility" or "irradiance") and `generator` go into
-// the asset's extras and generator.
-Expected<std::vector<std::uint8_t>> glb_bytes(const std::vector<GltfReceiver>& receivers,
+// An object of the scene: a receiver with its lightmap, or a blocker without (it casts the
+// shadows the lightmaps show, so a viewer shows it too).
+struct GltfObject {
+  std::string name;
+  const GltfMesh* mesh = nullptr;
+  std::optional<GltfLightmap> lightmap;
+};
+
+// The .glb file's bytes: a node, mesh and material per object (white, rough, not metallic), the
+// textures embedded, a clamp-to-edge linear sampler (no mip-maps, whose lower levels would mix an
+// atlas's neighbours). `quantity` ("visibility" or "irradiance") and `generator` go into the
+// asset's extras and generator.
+Expected<std::vector<std::uint8_t>> glb_bytes(const std::vector<GltfObject>& objects,
                                               const std::vector<GltfTexture>& textures,
                                               const std::string& quantity,
                                               const std::string& generator);

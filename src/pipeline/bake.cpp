@@ -130,6 +130,12 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
       return fits.error();
   }
   if (scene.output.atlas) result.atlas = pack_atlases(sides, *scene.output.atlas);
+  if (scene.output.gltf) {
+    for (std::size_t i = 0; i < meshes.size(); ++i)
+      if (!scene.objects[i].receiver)
+        result.gltf_blockers.emplace_back(
+            scene.objects[i].name, std::make_shared<const GltfMesh>(gltf_mesh(meshes[i], false)));
+  }
   const std::vector<const Mesh*> blockers = blocker_meshes(scene, meshes);
   // What the method asks for, built once and shared by every receiver.
   const MethodNeeds needs = entry->needs(scene.bake);

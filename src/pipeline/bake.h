@@ -59,6 +59,8 @@ struct BakeResult {
   // With [output] shadowmask, each light's channel (lightmaps/shadowmask.h); the lights left
   // out are warnings.
   std::vector<int> shadowmask_channels;
+  // With [output] gltf, the objects that are blockers only, in scene order, as a glTF shows them.
+  std::vector<std::pair<std::string, std::shared_ptr<const GltfMesh>>> gltf_blockers;
   double load_seconds = 0;       // mesh import and acceleration structures
   double bake_seconds = 0;       // all receivers: texel space, method, dilation
   std::int64_t shadow_rays = 0;  // rays traced, for sampling methods

@@ -416,24 +416,24 @@ Status write_outputs(OutputFolder& folder, const Scene& scene, const BakeSetting
   }
 
   if (out.gltf) {
-    std::vector<GltfReceiver> receivers;
+    std::vector<GltfObject> objects;
     for (std::size_t r = 0; r < result.receivers.size(); ++r) {
       const ReceiverBake& rb = result.receivers[r];
-      GltfReceiver g;
-      g.name = rb.name;
-      g.mesh = rb.gltf_mesh.get();
-      g.intensity = scales.gltf;
+      GltfLightmap lightmap;
+      lightmap.intensity = scales.gltf;
       if (result.atlas) {
         const AtlasPlacement& p = result.atlas->placements[r];
-        g.texture = p.atlas;
-        g.transform =
+        lightmap.texture = p.atlas;
+        lightmap.transform =
             atlas_scale_offset(p, result.atlas->sizes[std::size_t(p.atlas)], /*v_up=*/false);
       } else {
-        g.texture = int(r);
+        lightmap.texture = int(r);
       }
-      receivers.push_back(std::move(g));
+      objects.push_back({rb.name, rb.gltf_mesh.get(), lightmap});
     }
-    auto glb = glb_bytes(receivers, textures, to_string(effective.quantity),
+    for (const auto& [name, mesh] : result.gltf_blockers)
+      objects.push_back({name, mesh.get(), std::nullopt});
+    auto glb = glb_bytes(objects, textures, to_string(effective.quantity),
                          std::string("shadowbake ") + SHADOWBAKE_VERSION);
     if (!glb) return glb.error();
     if (Status s = write_text_file(folder.staged(kGltfFile), std::string(glb->begin(), glb->end()));

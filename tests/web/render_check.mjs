@@ -24,6 +24,7 @@
 // Exit 0 when every check passes, 1 when one fails, 2 on a usage error.
 
 import { createServer } from 'node:http';
+import { existsSync } from 'node:fs';
 import { readFile, writeFile, mkdtemp, rm } from 'node:fs/promises';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
@@ -310,8 +311,17 @@ const fmt = (x, n = 3) => Number(x).toFixed(n);
 async function main() {
   const opts = parseArgs(process.argv.slice(2));
   const t0 = performance.now();
-  const manifest = JSON.parse(await readFile(path.join(opts.bakeDir, 'manifest.json'), 'utf8'));
+  const manifestPath = path.join(opts.bakeDir, 'manifest.json');
+  if (!existsSync(manifestPath)) {
+    console.log(`render_check: FAIL: ${manifestPath} not found (is ${opts.bakeDir} a shadowbake bake folder?)`);
+    return 1;
+  }
+  const manifest = JSON.parse(await readFile(manifestPath, 'utf8'));
   const glbName = manifest.gltf ?? 'scene.glb';
+  if (!existsSync(path.join(opts.bakeDir, glbName))) {
+    console.log(`render_check: FAIL: ${path.join(opts.bakeDir, glbName)} not found (bake with --gltf)`);
+    return 1;
+  }
   const sources = await receiverSources(opts.bakeDir, manifest);
 
   const { result, png } = await renderInChromium(opts, glbName);

@@ -216,13 +216,23 @@ async function main() {
   scene.add(gltf.scene);
   scene.updateMatrixWorld(true);
 
-  const meshes = [];
+  const meshes = [];          // everything a ray may hit
+  const receiverMeshes = [];  // those with a lightmap: the camera frames them
   const receivers = {};
   const problems = [];
   gltf.scene.traverse((o) => {
     if (!o.isMesh) return;
     const name = nodeName(gltf.parser, o);
     const m = o.material;
+    if (!o.geometry.attributes.uv1) {
+      // A blocker: shadowbake writes it without lightmap UVs or lightmap. It hides what lies
+      // behind it (raycasts stop on it) and is drawn plain grey; no check point lies on it.
+      const plain = new THREE.MeshBasicMaterial({ color: 0x808080, side: m.side });
+      plain.name = m.name;
+      o.material = plain;
+      meshes.push(o);
+      return;
+    }
     if (!m.lightMap) {
       problems.push(`'${name}': its material '${m.name}' has no lightMap (MOZ_lightmap missing?)`);
       return;
@@ -239,15 +249,16 @@ async function main() {
     basic.name = m.name;
     o.material = basic;
     meshes.push(o);
+    receiverMeshes.push(o);
     receivers[name] = { material: m.name, intensity: m.lightMapIntensity,
       texture: describeTexture(m.lightMap) };
   });
   if (problems.length) return fail(problems.join('; '));
-  if (meshes.length === 0) return fail('the glTF has no meshes');
+  if (receiverMeshes.length === 0) return fail('the glTF has no meshes with a lightmap');
 
   const camera = new THREE.PerspectiveCamera(40, WIDTH / HEIGHT, 0.01, 1000);
   const vertices = [];
-  for (const mesh of meshes) {
+  for (const mesh of receiverMeshes) {
     const pos = mesh.geometry.attributes.position;
     for (let i = 0; i < pos.count; i++) {
       vertices.push(new THREE.Vector3().fromBufferAttribute(pos, i).applyMatrix4(mesh.matrixWorld));

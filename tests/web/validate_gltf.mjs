@@ -71,6 +71,6 @@ main().then(
   (code) => { process.exitCode = code; },
   (err) => {
     // validateBytes rejects when the input is not glTF at all (bad magic, unreadable JSON).
-    console.error(`validate_gltf: ${err?.stack ?? err}`);
+    console.error(`validate_gltf: ${err?.code === 'ENOENT' ? err.message : err?.stack ?? err}`);
     process.exitCode = 1;
   });
