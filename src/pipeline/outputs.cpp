@@ -100,17 +100,6 @@ std::string lower(std::string text) {
   return text;
 }
 
-// Usable inside a file name on every platform the outputs travel to (as object names are).
-bool is_file_name_part(std::string_view name) {
-  if (name.empty() || name.front() == '.') return false;
-  for (char c : name) {
-    const bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
-                    c == '_' || c == '.' || c == '-';
-    if (!ok) return false;
-  }
-  return true;
-}
-
 // A set of files written together: a receiver's own, or an atlas's.
 struct Sheet {
   std::string stem;

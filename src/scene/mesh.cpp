@@ -1,6 +1,8 @@
 // Access to the working mesh's triangles as plain project types.
 #include "scene/mesh.h"
 
+#include <cmath>
+
 namespace sb {
 
 Triangle triangle(const TriMesh& mesh, TriMesh::FaceHandle f) {
@@ -16,6 +18,17 @@ Triangle triangle(const TriMesh& mesh, TriMesh::FaceHandle f) {
     ++i;
   }
   return t;
+}
+
+SurfaceAreas surface_areas(const Mesh& mesh) {
+  SurfaceAreas areas;
+  for (auto f : mesh.mesh.faces()) {
+    const Triangle t = triangle(mesh.mesh, f);
+    areas.world += 0.5 * (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]).norm();
+    const Vec2 a = t.uv[1] - t.uv[0], b = t.uv[2] - t.uv[0];
+    areas.uv += 0.5 * std::abs(a.x() * b.y() - a.y() * b.x());
+  }
+  return areas;
 }
 
 }  // namespace sb

@@ -57,4 +57,11 @@ struct Triangle {
 };
 Triangle triangle(const TriMesh& mesh, TriMesh::FaceHandle f);
 
+// The mesh's surface area in world space (m²) and its lightmap UV triangles' total area (Σ of
+// |area|, the unit square being 1): their ratio is the world area a unit of UV area stands for.
+struct SurfaceAreas {
+  double world = 0, uv = 0;
+};
+SurfaceAreas surface_areas(const Mesh& mesh);
+
 }  // namespace sb

@@ -5,10 +5,7 @@
 
 namespace sb {
 
-namespace {
-
-// Usable as a file stem on every platform the outputs travel to: no separators, no hidden files.
-bool is_valid_object_name(std::string_view name) {
+bool is_file_name_part(std::string_view name) {
   if (name.empty() || name.front() == '.') return false;
   for (char c : name) {
     const bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
@@ -18,8 +15,6 @@ bool is_valid_object_name(std::string_view name) {
   return true;
 }
 
-}  // namespace
-
 Expected<ObjectDesc> read_object(const std::filesystem::path& file, const toml::table& table,
                                  std::size_t index) {
   TableReader r(file, table, fmt::format("[[object]] #{}", index + 1));
@@ -27,7 +22,7 @@ Expected<ObjectDesc> read_object(const std::filesystem::path& file, const toml::
   obj.line = static_cast<int>(r.line());
   if (r.require("name")) {
     if (auto name = r.string("name")) {
-      if (is_valid_object_name(*name)) {
+      if (is_file_name_part(*name)) {
         obj.name = *name;
         r.set_item(item_name("object", obj.name));
       } else {

@@ -9,15 +9,9 @@
 namespace sb {
 
 LightmapSide lightmap_side(const Mesh& mesh, double texels_per_metre, int max_side) {
-  double world_area = 0, uv_area = 0;
-  for (auto f : mesh.mesh.faces()) {
-    const Triangle t = triangle(mesh.mesh, f);
-    world_area += 0.5 * (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]).norm();
-    const Vec2 a = t.uv[1] - t.uv[0], b = t.uv[2] - t.uv[0];
-    uv_area += 0.5 * std::abs(a.x() * b.y() - a.y() * b.x());
-  }
+  const SurfaceAreas areas = surface_areas(mesh);
+  const double world_area = areas.world, uv_area = std::min(areas.uv, 1.0);
   LightmapSide out;
-  uv_area = std::min(uv_area, 1.0);
   out.wanted = mesh.has_uv && uv_area > 0 ? texels_per_metre * std::sqrt(world_area / uv_area) : 0;
   const double rounded = std::ceil(out.wanted - 1e-9);
   const int lo = kMinLightmapSide, hi = std::max(kMinLightmapSide, max_side);

@@ -37,6 +37,18 @@ double worst_difference(const Image& a, const Image& b, const std::vector<std::u
   return worst;
 }
 
+// Every receiver's per-light image of light l in `all` is `one`'s combined image, to `tolerance`.
+void expect_per_light_is(const BakeResult& all, std::size_t l, const BakeResult& one,
+                         double tolerance, const std::string& light) {
+  ASSERT_EQ(one.receivers.size(), all.receivers.size());
+  for (std::size_t r = 0; r < all.receivers.size(); ++r) {
+    const ReceiverBake& rb = all.receivers[r];
+    ASSERT_GT(rb.per_light.size(), l) << rb.name;
+    EXPECT_LE(worst_difference(rb.per_light[l], one.receivers[r].image, rb.covered), tolerance)
+        << rb.name << ", light " << light;
+  }
+}
+
 class PerLight : public ::testing::TestWithParam<std::string> {};
 
 // The showcase's two lights (a tilted panel and a sphere), irradiance: light l's per-light image
@@ -54,14 +66,7 @@ TEST_P(PerLight, EachLightsImageIsThatLightAlone) {
     Scene alone = scene;
     for (std::size_t k = 0; k < alone.lights.size(); ++k)
       if (k != l) alone.lights[k].power *= 1e-12;
-    const BakeResult one = bake_or_fail(alone, false);
-    ASSERT_EQ(one.receivers.size(), all.receivers.size());
-    for (std::size_t r = 0; r < all.receivers.size(); ++r) {
-      const ReceiverBake& rb = all.receivers[r];
-      ASSERT_EQ(rb.per_light.size(), scene.lights.size()) << rb.name;
-      EXPECT_LE(worst_difference(rb.per_light[l], one.receivers[r].image, rb.covered), 1e-5)
-          << rb.name << ", light " << scene.lights[l].name;
-    }
+    expect_per_light_is(all, l, bake_or_fail(alone, false), 1e-5, scene.lights[l].name);
   }
   // And the combined image is the sum of the per-light ones (irradiance).
   for (const ReceiverBake& rb : all.receivers) {
@@ -82,14 +87,7 @@ TEST_P(PerLight, EachLightsVisibilityIsTheSceneWithThatLightAlone) {
   for (std::size_t l = 0; l < scene.lights.size(); ++l) {
     Scene alone = scene;
     alone.lights = {scene.lights[l]};
-    const BakeResult one = bake_or_fail(alone, false);
-    ASSERT_EQ(one.receivers.size(), all.receivers.size());
-    for (std::size_t r = 0; r < all.receivers.size(); ++r) {
-      const ReceiverBake& rb = all.receivers[r];
-      ASSERT_EQ(rb.per_light.size(), scene.lights.size()) << rb.name;
-      EXPECT_LE(worst_difference(rb.per_light[l], one.receivers[r].image, rb.covered), 1e-6)
-          << rb.name << ", light " << scene.lights[l].name;
-    }
+    expect_per_light_is(all, l, bake_or_fail(alone, false), 1e-6, scene.lights[l].name);
   }
 }
 

@@ -47,15 +47,9 @@
 namespace sb {
 
 double texel_size(const Mesh& mesh, int width, int height) {
-  double world = 0, uv = 0;
-  for (auto f : mesh.mesh.faces()) {
-    const Triangle t = triangle(mesh.mesh, f);
-    world += 0.5 * (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]).norm();
-    const Vec2 a = t.uv[1] - t.uv[0], b = t.uv[2] - t.uv[0];
-    uv += 0.5 * std::abs(a.x() * b.y() - a.y() * b.x());
-  }
-  if (uv <= 0) return 0;
-  return std::sqrt(world / (uv * double(width) * height));
+  const SurfaceAreas areas = surface_areas(mesh);
+  if (areas.uv <= 0) return 0;
+  return std::sqrt(areas.world / (areas.uv * double(width) * height));
 }
 
 std::vector<int> ConvolutionPlan::leaves() const {
