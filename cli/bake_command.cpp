@@ -3,8 +3,11 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -15,6 +18,7 @@
 #include "pipeline/bake.h"
 #include "pipeline/memory_budget.h"
 #include "pipeline/outputs.h"
+#include "pipeline/shards.h"
 #include "scene/scene.h"
 
 namespace sbcli {
@@ -55,8 +59,11 @@ class ProgressBar {
 };
 
 struct BakeArgs {
-  std::string scene;
+  std::vector<std::string> scenes;  // one, or a batch
+  std::string list;                 // a file naming more scenes, one per line
   std::string out_dir;
+  std::optional<std::string> shard;  // "K/N" or "auto/N"
+  sb::ShardBalance balance = sb::ShardBalance::cost;
   std::optional<std::string> method, quantity;
   std::optional<int> resolution, samples;
   std::optional<double> texels_per_metre;
@@ -84,9 +91,17 @@ void print_explanation(const sb::BakeResult& result) {
   }
 }
 
-int run_bake(const BakeArgs& args) {
+// Bakes one scene into `out_dir` (a shard's part of it, with --shard); the exit code.
+int bake_scene(const BakeArgs& args, const std::string& scene_file, const std::string& out_dir) {
   const auto start = std::chrono::steady_clock::now();
-  auto scene = sb::load_scene(args.scene);
+  std::optional<sb::ShardSpec> shard;
+  if (args.shard) {
+    auto spec = sb::parse_shard(*args.shard);
+    if (!spec) return fail(spec.error());
+    spec->balance = args.balance;
+    shard = *spec;
+  }
+  auto scene = sb::load_scene(scene_file);
   if (!scene) return fail(scene.error());
   auto& settings = scene->bake;
   if (args.method) settings.method = *args.method;
@@ -119,16 +134,19 @@ int run_bake(const BakeArgs& args) {
   // The output folder is locked and its names checked before the bake, so a bake that could not
   // publish its files fails in a second, not after its work.
   if (sb::Status names = sb::check_output_names(*scene); !names) return fail(names.error());
-  auto folder = sb::OutputFolder::open(args.out_dir);
+  auto folder = sb::OutputFolder::open(out_dir);
   if (!folder) return fail(folder.error());
-  // With an atlas, the first atlas's names (how many there are is known after the bake).
-  if (sb::Status targets = folder->check_targets(sb::output_names(*scene)); !targets)
-    return fail(targets.error());
+  // With an atlas, the first atlas's names (how many there are is known after the bake); a
+  // shard's names once it knows its receivers.
+  if (!shard)
+    if (sb::Status targets = folder->check_targets(sb::output_names(*scene)); !targets)
+      return fail(targets.error());
 
   const bool show_progress = !args.quiet && ::isatty(STDERR_FILENO);
   ProgressBar bar("baking " + settings.method);
   sb::BakeOptions options;
   options.threads = args.threads;
+  options.shard = shard;
   if (show_progress) options.progress = [&bar](double f) { bar.update(f); };
 
   auto result = sb::bake(*scene, options);
@@ -137,7 +155,8 @@ int run_bake(const BakeArgs& args) {
     std::fprintf(stderr, "shadowbake: warning: %s\n", w.c_str());
 
   const auto write_start = std::chrono::steady_clock::now();
-  auto written = sb::write_outputs(*folder, *scene, settings, *result);
+  auto written = shard ? sb::write_shard(*folder, *scene, *shard, *result)
+                       : sb::write_outputs(*folder, *scene, settings, *result);
   reraise_pending_interrupt();
   if (!written) return fail(written.error());
   const double write_seconds =
@@ -156,13 +175,76 @@ int run_bake(const BakeArgs& args) {
                                  : fmt::format("{}²", settings.resolution);
     const std::string atlases =
         result->atlas ? fmt::format(", {} atlas(es)", result->atlas->sizes.size()) : "";
+    const std::string what = shard ? fmt::format("shard {}/{}: ", shard->index, shard->count) : "";
     fmt::print(
-        "baked {} receiver(s) with '{}' at {}{} into {}/ (manifest.json): load {:.2f} s, bake "
+        "{}baked {} receiver(s) with '{}' at {}{} into {}/ ({}): load {:.2f} s, bake "
         "{:.2f} s, write {:.2f} s, total {:.2f} s\n",
-        result->receivers.size(), settings.method, size, atlases, args.out_dir,
-        result->load_seconds, result->bake_seconds, write_seconds, total_seconds);
+        what, result->receivers.size(), settings.method, size, atlases, out_dir,
+        shard ? sb::kShardFile : "manifest.json", result->load_seconds, result->bake_seconds,
+        write_seconds, total_seconds);
   }
   return ok;
+}
+
+// The scenes a list file names: a scene file per line, relative to the list file's folder;
+// blank lines and lines starting with '#' are skipped.
+sb::Expected<std::vector<std::string>> read_scene_list(const std::string& list) {
+  std::ifstream in(list);
+  if (!in) return sb::input_error(list + ": cannot read the list of scenes");
+  std::vector<std::string> scenes;
+  std::string line;
+  const std::filesystem::path folder = std::filesystem::path(list).parent_path();
+  while (std::getline(in, line)) {
+    while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back()))) line.pop_back();
+    std::size_t first = 0;
+    while (first < line.size() && std::isspace(static_cast<unsigned char>(line[first]))) ++first;
+    line.erase(0, first);
+    if (line.empty() || line.front() == '#') continue;
+    const std::filesystem::path scene(line);
+    scenes.push_back(scene.is_absolute() ? line : (folder / scene).lexically_normal().string());
+  }
+  return scenes;
+}
+
+// In a batch, scene `file`'s output folder: OUT/<its path without the extension>, made
+// relative (scenes/hall/scene.toml → OUT/scenes/hall/scene), so distinct scenes never share one.
+std::string batch_folder(const std::string& out_dir, const std::string& file) {
+  std::filesystem::path relative, stem = std::filesystem::path(file).lexically_normal();
+  stem.replace_extension();
+  for (const auto& part : stem)
+    if (part != ".." && part != "." && !part.has_root_directory() && !part.has_root_name() &&
+        !part.empty())
+      relative /= part;
+  return (std::filesystem::path(out_dir) / relative).string();
+}
+
+// One scene into its folder, or a batch, each scene into its own folder under OUT: the library
+// is loaded once for all. A scene that fails does not stop the others; the exit code is the
+// first failure's.
+int run_bake(const BakeArgs& args) {
+  std::vector<std::string> scenes = args.scenes;
+  if (!args.list.empty()) {
+    auto listed = read_scene_list(args.list);
+    if (!listed) return fail(listed.error());
+    scenes.insert(scenes.end(), listed->begin(), listed->end());
+  }
+  if (scenes.empty()) return fail(sb::scene_error("bake: no scene given (a file, or --list FILE)"));
+  if (scenes.size() == 1 && args.list.empty()) return bake_scene(args, scenes[0], args.out_dir);
+  int first_failure = ok, failed = 0;
+  const auto start = std::chrono::steady_clock::now();
+  for (const std::string& scene : scenes) {
+    const int code = bake_scene(args, scene, batch_folder(args.out_dir, scene));
+    reraise_pending_interrupt();
+    if (code == ok) continue;
+    ++failed;
+    if (first_failure == ok) first_failure = code;
+  }
+  if (!args.quiet)
+    fmt::print("batch: {} of {} scene(s) baked into {}/ in {:.2f} s{}\n", scenes.size() - failed,
+               scenes.size(), args.out_dir,
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+               failed ? fmt::format("; {} failed (above)", failed) : "");
+  return first_failure;
 }
 
 }  // namespace
@@ -176,14 +258,23 @@ Runner add_bake_command(CLI::App& app) {
     double error_texels = 1;
     std::string max_memory;
     double texels_per_metre = 0;
-    std::string encoding;
+    std::string encoding, shard, balance;
     int atlas_size = 0, atlas_padding = 0;
   };
   auto o = std::make_shared<Options>();
-  auto* bake = app.add_subcommand("bake", "bake every receiver of a scene into OUTDIR");
-  bake->add_option("scene", o->args.scene, "scene file (TOML, docs/scene-format.md)")->required();
+  auto* bake = app.add_subcommand(
+      "bake", "bake every receiver of a scene into OUTDIR (several scenes: each into OUTDIR/...)");
+  bake->add_option("scene", o->args.scenes, "scene file(s) (TOML, docs/scene-format.md)");
+  bake->add_option("--list", o->args.list,
+                   "a file naming scene files, one per line (relative to it), baked as a batch");
   bake->add_option("-o,--output", o->args.out_dir, "output folder (created if missing)")
       ->required();
+  bake->add_option("--shard", o->shard,
+                   "bake shard K of N (K/N, 0 <= K < N; auto/N takes K from "
+                   "SLURM_ARRAY_TASK_ID or JOB_COMPLETION_INDEX) for `shadowbake merge`");
+  bake->add_option("--shard-balance", o->balance,
+                   "how receivers are dealt to shards: cost (default) or count (round robin)")
+      ->check(CLI::IsMember({"cost", "count"}));
   auto* method_opt =
       bake->add_option("--method", o->method, "bake method (overrides [bake] method)")
           ->check(CLI::IsMember(sb::known_methods()));
@@ -249,6 +340,8 @@ Runner add_bake_command(CLI::App& app) {
     if (*quantity_opt) o->args.quantity = o->quantity;
     if (*resolution_opt) o->args.resolution = o->resolution;
     if (*density_opt) o->args.texels_per_metre = o->texels_per_metre;
+    if (!o->shard.empty()) o->args.shard = o->shard;
+    if (o->balance == "count") o->args.balance = sb::ShardBalance::count;
     if (*encoding_opt) o->args.encoding = o->encoding;
     if (*atlas_opt) o->args.atlas_size = o->atlas_size;
     if (*padding_opt) o->args.atlas_padding = o->atlas_padding;

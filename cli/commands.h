@@ -39,5 +39,6 @@ Runner add_bake_command(CLI::App& app);     // bake_command.cpp
 Runner add_compare_command(CLI::App& app);  // compare_command.cpp
 Runner add_report_command(CLI::App& app);   // report_command.cpp
 Runner add_plan_command(CLI::App& app);     // plan_command.cpp
+Runner add_merge_command(CLI::App& app);    // merge_command.cpp
 
 }  // namespace sbcli

@@ -63,10 +63,9 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("shadowbake ") + SHADOWBAKE_VERSION);
   app.require_subcommand(1);
   const std::vector<std::pair<std::string, sbcli::Runner>> commands = {
-      {"bake", sbcli::add_bake_command(app)},
-      {"compare", sbcli::add_compare_command(app)},
-      {"report", sbcli::add_report_command(app)},
-      {"plan", sbcli::add_plan_command(app)},
+      {"bake", sbcli::add_bake_command(app)},     {"compare", sbcli::add_compare_command(app)},
+      {"report", sbcli::add_report_command(app)}, {"plan", sbcli::add_plan_command(app)},
+      {"merge", sbcli::add_merge_command(app)},
   };
   sbcli::install_interrupt_handlers();
   try {

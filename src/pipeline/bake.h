@@ -21,6 +21,17 @@
 
 namespace sb {
 
+// Which part of a scene's receivers a bake does (docs/distributed.md): receivers are dealt to
+// `count` shards by their estimated cost, and this bake does shard `index` (0 ≤ index < count).
+enum class ShardBalance {
+  cost,  // longest first onto the least loaded shard (LPT), cost ~ covered texels × lights
+  count  // round robin in scene order, for comparison
+};
+struct ShardSpec {
+  int index = 0, count = 1;
+  ShardBalance balance = ShardBalance::cost;
+};
+
 struct BakeOptions {
   int threads = 0;  // 0: all cores
   // Called from worker threads with the fraction of the bake done, in [0, 1]; may be empty.
@@ -28,9 +39,13 @@ struct BakeOptions {
   // Per-light images to keep beyond what the scene's [output] asks for (per_light: values,
   // shadowmask: visibility).
   KeepPerLight keep_per_light;
+  // Bake only this shard's receivers, and leave what needs every receiver (shadow-mask channels,
+  // the warnings about lights that reach nothing) to the merge (pipeline/shards.h).
+  std::optional<ShardSpec> shard;
 };
 
 struct ReceiverBake {
+  std::size_t object = 0;  // its index among the scene's objects
   std::string name;
   int uv_channel = 0;
   Image image;  // RGB, the receiver's side² (resolution, or its texels_per_metre size), dilated
@@ -46,14 +61,21 @@ struct ReceiverBake {
   std::vector<Image> per_light_visibility;
   // The receiver's mesh as a glTF carries it, when [output] gltf.
   std::shared_ptr<const GltfMesh> gltf_mesh;
-  // What the method reports beyond its values: named figures, its own manifest entries and
-  // what --explain prints (its warnings are in BakeResult::warnings).
+  // What the method reports beyond its values: named figures, its own manifest entries, what
+  // --explain prints and its warnings (gathered into BakeResult::warnings by finish_bake).
   MethodReport report;
+  std::int64_t rays = 0;                     // shadow rays the method traced for it
+  std::vector<std::string> uv_warnings;      // its UV layout's (and a black lightmap's) warnings
+  std::vector<std::uint8_t> lights_reached;  // per light: 1 where it reaches a texel of it
 };
 
 struct BakeResult {
-  std::vector<ReceiverBake> receivers;  // in scene order
-  std::vector<std::string> warnings;    // e.g. degenerate triangles skipped
+  std::vector<ReceiverBake> receivers;  // in scene order (a shard's: its own)
+  // Every warning, in the order they arise: the setup's (settings a method ignores, meshes,
+  // lightmap sizes), each receiver's UV layout, lights that reach no receiver, each receiver's
+  // method, shadow-mask channels (finish_bake).
+  std::vector<std::string> warnings;
+  std::vector<std::string> setup_warnings;  // the first part, the same for every shard
   // The receivers' places in atlases ([output] atlas), placements in receiver order.
   std::optional<AtlasLayout> atlas;
   // With [output] shadowmask, each light's channel (lightmaps/shadowmask.h); the lights left
@@ -66,8 +88,19 @@ struct BakeResult {
   std::int64_t shadow_rays = 0;  // rays traced, for sampling methods
 };
 
-// Bakes scene.bake.method for every receiver. Errors name the scene file and the item.
+// Bakes scene.bake.method for every receiver (or a shard's). Errors name the scene file and the
+// item.
 Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options = {});
+
+// What needs every receiver: the shadow-mask channels and the warnings list, from the
+// receivers' own parts. A bake does it itself; the merge of shards does it on their receivers.
+// `whole`: false for a shard alone, whose warnings leave out what only all receivers tell.
+void finish_bake(const Scene& scene, BakeResult& result, bool whole = true);
+
+// The receivers a shard bakes (indices among the scene's receivers, in scene order): `costs`
+// per receiver dealt to `spec.count` shards as spec.balance says. The same costs give the same
+// shards.
+std::vector<std::size_t> shard_receivers(const std::vector<double>& costs, const ShardSpec& spec);
 
 // The convolution method's plan for every receiver (describe_plan's text, in scene order),
 // without convolving: what `shadowbake plan` prints.

@@ -29,6 +29,14 @@ std::string slurp(const fs::path& p) {
   return ss.str();
 }
 
+// `text` with every `from` replaced by `to`.
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  for (std::size_t at = text.find(from); at != std::string::npos;
+       at = text.find(from, at + to.size()))
+    text.replace(at, from.size(), to);
+  return text;
+}
+
 class Cli : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -122,6 +130,62 @@ TEST_F(Cli, BakesFilesAndManifest) {
   auto png = sb::read_image(dir_ / "out" / "floor.png");
   ASSERT_TRUE(png);
   EXPECT_NEAR(png->at(1, 1)[0], exr->at(1, 1)[0], 1.0 / 255 + 1e-6);
+}
+
+TEST_F(Cli, ShardsMergeIntoWhatOneBakeWrites) {
+  // The floor and the blocker both receive, so that two shards each get one.
+  write("scene.toml", replaced(scene("method = \"reference\"\n"), "receiver = false\n", ""));
+  const std::string s = (dir_ / "scene.toml").string();
+  ASSERT_EQ(run("bake " + s + " -o " + (dir_ / "whole").string() + " --gltf --per-light").code, 0);
+  const CliRun a =
+      run("bake " + s + " -o " + (dir_ / "a").string() + " --gltf --per-light --shard 0/2");
+  ASSERT_EQ(a.code, 0) << a.err;
+  EXPECT_NE(a.out.find("shard 0/2: baked 1 receiver(s)"), std::string::npos) << a.out;
+  // auto/N takes K from the scheduler's variable.
+  const std::string with_env = "SLURM_ARRAY_TASK_ID=1 " + std::string(SB_CLI);
+  const int code = std::system((with_env + " bake " + s + " -o " + (dir_ / "b").string() +
+                                " --gltf --per-light --shard auto/2 -q")
+                                   .c_str());
+  ASSERT_EQ(WEXITSTATUS(code), 0);
+  const CliRun missing = run("merge " + (dir_ / "a").string() + " -o " + (dir_ / "m").string());
+  EXPECT_EQ(missing.code, 3);
+  EXPECT_NE(missing.err.find("shard 1/2 is missing"), std::string::npos) << missing.err;
+  EXPECT_FALSE(fs::exists(dir_ / "m" / "manifest.json"));
+  const CliRun merged = run("merge " + (dir_ / "b").string() + " " + (dir_ / "a").string() +
+                            " -o " + (dir_ / "m").string());
+  ASSERT_EQ(merged.code, 0) << merged.err;
+  for (const std::string file : {"floor.exr", "blocker.exr", "floor.panel.exr", "scene.glb"}) {
+    std::ifstream x(dir_ / "whole" / file, std::ios::binary),
+        y(dir_ / "m" / file, std::ios::binary);
+    const std::string bx((std::istreambuf_iterator<char>(x)), {}),
+        by((std::istreambuf_iterator<char>(y)), {});
+    EXPECT_FALSE(bx.empty()) << file;
+    EXPECT_EQ(bx, by) << file;
+  }
+}
+
+TEST_F(Cli, BatchBakesEachSceneIntoItsOwnFolder) {
+  fs::create_directories(dir_ / "one");
+  fs::create_directories(dir_ / "two");
+  const auto beside = [](const std::string& text) {
+    return replaced(replaced(text, "floor.obj", "../floor.obj"), "blocker.obj", "../blocker.obj");
+  };
+  write("one/scene.toml", beside(scene()));
+  write("two/scene.toml", beside(scene("quantity = \"irradiance\"\n")));
+  write("broken.toml", "[bake\n");
+  write("scenes.txt", "# the batch\none/scene.toml\n\ntwo/scene.toml\n");
+  const fs::path out = dir_ / "out";
+  const CliRun r = run("bake --list " + (dir_ / "scenes.txt").string() + " " +
+                       (dir_ / "broken.toml").string() + " -o " + out.string());
+  // The broken scene fails with its own error; the others are baked.
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_NE(r.err.find("TOML syntax error"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("batch: 2 of 3 scene(s) baked"), std::string::npos) << r.out;
+  auto first = sb::read_manifest(out / dir_.relative_path() / "one" / "scene");
+  auto second = sb::read_manifest(out / dir_.relative_path() / "two" / "scene");
+  ASSERT_TRUE(first) << first.error().message;
+  ASSERT_TRUE(second) << second.error().message;
+  EXPECT_EQ(second->quantity, sb::Quantity::irradiance);
 }
 
 TEST_F(Cli, OutputFlagsWriteAtlasesMasksPerLightImagesAndGltf) {
