@@ -66,11 +66,23 @@ std::unique_ptr<tbb::global_control> limit_threads(const BakeOptions& options) {
                                                std::size_t(options.threads));
 }
 
-// A receiver's estimated cost for sharding: the texels its UVs cover (its side² times its UV
-// area in the unit square) times the lights; what every method's time grows with.
-double receiver_cost(const Mesh& mesh, int side, std::size_t lights) {
-  const double uv = std::clamp(surface_areas(mesh).uv, 1e-6, 1.0);
-  return double(side) * double(side) * uv * double(std::max<std::size_t>(lights, 1));
+// A receiver's estimated cost for sharding: the (texel, light) pairs a method shades, what every
+// method's time grows with. Per triangle, the texels its UVs cover (its UV area times side²)
+// times the lights that reach its centroid, plus a tenth of a light for the work every texel
+// takes whatever the lights (texel space, dilation, writing).
+double receiver_cost(const Mesh& mesh, int side, const std::vector<Light>& lights) {
+  double pairs = 0;
+  for (auto f : mesh.mesh.faces()) {
+    const Triangle t = triangle(mesh.mesh, f);
+    const Vec2 a = t.uv[1] - t.uv[0], b = t.uv[2] - t.uv[0];
+    const double uv_area = 0.5 * std::abs(a.x() * b.y() - a.y() * b.x());
+    const Vec3 centroid = (t.p[0] + t.p[1] + t.p[2]) / 3.0;
+    const Vec3 normal = (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]).normalized();
+    double reached = 0.1;
+    for (const Light& light : lights) reached += light.reaches(centroid, normal) ? 1.0 : 0.0;
+    pairs += uv_area * reached;
+  }
+  return double(side) * double(side) * pairs;
 }
 
 // The index of object `object` among the scene's receivers.
@@ -138,6 +150,9 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   if (!loaded) return loaded.error();
   const std::vector<Mesh>& meshes = *loaded;
   const std::vector<int> sides = lightmap_sides(scene, meshes, &result.setup_warnings);
+  auto lights_or = make_lights(scene.lights, scene.file);
+  if (!lights_or) return lights_or.error();
+  const std::vector<Light>& lights = *lights_or;
   // The receivers this bake does: all, or its shard's.
   std::vector<std::size_t> receivers;  // object indices
   for (std::size_t i = 0; i < meshes.size(); ++i)
@@ -145,7 +160,7 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   if (options.shard) {
     std::vector<double> costs;
     for (std::size_t r = 0; r < receivers.size(); ++r)
-      costs.push_back(receiver_cost(meshes[receivers[r]], sides[r], scene.lights.size()));
+      costs.push_back(receiver_cost(meshes[receivers[r]], sides[r], lights));
     std::vector<std::size_t> mine = shard_receivers(costs, *options.shard);
     std::vector<std::size_t> objects;
     for (std::size_t r : mine) objects.push_back(receivers[r]);
@@ -178,10 +193,6 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   if (needs.clusters) clusters = build_clusters(blockers);
   std::optional<ShaftCuller> shafts;
   if (needs.shafts) shafts.emplace(blockers);
-  auto lights_or = make_lights(scene.lights, scene.file);
-  if (!lights_or) return lights_or.error();
-  const std::vector<Light>& lights = *lights_or;
-
   result.load_seconds = seconds_since(load_start);
 
   // The bake proper, timed from here: texel space, the method, dilation.

@@ -24,7 +24,7 @@ namespace sb {
 // Which part of a scene's receivers a bake does (docs/distributed.md): receivers are dealt to
 // `count` shards by their estimated cost, and this bake does shard `index` (0 ≤ index < count).
 enum class ShardBalance {
-  cost,  // longest first onto the least loaded shard (LPT), cost ~ covered texels × lights
+  cost,  // longest first onto the least loaded shard (LPT); cost ~ the (texel, light) pairs
   count  // round robin in scene order, for comparison
 };
 struct ShardSpec {
