@@ -20,13 +20,14 @@ namespace {
 struct MergeArgs {
   std::vector<std::string> shards;
   std::string out_dir;
+  std::string scene;  // where the scene lies, when not where the shards read it
   bool quiet = false;
 };
 
 int run_merge(const MergeArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   std::vector<std::filesystem::path> folders(args.shards.begin(), args.shards.end());
-  auto merged = sb::merge_shards(folders);
+  auto merged = sb::merge_shards(folders, args.scene);
   if (!merged) return fail(merged.error());
   const sb::Scene& scene = merged->scene;
   if (sb::Status names = sb::check_output_names(scene); !names) return fail(names.error());
@@ -54,6 +55,9 @@ Runner add_merge_command(CLI::App& app) {
   merge->add_option("shards", args->shards, "the shards' output folders, every shard once")
       ->required();
   merge->add_option("-o,--output", args->out_dir, "output folder (created if missing)")->required();
+  merge->add_option("--scene", args->scene,
+                    "the scene file, when it is not where the shards read it (its content must "
+                    "be the same)");
   merge->add_flag("-q,--quiet", args->quiet, "no summary; errors and warnings still go to stderr");
   return [args]() { return run_merge(*args); };
 }

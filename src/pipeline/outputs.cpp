@@ -151,25 +151,26 @@ Image coverage_image(const ReceiverBake& r) {
   return mask;
 }
 
-// The largest finite value of the images at their covered texels.
-double covered_peak(const BakeResult& result, const std::vector<Image> ReceiverBake::*images) {
+// The largest finite value of `image` at the receiver's covered texels.
+double covered_peak(const ReceiverBake& r, const Image& image) {
+  double peak = 0;
+  for (std::size_t i = 0; i < r.covered.size(); ++i) {
+    if (!r.covered[i]) continue;
+    for (int c = 0; c < image.channels; ++c) {
+      const float v = image.pixels[i * std::size_t(image.channels) + std::size_t(c)];
+      if (std::isfinite(v)) peak = std::max(peak, double(v));
+    }
+  }
+  return peak;
+}
+
+// The largest of the lightmaps' (per_light false) or of the per-light images'.
+double covered_peak(const BakeResult& result, bool per_light) {
   double peak = 0;
   for (const ReceiverBake& r : result.receivers) {
-    const std::vector<const Image*> list =
-        images ? [&] {
-          std::vector<const Image*> out;
-          for (const Image& image : r.*images) out.push_back(&image);
-          return out;
-        }()
-               : std::vector<const Image*>{&r.image};
-    for (const Image* image : list)
-      for (std::size_t i = 0; i < r.covered.size(); ++i) {
-        if (!r.covered[i]) continue;
-        for (int c = 0; c < image->channels; ++c) {
-          const float v = image->pixels[i * std::size_t(image->channels) + std::size_t(c)];
-          if (std::isfinite(v)) peak = std::max(peak, double(v));
-        }
-      }
+    if (!per_light) peak = std::max(peak, covered_peak(r, r.image));
+    if (per_light)
+      for (const Image& image : r.per_light) peak = std::max(peak, covered_peak(r, image));
   }
   return peak;
 }
@@ -349,12 +350,11 @@ Status write_outputs(OutputFolder& folder, const Scene& scene, const BakeSetting
   const bool irradiance = effective.quantity == Quantity::irradiance;
   const double white = irradiance ? irradiance_white_point(result) : 1.0;
   Scales scales;
-  const double lightmap_peak = covered_peak(result, nullptr);
+  const double lightmap_peak = covered_peak(result, false);
   scales.lightmap = encoding_scale(out.encoding, effective.quantity, lightmap_peak);
   scales.gltf = encoding_scale(Encoding::png, effective.quantity, lightmap_peak);
   if (out.per_light)
-    scales.per_light = encoding_scale(out.encoding, effective.quantity,
-                                      covered_peak(result, &ReceiverBake::per_light));
+    scales.per_light = encoding_scale(out.encoding, effective.quantity, covered_peak(result, true));
 
   Manifest manifest;
   manifest.shadowbake = SHADOWBAKE_VERSION;

@@ -183,7 +183,8 @@ Status write_shard(OutputFolder& folder, const Scene& scene, const ShardSpec& sp
   return folder.publish(names);
 }
 
-Expected<MergedBake> merge_shards(const std::vector<fs::path>& folders) {
+Expected<MergedBake> merge_shards(const std::vector<fs::path>& folders,
+                                  const fs::path& scene_file) {
   if (folders.empty()) return scene_error("merge: no shard folders given");
   std::vector<ShardRead> shards;
   for (const fs::path& folder : folders) {
@@ -246,7 +247,8 @@ Expected<MergedBake> merge_shards(const std::vector<fs::path>& folders) {
   // The scene, as the shards baked it.
   const json& d = by_index[0]->description;
   MergedBake merged;
-  const std::string as_given = d.value("scene", ""), path = d.value("scene_path", "");
+  const std::string as_given = d.value("scene", "");
+  const std::string path = scene_file.empty() ? d.value("scene_path", "") : scene_file.string();
   auto scene = load_scene(path);
   if (!scene) return scene.error();
   merged.scene = std::move(*scene);

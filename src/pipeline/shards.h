@@ -45,9 +45,12 @@ struct MergedBake {
   BakeResult result;
 };
 
-// Reads the shard folders and merges them. Errors (one line, naming the folder): a folder that
-// is not a shard, shards of different scenes, settings or shard counts, a shard given twice, a
-// missing shard, a scene changed since the shards were baked, damaged data.
-Expected<MergedBake> merge_shards(const std::vector<std::filesystem::path>& folders);
+// Reads the shard folders and merges them. The scene is read from where the shards read it, or
+// from `scene_file` when given (the merge runs where the scene lies elsewhere); its content hash
+// must be the shards'. Errors (one line, naming the folder): a folder that is not a shard, shards
+// of different scenes, settings or shard counts, a shard given twice, a missing shard, a scene
+// changed since the shards were baked, damaged data.
+Expected<MergedBake> merge_shards(const std::vector<std::filesystem::path>& folders,
+                                  const std::filesystem::path& scene_file = {});
 
 }  // namespace sb

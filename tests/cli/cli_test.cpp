@@ -151,8 +151,22 @@ TEST_F(Cli, ShardsMergeIntoWhatOneBakeWrites) {
   EXPECT_EQ(missing.code, 3);
   EXPECT_NE(missing.err.find("shard 1/2 is missing"), std::string::npos) << missing.err;
   EXPECT_FALSE(fs::exists(dir_ / "m" / "manifest.json"));
-  const CliRun merged = run("merge " + (dir_ / "b").string() + " " + (dir_ / "a").string() +
-                            " -o " + (dir_ / "m").string());
+  // The scene where the merge sees it: a copy elsewhere (the same bytes) is accepted, a changed
+  // one is not.
+  fs::create_directories(dir_ / "elsewhere");
+  for (const std::string file : {"scene.toml", "floor.obj", "blocker.obj"})
+    fs::copy_file(dir_ / file, dir_ / "elsewhere" / file);
+  const std::string shards = (dir_ / "b").string() + " " + (dir_ / "a").string();
+  std::ofstream(dir_ / "elsewhere" / "floor.obj", std::ios::app) << "# changed\n";
+  const CliRun changed = run("merge " + shards + " -o " + (dir_ / "m").string() + " --scene " +
+                             (dir_ / "elsewhere" / "scene.toml").string());
+  EXPECT_EQ(changed.code, 3);
+  EXPECT_NE(changed.err.find("changed since the shards were baked"), std::string::npos)
+      << changed.err;
+  fs::copy_file(dir_ / "floor.obj", dir_ / "elsewhere" / "floor.obj",
+                fs::copy_options::overwrite_existing);
+  const CliRun merged = run("merge " + shards + " -o " + (dir_ / "m").string() + " --scene " +
+                            (dir_ / "elsewhere" / "scene.toml").string());
   ASSERT_EQ(merged.code, 0) << merged.err;
   for (const std::string file : {"floor.exr", "blocker.exr", "floor.panel.exr", "scene.glb"}) {
     std::ifstream x(dir_ / "whole" / file, std::ios::binary),
