@@ -2,6 +2,7 @@
 #include "pipeline/shard_files.h"
 
 #include <fmt/format.h>
+#include <xxhash.h>
 
 #include <cstring>
 #include <fstream>
@@ -25,7 +26,7 @@ constexpr std::uint64_t kMaxSide = 16384;
 // Appends values' bytes, then zeros up to a multiple of 4.
 template <typename T>
 void put(std::string& out, const T* values, std::size_t count) {
-  out.append(reinterpret_cast<const char*>(values), count * sizeof(T));
+  if (count > 0) out.append(reinterpret_cast<const char*>(values), count * sizeof(T));
   while (out.size() % 4 != 0) out.push_back('\0');
 }
 void put_u64(std::string& out, std::uint64_t v) { put(out, &v, 1); }
@@ -54,6 +55,7 @@ class Unpacker {
       ok_ = false;
       return;
     }
+    if (size == 0) return;  // an empty array: out may be null
     std::memcpy(out, bytes_.data() + at_, size);
     at_ += size;
     while (at_ % 4 != 0 && at_ < bytes_.size()) ++at_;
@@ -112,6 +114,10 @@ Error damaged(const std::string& where, const std::string& what) {
 }
 
 }  // namespace
+
+std::string data_checksum(const std::string& bytes) {
+  return fmt::format("{:016x}", XXH3_64bits(bytes.data(), bytes.size()));
+}
 
 std::string receiver_data_file(std::size_t object) {
   return fmt::format("receiver_{}.bin", object);
@@ -197,6 +203,8 @@ Expected<ReceiverBake> read_receiver(const json& meta, const std::filesystem::pa
     return damaged(where, "receiver '" + r.name + "' has impossible sizes");
   auto bytes = read_bytes(data);
   if (!bytes) return bytes.error();
+  if (data_checksum(*bytes) != meta.value("checksum", ""))
+    return damaged(data.string(), "its checksum is not the one " + where + " gives");
   Unpacker in(std::move(*bytes), data.string());
   const std::uint32_t magic = in.u32(), version = in.u32(), width = in.u32(), height = in.u32();
   if (magic != kReceiverMagic || version != kVersion || int(width) != side || int(height) != side)
@@ -223,9 +231,11 @@ std::string gltf_mesh_data(const GltfMesh& mesh) {
   return out;
 }
 
-Expected<GltfMesh> read_gltf_mesh(const std::filesystem::path& data) {
+Expected<GltfMesh> read_gltf_mesh(const std::filesystem::path& data, const std::string& checksum) {
   auto bytes = read_bytes(data);
   if (!bytes) return bytes.error();
+  if (data_checksum(*bytes) != checksum)
+    return damaged(data.string(), "its checksum is not the one shard.json gives");
   Unpacker in(std::move(*bytes), data.string());
   if (in.u32() != kMeshMagic || in.u32() != kVersion)
     return damaged(data.string(), "not a glTF mesh");

@@ -25,12 +25,17 @@ nlohmann::ordered_json receiver_metadata(const ReceiverBake& r);
 // The binary file's bytes.
 std::string receiver_data(const ReceiverBake& r);
 
-// The receiver `metadata` and the binary file at `data` describe; errors name `where`.
+// A binary file's checksum (XXH3-64, 16 hex digits), kept in shard.json: a merge refuses data
+// damaged in any byte.
+std::string data_checksum(const std::string& bytes);
+
+// The receiver `metadata` and the binary file at `data` describe, the file's checksum being
+// metadata's "checksum"; errors name `where`.
 Expected<ReceiverBake> read_receiver(const nlohmann::ordered_json& metadata,
                                      const std::filesystem::path& data, const std::string& where);
 
 // A glTF mesh's arrays as a binary file, and back (the blockers' meshes, written by shard 0).
 std::string gltf_mesh_data(const GltfMesh& mesh);
-Expected<GltfMesh> read_gltf_mesh(const std::filesystem::path& data);
+Expected<GltfMesh> read_gltf_mesh(const std::filesystem::path& data, const std::string& checksum);
 
 }  // namespace sb

@@ -158,23 +158,23 @@ Status write_shard(OutputFolder& folder, const Scene& scene, const ShardSpec& sp
                   {"bake_seconds", result.bake_seconds},
                   {"receivers", json::object()}};
   for (const ReceiverBake& r : result.receivers) {
-    description["receivers"].push_back(receiver_metadata(r));
+    const std::string data = receiver_data(r);
+    json metadata = receiver_metadata(r);
+    metadata["checksum"] = data_checksum(data);
+    description["receivers"].push_back(std::move(metadata));
     timings["receivers"][r.name] = {{"seconds", r.seconds},
                                     {"texels", r.seconds_texels},
                                     {"method", r.seconds_method},
                                     {"dilate", r.seconds_dilate}};
-    if (Status s = write_text_file(folder.staged(receiver_data_file(r.object)), receiver_data(r));
-        !s)
-      return s;
+    if (Status s = write_text_file(folder.staged(receiver_data_file(r.object)), data); !s) return s;
   }
   for (std::size_t b = 0; b < result.gltf_blockers.size(); ++b) {
     const std::string file = fmt::format("{}{}.bin", kBlockerMeshPrefix, b);
-    description["gltf_blockers"].push_back(
-        {{"name", result.gltf_blockers[b].first}, {"file", file}});
-    if (Status s =
-            write_text_file(folder.staged(file), gltf_mesh_data(*result.gltf_blockers[b].second));
-        !s)
-      return s;
+    const std::string data = gltf_mesh_data(*result.gltf_blockers[b].second);
+    description["gltf_blockers"].push_back({{"name", result.gltf_blockers[b].first},
+                                            {"file", file},
+                                            {"checksum", data_checksum(data)}});
+    if (Status s = write_text_file(folder.staged(file), data); !s) return s;
   }
   if (Status s = write_text_file(folder.staged(kShardTimingsFile), timings.dump(2) + "\n"); !s)
     return s;
@@ -313,7 +313,8 @@ Expected<MergedBake> merge_shards(const std::vector<fs::path>& folders,
   }
   result.setup_warnings = d.at("setup_warnings").get<std::vector<std::string>>();
   for (const json& blocker : d.at("gltf_blockers")) {
-    auto mesh = read_gltf_mesh(by_index[0]->folder / blocker.value("file", ""));
+    auto mesh = read_gltf_mesh(by_index[0]->folder / blocker.value("file", ""),
+                               blocker.value("checksum", ""));
     if (!mesh) return mesh.error();
     result.gltf_blockers.emplace_back(blocker.value("name", ""),
                                       std::make_shared<const GltfMesh>(std::move(*mesh)));

@@ -210,14 +210,22 @@ TEST(Shards, MissingDuplicatedOrForeignShardsAreNamed) {
   // A shard of a split into 4.
   f.bake_shard(scene, {1, 4, ShardBalance::cost}, f.dir() / "four");
   EXPECT_NE(error({s0, f.dir() / "four", s2}).find("another split"), std::string::npos);
-  // Damaged data.
+  // Damaged data: one byte of a texel changed, or the file cut short.
+  fs::path data;
   for (const auto& e : fs::directory_iterator(s1))
-    if (e.path().filename().string().rfind("receiver_", 0) == 0) {
-      fs::resize_file(e.path(), 100);
-      break;
-    }
-  const std::string damaged = error({s0, s1, s2});
+    if (e.path().filename().string().rfind("receiver_", 0) == 0) data = e.path();
+  ASSERT_FALSE(data.empty());
+  const std::string original = slurp(data);
+  std::string flipped = original;
+  flipped[flipped.size() / 2] ^= 0x10;
+  std::ofstream(data, std::ios::binary | std::ios::trunc) << flipped;
+  std::string damaged = error({s0, s1, s2});
+  EXPECT_NE(damaged.find("damaged shard data: its checksum"), std::string::npos) << damaged;
+  std::ofstream(data, std::ios::binary | std::ios::trunc) << original.substr(0, 100);
+  damaged = error({s0, s1, s2});
   EXPECT_NE(damaged.find("damaged shard data"), std::string::npos) << damaged;
+  std::ofstream(data, std::ios::binary | std::ios::trunc) << original;
+  EXPECT_TRUE(merge_shards({s0, s1, s2}));
 }
 
 TEST(ShardSpec, ParsesKOfNAndTakesAutoFromTheScheduler) {
