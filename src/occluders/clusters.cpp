@@ -299,45 +299,51 @@ Shaft::Shaft(const std::vector<Vec3>& light_points, const Bounds3& receiver) {
       box.hi[k] = middle + 0.5 * tolerance_;
     }
   }
-  std::vector<Point3> points;
+  std::vector<Vec3> points;
   for (int corner = 0; corner < 8; ++corner) {
     points.emplace_back(corner & 1 ? box.hi.x() : box.lo.x(), corner & 2 ? box.hi.y() : box.lo.y(),
                         corner & 4 ? box.hi.z() : box.lo.z());
   }
-  for (const Vec3& p : light_points) points.emplace_back(p.x(), p.y(), p.z());
+  points.insert(points.end(), light_points.begin(), light_points.end());
 
-  std::vector<Point3> hull_points;
-  std::vector<std::array<std::size_t, 3>> hull_faces;
-  CGAL::convex_hull_3(points.begin(), points.end(), hull_points, hull_faces);
-
-  std::vector<Vec3> vertices;
-  Vec3 inside = Vec3::Zero();
-  for (const Point3& p : hull_points) {
-    vertices.push_back(to_vec(p));
-    inside += vertices.back();
-  }
-  inside /= std::max<std::size_t>(vertices.size(), 1);
-
-  for (const auto& face : hull_faces) {
-    const Vec3 a = vertices[face[0]];
-    Vec3 normal = (vertices[face[1]] - a).cross(vertices[face[2]] - a);
-    const double length = normal.norm();
-    if (!(length > 0)) continue;
-    normal /= length;
-    // Outward whatever the hull's winding: the vertices' centroid lies strictly inside.
-    if (normal.dot(inside - a) > 0) normal = -normal;
-    // The plane through the farthest vertex, so rounding in the normal never cuts the hull.
-    double offset = -std::numeric_limits<double>::infinity();
-    for (const Vec3& v : vertices) offset = std::max(offset, normal.dot(v));
-    bool duplicate = false;
-    for (std::size_t i = 0; i < normals_.size() && !duplicate; ++i) {
-      duplicate =
-          normals_[i].dot(normal) > 1 - 1e-12 && std::abs(offsets_[i] - offset) <= tolerance_;
-    }
-    if (duplicate) continue;
+  // The hull's face planes, found by brute force over the points' triples rather than by
+  // CGAL::convex_hull_3: its facets of these degenerate inputs (a box 1e-6 thick, coplanar light
+  // outlines) depend on the order it meets vertices in, which follows their memory addresses, so
+  // two runs (two threads planning two halves of a light) got different shafts and plans. A
+  // triple spans a face plane when no point lies beyond its plane by more than the tolerance;
+  // each such plane is kept through the farthest point (so it never cuts the hull), in the order
+  // the triples come: a function of the points alone. At most 24 points: ~2000 triples, most
+  // refused after a few points.
+  const std::size_t n = points.size();
+  const double min_cross = 1e-12 * size * size;
+  const auto add = [&](const Vec3& normal, double offset) {
+    for (std::size_t i = 0; i < normals_.size(); ++i)
+      if (normals_[i].dot(normal) > 1 - 1e-12 && std::abs(offsets_[i] - offset) <= tolerance_)
+        return;
     normals_.push_back(normal);
     offsets_.push_back(offset);
-  }
+  };
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 1; j < n; ++j)
+      for (std::size_t k = j + 1; k < n; ++k) {
+        Vec3 normal = (points[j] - points[i]).cross(points[k] - points[i]);
+        const double length = normal.norm();
+        if (!(length > min_cross)) continue;
+        normal /= length;
+        const double on = normal.dot(points[i]);
+        // Which sides the other points lie on, beyond the tolerance; stop once both.
+        bool above = false, below = false;
+        double hi = on, lo = on;
+        for (std::size_t m = 0; m < n && !(above && below); ++m) {
+          const double d = normal.dot(points[m]);
+          hi = std::max(hi, d);
+          lo = std::min(lo, d);
+          above = above || d > on + tolerance_;
+          below = below || d < on - tolerance_;
+        }
+        if (!above) add(normal, hi);
+        if (!below) add(-normal, -lo);
+      }
 }
 
 bool Shaft::may_contain_any(const std::vector<Vec3>& points) const {

@@ -52,7 +52,8 @@ struct ClusterTree {
 ClusterTree build_clusters(const std::vector<const Mesh*>& meshes, int leaf_faces = 64);
 
 // The shaft between a light and a receiver part: the convex hull of the light's outline points
-// and the receiver part's bounding box corners (CGAL convex_hull_3), kept as its face planes.
+// and the receiver part's bounding box corners, kept as its face planes (found by brute force
+// over the points' triples, so that they depend on the points alone: clusters.cpp).
 // A flat receiver box gets a tiny thickness (1e-6 of the shaft's size), so the shaft is always a
 // solid; points within that same tolerance outside a plane count as inside.
 class Shaft {

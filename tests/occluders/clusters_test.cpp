@@ -440,6 +440,51 @@ TEST(Shaft, DegenerateShaftsStillCull) {
   EXPECT_FALSE(segment.may_contain_any({Vec3(0.01, 0, 0.5)}));
 }
 
+// A disk light's 16-gon outline over a single texel (the box of one point), as the planner
+// builds it for the smallest receiver groups: the shaft holds the segment from the texel to the
+// light, refuses points beside it, and decides every probe the same way however the heap is laid
+// out when it is built. (CGAL's convex_hull_3, which the shaft used before, ordered these
+// degenerate points by their addresses, and `shadowbake plan` on the hall on 2 threads printed
+// different face counts from run to run; this test did not catch that in one thread, the
+// repeated plans did: docs/methods.md.)
+TEST(Shaft, DegenerateShaftIsTheSameWhateverTheHeap) {
+  std::vector<Vec3> disk;
+  const double r = 0.1 / std::cos(std::numbers::pi / 16);
+  for (int i = 0; i < 16; ++i) {
+    const double phi = 2 * std::numbers::pi * i / 16;
+    disk.push_back(Vec3(-1, -1.6, 3.485) + r * Vec3(std::cos(phi), std::sin(phi), 0));
+  }
+  Bounds3 texel;
+  texel.extend(Vec3(-2.9815893173217773, 1.4829732179641724, 0.4686336815357208));
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<Vec3> probes;
+  for (int i = 0; i < 20000; ++i) {
+    const double t = 0.5 * (u(rng) + 1);
+    const Vec3 on = texel.lo + t * (Vec3(-1, -1.6, 3.485) - texel.lo);
+    probes.push_back(on + 0.15 * Vec3(u(rng), u(rng), u(rng)));
+  }
+  const auto decisions = [&] {
+    const Shaft shaft(disk, texel);
+    std::vector<bool> inside;
+    for (const Vec3& p : probes) inside.push_back(shaft.may_contain_any({p}));
+    return inside;
+  };
+  const std::vector<bool> first = decisions();
+  for (int round = 0; round < 16; ++round) {
+    // Another heap: blocks of many sizes, every other one freed again, so that the shaft's own
+    // allocations land in holes in another order.
+    std::vector<std::vector<char>> clutter;
+    for (int i = 0; i < 200 * (round + 1); ++i) clutter.emplace_back(16 + rng() % 2000);
+    for (std::size_t i = 0; i < clutter.size(); i += 2 + rng() % 2) clutter[i] = {};
+    EXPECT_EQ(decisions(), first) << "round " << round;
+  }
+  const Shaft shaft(disk, texel);
+  EXPECT_TRUE(shaft.contains_all({texel.lo, 0.5 * (texel.lo + Vec3(-1, -1.6, 3.485))}));
+  EXPECT_FALSE(shaft.may_contain_any({texel.lo + Vec3(0.05, 0, 0)}));
+  EXPECT_GT(std::count(first.begin(), first.end(), false), 1000);
+}
+
 // True when some point of the triangle (on a dense barycentric grid) is in the shaft.
 bool triangle_hits_shaft(const Shaft& shaft, const std::vector<Vec3>& t) {
   const int n = 12;
