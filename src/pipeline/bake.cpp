@@ -85,13 +85,6 @@ double receiver_cost(const Mesh& mesh, int side, const std::vector<Light>& light
   return double(side) * double(side) * pairs;
 }
 
-// The index of object `object` among the scene's receivers.
-std::size_t receiver_rank(const Scene& scene, std::size_t object) {
-  std::size_t rank = 0;
-  for (std::size_t i = 0; i < object; ++i) rank += scene.objects[i].receiver ? 1 : 0;
-  return rank;
-}
-
 // The [bake] keys every bake reads, whatever its method.
 bool read_by_every_method(const std::string& key) {
   for (const char* k : {"resolution", "method", "quantity", "margin", "max_memory"})
@@ -153,21 +146,24 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   auto lights_or = make_lights(scene.lights, scene.file);
   if (!lights_or) return lights_or.error();
   const std::vector<Light>& lights = *lights_or;
-  // The receivers this bake does: all, or its shard's.
-  std::vector<std::size_t> receivers;  // object indices
+  // The receivers this bake does: all, or its shard's (as object indices, and their sides).
+  std::vector<std::size_t> all_receivers;
   for (std::size_t i = 0; i < meshes.size(); ++i)
-    if (scene.objects[i].receiver) receivers.push_back(i);
+    if (scene.objects[i].receiver) all_receivers.push_back(i);
+  std::vector<std::size_t> mine(all_receivers.size());  // indices into all_receivers
+  for (std::size_t r = 0; r < mine.size(); ++r) mine[r] = r;
   if (options.shard) {
     std::vector<double> costs;
-    for (std::size_t r = 0; r < receivers.size(); ++r)
-      costs.push_back(receiver_cost(meshes[receivers[r]], sides[r], lights));
-    std::vector<std::size_t> mine = shard_receivers(costs, *options.shard);
-    std::vector<std::size_t> objects;
-    for (std::size_t r : mine) objects.push_back(receivers[r]);
-    receivers = std::move(objects);
+    for (std::size_t r = 0; r < all_receivers.size(); ++r)
+      costs.push_back(receiver_cost(meshes[all_receivers[r]], sides[r], lights));
+    mine = shard_receivers(costs, *options.shard);
   }
-  std::vector<int> my_sides;  // per receiver of this bake
-  for (std::size_t i : receivers) my_sides.push_back(sides[receiver_rank(scene, i)]);
+  std::vector<std::size_t> receivers;
+  std::vector<int> my_sides;
+  for (std::size_t r : mine) {
+    receivers.push_back(all_receivers[r]);
+    my_sides.push_back(sides[r]);
+  }
   if (estimate.empty()) {
     estimate = bake_memory_estimate(scene, my_sides);
     if (Status fits = check_memory(scene, estimate, memory_budget(scene.bake), advice); !fits)
