@@ -330,6 +330,21 @@ void read_receiver(const json& entry, const std::string& where, const std::strin
     if (!receiver_schema_keys().contains(key)) r.method_entries[key] = value;
 }
 
+// Calls read(element, "name[i].") for each element of `array`, in order; an element that is not
+// an object is an error naming it, and ends the reading (as any error does).
+template <typename Read>
+void read_objects(const json& array, const std::string& name, const std::string& where,
+                  Status& status, Read read) {
+  for (std::size_t i = 0; status && i < array.size(); ++i) {
+    const std::string path = name + "[" + std::to_string(i) + "]";
+    if (!array[i].is_object()) {
+      status = input_error(where + ": " + path + " in the bake's manifest is not an object");
+      return;
+    }
+    read(array[i], path + ".");
+  }
+}
+
 }  // namespace
 
 json manifest_to_json(const Manifest& m) {
@@ -393,58 +408,44 @@ Expected<Manifest> manifest_from_json(const json& json_manifest, const std::stri
   fields.read_optional("convolve", m.convolve);
   read_output(fields, where, m.output, status);
   if (const json* lights = fields.array("lights")) {
-    for (std::size_t i = 0; status && i < lights->size(); ++i) {
-      const std::string path = "lights[" + std::to_string(i) + "]";
-      if (!(*lights)[i].is_object()) {
-        status = input_error(where + ": " + path + " in the bake's manifest is not an object");
-        break;
-      }
+    read_objects(*lights, "lights", where, status, [&](const json& entry, const std::string& path) {
       ManifestLight& light = m.lights.emplace_back();
-      FieldReader light_fields((*lights)[i], where, path + ".", status);
+      FieldReader light_fields(entry, where, path, status);
       light_fields.read("name", light.name);
       light_fields.read("shape", light.shape);
-      if (status && (*lights)[i].contains("shadowmask_channel")) {
-        const json& channel = (*lights)[i]["shadowmask_channel"];
-        int c = -1;
-        for (int k = 0; k < kShadowmaskChannels && !channel.is_null(); ++k)
-          if (channel == shadowmask_channel_name(k)) c = k;
-        if (!channel.is_null() && c < 0) {
-          status = input_error(where + ": " + path +
-                               ".shadowmask_channel in the bake's manifest is not \"R\", \"G\", "
-                               "\"B\", \"A\" or null");
-          break;
-        }
-        light.shadowmask_channel = c;
+      if (!status || !entry.contains("shadowmask_channel")) return;
+      const json& channel = entry["shadowmask_channel"];
+      int c = -1;
+      for (int k = 0; k < kShadowmaskChannels && !channel.is_null(); ++k)
+        if (channel == shadowmask_channel_name(k)) c = k;
+      if (!channel.is_null() && c < 0) {
+        status = input_error(where + ": " + path +
+                             "shadowmask_channel in the bake's manifest is not \"R\", \"G\", "
+                             "\"B\", \"A\" or null");
+        return;
       }
-    }
+      light.shadowmask_channel = c;
+    });
   }
   fields.read_optional("png_white_point", m.png_white_point);
   if (status && json_manifest.contains("atlases")) {
     if (const json* atlases = fields.array("atlases")) {
-      for (std::size_t i = 0; status && i < atlases->size(); ++i) {
-        const std::string path = "atlases[" + std::to_string(i) + "]";
-        if (!(*atlases)[i].is_object()) {
-          status = input_error(where + ": " + path + " in the bake's manifest is not an object");
-          break;
-        }
-        ManifestAtlas& atlas = m.atlases.emplace_back();
-        FieldReader atlas_fields((*atlases)[i], where, path + ".", status);
-        atlas_fields.read("index", atlas.index);
-        atlas_fields.read("size", atlas.size);
-        read_files(atlas_fields, "files", where, atlas.files, status);
-      }
+      read_objects(*atlases, "atlases", where, status,
+                   [&](const json& entry, const std::string& path) {
+                     ManifestAtlas& atlas = m.atlases.emplace_back();
+                     FieldReader atlas_fields(entry, where, path, status);
+                     atlas_fields.read("index", atlas.index);
+                     atlas_fields.read("size", atlas.size);
+                     read_files(atlas_fields, "files", where, atlas.files, status);
+                   });
     }
   }
   fields.read_optional("gltf", m.gltf);
   const json& receivers = json_manifest["receivers"];
-  for (std::size_t i = 0; status && i < receivers.size(); ++i) {
-    const std::string path = "receivers[" + std::to_string(i) + "]";
-    if (!receivers[i].is_object()) {
-      status = input_error(where + ": " + path + " in the bake's manifest is not an object");
-      break;
-    }
-    read_receiver(receivers[i], where, path + ".", m.receivers.emplace_back(), status);
-  }
+  read_objects(receivers, "receivers", where, status,
+               [&](const json& entry, const std::string& path) {
+                 read_receiver(entry, where, path, m.receivers.emplace_back(), status);
+               });
   if (const json* warnings = fields.array("warnings")) {
     for (const auto& w : *warnings) {
       if (!w.is_string()) {

@@ -34,10 +34,7 @@ void put_u64(std::string& out, std::uint64_t v) { put(out, &v, 1); }
 // Reads a binary file's arrays in order, each checked against what is left.
 class Unpacker {
  public:
-  Unpacker(std::string bytes, std::string where)
-      : bytes_(std::move(bytes)), where_(std::move(where)) {}
-  bool ok() const { return ok_; }
-  const std::string& where() const { return where_; }
+  explicit Unpacker(std::string bytes) : bytes_(std::move(bytes)) {}
   std::uint64_t u64() {
     std::uint64_t v = 0;
     take(&v, 1);
@@ -75,7 +72,6 @@ class Unpacker {
 
  private:
   std::string bytes_;
-  std::string where_;
   std::size_t at_ = 0;
   bool ok_ = true;
 };
@@ -205,7 +201,7 @@ Expected<ReceiverBake> read_receiver(const json& meta, const std::filesystem::pa
   if (!bytes) return bytes.error();
   if (data_checksum(*bytes) != meta.value("checksum", ""))
     return damaged(data.string(), "its checksum is not the one " + where + " gives");
-  Unpacker in(std::move(*bytes), data.string());
+  Unpacker in(std::move(*bytes));
   const std::uint32_t magic = in.u32(), version = in.u32(), width = in.u32(), height = in.u32();
   if (magic != kReceiverMagic || version != kVersion || int(width) != side || int(height) != side)
     return damaged(data.string(), "not receiver '" + r.name + "'s data");
@@ -236,7 +232,7 @@ Expected<GltfMesh> read_gltf_mesh(const std::filesystem::path& data, const std::
   if (!bytes) return bytes.error();
   if (data_checksum(*bytes) != checksum)
     return damaged(data.string(), "its checksum is not the one shard.json gives");
-  Unpacker in(std::move(*bytes), data.string());
+  Unpacker in(std::move(*bytes));
   if (in.u32() != kMeshMagic || in.u32() != kVersion)
     return damaged(data.string(), "not a glTF mesh");
   GltfMesh mesh = take_mesh(in);
