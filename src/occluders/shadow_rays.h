@@ -66,10 +66,9 @@ class ShadowRays {
 };
 
 // The reference's samples of `light` at one texel (reference_bake.cpp), into `batch`: `samples`
-// stratified points, from the texel's own random stream (seed, receiver stream, the light's
-// stream (Light::stream, from its name), pixel),
-// one shadow ray each from the lifted shadow origin; points below the texel's horizon or on the
-// light's back add none.
+// stratified points of the part of the light above the texel's horizon (Light::above_horizon),
+// from the texel's own random stream (seed, receiver stream, the light's stream (Light::stream,
+// from its name), pixel), one shadow ray each from the lifted shadow origin.
 inline void add_reference_samples(const Texel& texel, const Light& light, const RayScene& rays,
                                   int samples, std::uint64_t seed, std::uint64_t stream, int width,
                                   ShadowRays& batch, std::vector<Vec2>& strata) {
@@ -82,8 +81,8 @@ inline void add_reference_samples(const Texel& texel, const Light& light, const 
                       std::uint64_t(texel.y) * width + texel.x));
   stratified_samples(samples, rng, strata);
   batch.clear();
-  for (int s = 0; s < samples; ++s)
-    batch.add(origin, light.sample(position, normal, strata[s]), offset);
+  const HorizonPart part = light.above_horizon(position, normal);
+  for (int s = 0; s < samples; ++s) batch.add(origin, part.sample(strata[s]), offset);
 }
 
 // The reference's estimate of `light`'s visibility at one texel, traced from those samples.
@@ -94,15 +93,6 @@ inline bool estimate_visibility(const Texel& texel, const Light& light, const Ra
                                 ShadowRays& batch, std::vector<Vec2>& strata, Vec3* v) {
   add_reference_samples(texel, light, rays, samples, seed, stream, width, batch, strata);
   return batch.visible_fraction(rays, v);
-}
-
-// Whether estimate_visibility would find a contributing point among the same samples, without
-// tracing: false where every sample lies below the texel's horizon or on the light's back.
-inline bool any_sample_contributes(const Texel& texel, const Light& light, const RayScene& rays,
-                                   int samples, std::uint64_t seed, std::uint64_t stream, int width,
-                                   ShadowRays& batch, std::vector<Vec2>& strata) {
-  add_reference_samples(texel, light, rays, samples, seed, stream, width, batch, strata);
-  return batch.size() > 0;
 }
 
 }  // namespace sb

@@ -16,6 +16,7 @@
 #include "scene/lights.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -70,12 +71,12 @@ double disk_form_factor(const Vec3& c, const Vec3& m, const Vec3& right, const V
   // Cut by the horizon: a regular polygon with the disk's area.
   const double sides = kDiskPolygonSides;
   const double r_poly = R * std::sqrt(2.0 * kPi / (sides * std::sin(2.0 * kPi / sides)));
-  std::vector<Vec3> poly(kDiskPolygonSides);
+  std::array<Vec3, kDiskPolygonSides> poly;
   for (int i = 0; i < kDiskPolygonSides; ++i) {
     const double t = 2.0 * kPi * i / sides;
-    poly[i] = c + r_poly * (std::cos(t) * right + std::sin(t) * up);
+    poly[std::size_t(i)] = c + r_poly * (std::cos(t) * right + std::sin(t) * up);
   }
-  return polygon_form_factor(std::move(poly), n);
+  return polygon_form_factor(poly.data(), kDiskPolygonSides, n);
 }
 
 // RGB of pixel (x, y): grey images repeat their one channel; alpha is ignored.
@@ -112,17 +113,35 @@ Vec3 orthogonal(const Vec3& m) {
 }  // namespace
 
 double polygon_form_factor(std::vector<Vec3> polygon, const Vec3& n) {
-  polygon = clip_to_horizon(polygon, n);
-  if (polygon.size() < 3) return 0.0;
+  return polygon_form_factor(polygon.data(), int(polygon.size()), n);
+}
+
+double polygon_form_factor(const Vec3* polygon, int count, const Vec3& n) {
+  // Clipped to the horizon without allocating (this runs per texel and light): a convex polygon
+  // gains at most one corner; a non-convex one at most one per edge.
+  constexpr int kMax = 2 * kDiskPolygonSides + 2;
+  std::array<Vec3, kMax> fixed;
+  std::vector<Vec3> large;  // for an outline of more corners than the disks' own
+  if (2 * count + 2 > kMax) large.resize(std::size_t(2 * count + 2));
+  Vec3* clipped = large.empty() ? fixed.data() : large.data();
+  int m = 0;
+  for (int i = 0; i < count; ++i) {
+    const Vec3& a = polygon[i];
+    const Vec3& b = polygon[(i + 1) % count];
+    const double da = n.dot(a), db = n.dot(b);
+    if (da >= 0) clipped[std::size_t(m++)] = a;
+    if ((da >= 0) != (db >= 0)) clipped[std::size_t(m++)] = a + (b - a) * (da / (da - db));
+  }
+  if (m < 3) return 0.0;
   double sum = 0;
-  for (std::size_t i = 0; i < polygon.size(); ++i) {
-    const Vec3 a = polygon[i].normalized();
-    const Vec3 b = polygon[(i + 1) % polygon.size()].normalized();
+  Vec3 a = clipped[0].normalized();
+  const Vec3 first = a;
+  for (int i = 0; i < m; ++i) {
+    const Vec3 b = i + 1 < m ? clipped[std::size_t(i + 1)].normalized() : first;
     const Vec3 cross = a.cross(b);
     const double len = cross.norm();
-    if (len < 1e-300) continue;
-    const double angle = std::atan2(len, a.dot(b));
-    sum += angle * n.dot(cross / len);
+    if (len >= 1e-300) sum += std::atan2(len, a.dot(b)) * n.dot(cross / len);
+    a = b;
   }
   return std::abs(sum) / (2.0 * kPi);
 }
@@ -217,7 +236,8 @@ double Light::form_factor(const Vec3& y, const Vec3& n) const {
     case LightShape::rectangle: {
       if (c.dot(desc_.normal) >= 0) return 0.0;  // the point is behind the emitting side
       const Vec3 hw = 0.5 * desc_.width * right_, hh = 0.5 * desc_.height * up_;
-      return polygon_form_factor({c - hw - hh, c + hw - hh, c + hw + hh, c - hw + hh}, n);
+      const std::array<Vec3, 4> corners = {c - hw - hh, c + hw - hh, c + hw + hh, c - hw + hh};
+      return polygon_form_factor(corners.data(), 4, n);
     }
     case LightShape::disk:
       return disk_form_factor(c, desc_.normal, right_, up_, desc_.radius, n);
@@ -317,6 +337,114 @@ LightSample Light::sample(const Vec3& y, const Vec3& n, const Vec2& u) const {
       return s;
     }
   }
+  return s;
+}
+
+bool Light::partly_below_horizon(const Vec3& y, const Vec3& n) const {
+  const Vec3 c = desc_.position - y;
+  switch (desc_.shape) {
+    case LightShape::rectangle:
+      return n.dot(c) - 0.5 * desc_.width * std::abs(n.dot(right_)) -
+                 0.5 * desc_.height * std::abs(n.dot(up_)) <
+             0;
+    case LightShape::disk:
+      return n.dot(c) - desc_.radius * (n - n.dot(desc_.normal) * desc_.normal).norm() < 0;
+    case LightShape::sphere:
+      return n.dot(c) - desc_.radius < 0;
+  }
+  return true;
+}
+
+HorizonPart Light::above_horizon(const Vec3& y, const Vec3& n) const {
+  HorizonPart part;
+  part.light_ = this;
+  part.y_ = y;
+  part.n_ = n;
+  if (!partly_below_horizon(y, n)) return part;
+  part.whole_ = false;
+  // The light's outline (relative to y), as its closed form clips it.
+  std::vector<Vec3> outline;
+  const auto polygon = [&](const Vec3& centre, const Vec3& a, const Vec3& b, double radius) {
+    const double sides = kDiskPolygonSides;
+    const double r = radius * std::sqrt(2.0 * kPi / (sides * std::sin(2.0 * kPi / sides)));
+    for (int i = 0; i < kDiskPolygonSides; ++i) {
+      const double t = 2.0 * kPi * i / sides;
+      outline.push_back(centre + r * (std::cos(t) * a + std::sin(t) * b));
+    }
+  };
+  const Vec3 c = desc_.position - y;
+  switch (desc_.shape) {
+    case LightShape::rectangle: {
+      if (c.dot(desc_.normal) >= 0) break;
+      const Vec3 hw = 0.5 * desc_.width * right_, hh = 0.5 * desc_.height * up_;
+      outline = {c - hw - hh, c + hw - hh, c + hw + hh, c - hw + hh};
+      break;
+    }
+    case LightShape::disk:
+      if (c.dot(desc_.normal) >= 0) break;
+      polygon(c, right_, up_, desc_.radius);
+      break;
+    case LightShape::sphere: {
+      const double d = c.norm(), r = desc_.radius;
+      if (d <= r) break;
+      const Vec3 axis = -c / d;
+      const Vec3 a = orthogonal(axis);
+      part.plane_ = (d * d - r * r) / d;
+      polygon(c * (1.0 - r * r / (d * d)), a, axis.cross(a), r * std::sqrt(d * d - r * r) / d);
+      break;
+    }
+  }
+  const std::vector<Vec3> clipped = clip_to_horizon(outline, n);
+  double total = 0;
+  for (std::size_t i = 1; i + 1 < clipped.size(); ++i) {
+    const double a = 0.5 * (clipped[i] - clipped[0]).cross(clipped[i + 1] - clipped[0]).norm();
+    if (!(a > 0)) continue;
+    part.fan_.insert(part.fan_.end(), {clipped[0], clipped[i], clipped[i + 1]});
+    total += a;
+    part.area_.push_back(total);
+  }
+  return part;
+}
+
+LightSample HorizonPart::sample(const Vec2& u) const {
+  if (whole_) return light_->sample(y_, n_, u);
+  LightSample s;
+  if (area_.empty()) return s;
+  // The triangle by area along u.x, then uniform in it.
+  const double at = u.x() * area_.back();
+  const std::size_t k =
+      std::size_t(std::upper_bound(area_.begin(), area_.end(), at) - area_.begin());
+  const std::size_t tri = std::min(k, area_.size() - 1);
+  const double before = tri == 0 ? 0.0 : area_[tri - 1];
+  const double ux = std::clamp((at - before) / (area_[tri] - before), 0.0, 1.0);
+  const double su = std::sqrt(ux);
+  const Vec3& a = fan_[3 * tri];
+  const Vec3& b = fan_[3 * tri + 1];
+  const Vec3& c = fan_[3 * tri + 2];
+  const Vec3 x = (1 - su) * a + su * ((1 - u.y()) * b + u.y() * c);  // relative to y
+  const double dist2 = x.squaredNorm();
+  if (!(dist2 > 0)) return s;
+  const double inv = 1.0 / std::sqrt(dist2);
+  const double cos_receiver = x.dot(n_) * inv;
+  if (!(cos_receiver > 0)) return s;
+  const LightDesc& d = light_->desc();
+  if (d.shape != LightShape::sphere) {
+    s.point = y_ + x;
+    const Vec3 local = s.point - d.position;
+    s.tint = light_->tint(Vec2(local.dot(light_->right()), local.dot(light_->up())));
+    const double cos_light = -x.dot(d.normal) * inv;
+    if (cos_light > 0) s.weight = cos_light * cos_receiver / dist2;
+    return s;
+  }
+  // On the silhouette's plane, uniform by area: a direction's solid angle is plane/ℓ³ per unit
+  // area, and the ray ends where it meets the sphere.
+  const Vec3 dir = x * inv;
+  const Vec3 to_centre = d.position - y_;
+  const double proj = dir.dot(to_centre);
+  const double t = proj - std::sqrt(std::max(
+                              0.0, d.radius * d.radius - (to_centre.squaredNorm() - proj * proj)));
+  s.point = y_ + t * dir;
+  s.weight = cos_receiver * plane_ * inv * inv * inv;
   return s;
 }
 

@@ -22,6 +22,33 @@ struct LightSample {
   Vec3 tint = Vec3::Ones();  // the emission texture at the point (ones for an untextured light)
 };
 
+class Light;
+
+// The part of a light above the horizon of a point (Light::above_horizon), for the reference's
+// samples: where the whole light is above, sample() as it is; where the horizon cuts it, the
+// polygon it leaves above (a disk, or a sphere's silhouette disk, as the regular 128-gon of its
+// area that its closed form clips too), sampled uniformly by area, so that every sample
+// contributes and a light cut by a texel's horizon is estimated from all of them rather than
+// from the few that fall above, or left out when none does.
+class HorizonPart {
+ public:
+  // A point of the part for a stratified u ∈ [0,1)², weighted so that Σ w·v / Σ w over such
+  // samples converges to V = H / H0.
+  LightSample sample(const Vec2& u) const;
+  bool empty() const { return !whole_ && area_.empty(); }
+
+ private:
+  friend class Light;
+  const Light* light_ = nullptr;
+  Vec3 y_, n_;
+  bool whole_ = true;
+  // The clipped polygon as a fan of triangles (3 corners each) and their cumulative areas; for a
+  // sphere, the polygon lies in its silhouette's plane, `plane` metres from y.
+  std::vector<Vec3> fan_;
+  std::vector<double> area_;
+  double plane_ = 0;
+};
+
 class Light {
  public:
   // `texture`, if given, is the emission image mapped over a rectangle or disk (linear RGB or
@@ -78,6 +105,11 @@ class Light {
   // Sphere: uniform in the solid angle of the cone it subtends, weight cosθ_receiver.
   // Either way Σ w·v / Σ w converges to V = H / H0.
   LightSample sample(const Vec3& y, const Vec3& n, const Vec2& u) const;
+  // The part of the light above the horizon of (y, n), for samples that all contribute.
+  HorizonPart above_horizon(const Vec3& y, const Vec3& n) const;
+  // Whether the horizon of (y, n) cuts the light (some of it lies below, a corner of a rectangle,
+  // the rim of a disk, the far side of a sphere).
+  bool partly_below_horizon(const Vec3& y, const Vec3& n) const;
 
  private:
   LightDesc desc_;
@@ -96,5 +128,6 @@ Expected<std::vector<Light>> make_lights(const std::vector<LightDesc>& descs,
 // either winding) seen from a point with unit normal n, after clipping the polygon to the
 // half-space n·x >= 0. Exposed for tests.
 double polygon_form_factor(std::vector<Vec3> polygon, const Vec3& n);
+double polygon_form_factor(const Vec3* polygon, int count, const Vec3& n);
 
 }  // namespace sb

@@ -29,24 +29,6 @@ constexpr float kCertain = 2e-3f;
 // convolution placed up to its ε (1 texel at the default target) off.
 constexpr int kTraceMargin = 2;
 
-// Whether some of the light lies below the horizon of (p, n): a corner of a rectangle, the rim of
-// a disk, the far side of a sphere.
-bool partly_below_horizon(const Light& light, const Vec3& p, const Vec3& n) {
-  const Vec3 c = light.centre() - p;
-  const LightDesc& d = light.desc();
-  switch (light.shape()) {
-    case LightShape::rectangle:
-      return n.dot(c) - 0.5 * d.width * std::abs(n.dot(light.right())) -
-                 0.5 * d.height * std::abs(n.dot(light.up())) <
-             0;
-    case LightShape::disk:
-      return n.dot(c) - d.radius * (n - n.dot(light.normal()) * light.normal()).norm() < 0;
-    case LightShape::sphere:
-      return n.dot(c) - d.radius < 0;
-  }
-  return true;
-}
-
 }  // namespace
 
 Expected<MixedImages> bake_traced_convolution(const TexelSpace& space,
@@ -144,13 +126,6 @@ Expected<MixedImages> bake_traced_convolution(const TexelSpace& space,
         Vec3 v = planned ? Vec3(per_light.visible[l][t].cast<double>()) : Vec3::Ones();
         if (!maybe.empty() && !maybe[l][t]) {
           ++local_clear;
-          // Nothing blocks the light, but where most of it is below the horizon the reference's
-          // samples may all fall there, and it then leaves the light out: so does this method,
-          // so that the two agree to the texel (no ray is traced for it).
-          if (in.rays && partly_below_horizon(lights[l], p, normal) &&
-              !any_sample_contributes(tx, lights[l], *in.rays, in.samples, in.seed, in.stream,
-                                      space.width, batch, strata))
-            continue;
         } else if (in.rays && trace[l][t]) {
           Vec3 traced_v;
           ++local_traced;
