@@ -20,6 +20,8 @@
 // over a small hierarchy.
 #include "occluders/shaft_culling.h"
 
+#include "occluders/blocker_solids.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -61,6 +63,15 @@ struct Tri {
   Vec3 v[3];
   Vec3 normal;  // unit (zero for a degenerate triangle, which blocks nothing)
   Vec3 lo, hi;  // bounding box
+  // Of a closed component whose normals point out (its index in Impl::solids), or -1: from a
+  // point outside the solid's box, a triangle facing away is never the first thing a ray meets.
+  int solid = -1;
+};
+
+// A convex polygon being clipped: a triangle cut by at most 13 planes keeps at most 16 corners.
+struct Clip {
+  std::array<Vec3, ShaftPolygon::kMaxVertices> v;
+  int n = 0;
 };
 
 constexpr int kLeafSize = 4;
@@ -68,16 +79,18 @@ constexpr int kLeafSize = 4;
 constexpr double kPlaneTolerance = 1e-9;
 
 // Sutherland–Hodgman: the part of a convex polygon inside one plane.
-void clip(std::vector<Vec3>& poly, std::vector<Vec3>& scratch, const Plane& plane) {
-  scratch.clear();
-  for (std::size_t i = 0; i < poly.size(); ++i) {
-    const Vec3& a = poly[i];
-    const Vec3& b = poly[(i + 1) % poly.size()];
+void clip(Clip& poly, Clip& scratch, const Plane& plane) {
+  scratch.n = 0;
+  for (int i = 0; i < poly.n; ++i) {
+    const Vec3& a = poly.v[std::size_t(i)];
+    const Vec3& b = poly.v[std::size_t((i + 1) % poly.n)];
     const double da = plane.eval(a), db = plane.eval(b);
-    if (da <= 0) scratch.push_back(a);
-    if ((da < 0 && db > 0) || (da > 0 && db < 0)) scratch.push_back(a + (b - a) * (da / (da - db)));
+    if (scratch.n + 2 > ShaftPolygon::kMaxVertices) break;  // cannot happen for ≤ 13 planes
+    if (da <= 0) scratch.v[std::size_t(scratch.n++)] = a;
+    if ((da < 0 && db > 0) || (da > 0 && db < 0))
+      scratch.v[std::size_t(scratch.n++)] = a + (b - a) * (da / (da - db));
   }
-  poly.swap(scratch);
+  std::swap(poly, scratch);
 }
 
 }  // namespace
@@ -85,6 +98,7 @@ void clip(std::vector<Vec3>& poly, std::vector<Vec3>& scratch, const Plane& plan
 struct ShaftCuller::Impl {
   std::vector<Tri> tris;
   std::vector<Node> nodes;
+  std::vector<BlockerSolid> solids;  // the closed, outward components (blocker_solids.h)
 
   int build(int first, int count) {
     Node node;
@@ -244,10 +258,10 @@ struct ShaftCuller::Impl {
     return false;
   }
 
-  // Whether a triangle may lie in the shaft (planes, base) from `apex`.
-  static bool in_shaft(const Tri& t, const Box& apex, const std::vector<Plane>& planes,
-                       const std::array<Vec3, 8>& base, int corners, const Light& light,
-                       std::vector<Vec3>& poly, std::vector<Vec3>& scratch) {
+  // Whether a triangle may lie in the shaft (planes, base) from `apex`, clipped to it in `poly`.
+  bool in_shaft(const Tri& t, const Box& apex, const std::vector<Plane>& planes,
+                const std::array<Vec3, 8>& base, int corners, const Light& light, Clip& poly,
+                Clip& scratch) const {
     if (t.normal.isZero()) return false;
     // The triangle's box wholly outside one plane: nothing of it is in the shaft.
     for (const Plane& pl : planes) {
@@ -255,39 +269,48 @@ struct ShaftCuller::Impl {
                       pl.n.z() >= 0 ? t.lo.z() : t.hi.z());
       if (pl.eval(near) > 0) return false;
     }
+    if (t.solid >= 0) {
+      // Of a closed solid, seen from outside its box: a ray enters it through a triangle facing
+      // the ray's origin before it meets one facing away, so those facing away add nothing.
+      const Bounds3& solid = solids[std::size_t(t.solid)].bounds;
+      const bool outside =
+          (apex.hi.array() < solid.lo.array()).any() || (apex.lo.array() > solid.hi.array()).any();
+      const Vec3 p = 0.5 * (apex.lo + apex.hi);
+      const double spread = (0.5 * (apex.hi - apex.lo)).dot(t.normal.cwiseAbs());
+      if (outside && t.normal.dot(p - t.v[0]) + spread < 0) return false;
+    }
     if (same_side(t, apex, base, corners, light)) return false;
-    poly.assign(std::begin(t.v), std::end(t.v));
+    poly.n = 3;
+    for (int k = 0; k < 3; ++k) poly.v[std::size_t(k)] = t.v[k];
     for (const Plane& pl : planes) {
       clip(poly, scratch, pl);
-      if (poly.empty()) return false;
+      if (poly.n == 0) return false;
     }
     return true;
   }
 
-  // Whether a blocker may lie in the apex's shaft. With `candidates`, every triangle that may
-  // (by index) is collected instead of stopping at the first; `among`, when given, restricts
-  // the search to those triangles (a tile's candidates, for its texels).
-  bool query(const Box& apex, const Vec3* surface, const Vec3* n, const Light& light,
-             std::vector<std::uint32_t>* candidates = nullptr,
-             const std::vector<std::uint32_t>* among = nullptr) const {
-    if (nodes.empty()) return false;
+  // Visits every triangle that may lie in the apex's shaft, clipped to it: visit(index, polygon)
+  // returns false to stop. `among`, when given, restricts the search to those triangles (a
+  // tile's candidates, for its texels). Returns kNone when the light cannot reach the apex,
+  // kUndecided for a box of which some point it cannot reach (its texels must be tested one by
+  // one, among every triangle), kStopped when a visit stopped it, and kDone otherwise.
+  enum Outcome { kNone, kUndecided, kStopped, kDone };
+  template <class Visit>
+  Outcome visit_shaft(const Box& apex, const Vec3* surface, const Vec3* n, const Light& light,
+                      const std::vector<std::uint32_t>* among, Visit&& visit) const {
     std::vector<Plane> planes;
     std::array<Vec3, 8> base;
     int corners = 0;
-    // A point the light cannot reach has nothing to block; a box of which some point it cannot
-    // reach is not decided here (its texels are tested one by one, among every triangle).
-    if (!shaft(apex, surface, n, light, planes, base, corners)) {
-      if (apex.lo == apex.hi) return false;
-      if (candidates) candidates->push_back(kAll);
-      return true;
-    }
-    std::vector<Vec3> poly, scratch;
+    if (!shaft(apex, surface, n, light, planes, base, corners))
+      return apex.lo == apex.hi ? kNone : kUndecided;
+    if (nodes.empty()) return kDone;
+    Clip poly, scratch;
     if (among) {
       for (std::uint32_t i : *among)
-        if (in_shaft(tris[i], apex, planes, base, corners, light, poly, scratch)) return true;
-      return false;
+        if (in_shaft(tris[i], apex, planes, base, corners, light, poly, scratch) && !visit(i, poly))
+          return kStopped;
+      return kDone;
     }
-    bool found = false;
     int stack[64];
     int top = 0;
     stack[top++] = 0;
@@ -306,25 +329,39 @@ struct ShaftCuller::Impl {
       }
       if (outside) continue;
       if (node.count == 0) {
-        if (top + 2 > 64) {  // deeper than any balanced tree: keep, to be safe
-          if (candidates) candidates->assign(1, kAll);
-          return true;
-        }
+        if (top + 2 > 64) return kUndecided;  // deeper than any balanced tree: keep, to be safe
         stack[top++] = node.left;
         stack[top++] = node.right;
         continue;
       }
-      for (int i = node.first; i < node.first + node.count; ++i) {
-        if (!in_shaft(tris[std::size_t(i)], apex, planes, base, corners, light, poly, scratch))
-          continue;
-        if (!candidates) return true;
-        found = true;
-        candidates->push_back(std::uint32_t(i));
-        if (candidates->size() > kMaxCandidates) {  // a busy tile: search each texel afresh
-          candidates->assign(1, kAll);
-          return true;
-        }
-      }
+      for (int i = node.first; i < node.first + node.count; ++i)
+        if (in_shaft(tris[std::size_t(i)], apex, planes, base, corners, light, poly, scratch) &&
+            !visit(std::uint32_t(i), poly))
+          return kStopped;
+    }
+    return kDone;
+  }
+
+  // Whether a blocker may lie in the apex's shaft. With `candidates`, every triangle that may
+  // (by index) is collected instead of stopping at the first, up to `max` (beyond, or for a box
+  // some point of which the light cannot reach, the list is {kAll}); `among` as in visit_shaft.
+  bool query(const Box& apex, const Vec3* surface, const Vec3* n, const Light& light,
+             std::vector<std::uint32_t>* candidates = nullptr,
+             const std::vector<std::uint32_t>* among = nullptr,
+             std::size_t max = kMaxCandidates) const {
+    bool found = false;
+    const Outcome outcome =
+        visit_shaft(apex, surface, n, light, among, [&](std::uint32_t i, const auto&) {
+          found = true;
+          if (!candidates) return false;
+          candidates->push_back(i);
+          return candidates->size() <= max;
+        });
+    if (outcome == kNone) return false;
+    if (outcome == kUndecided || (outcome == kStopped && candidates)) {
+      // A busy tile, or one the light reaches only in part: search each texel afresh.
+      if (candidates) candidates->assign(1, kAll);
+      return true;
     }
     return found;
   }
@@ -336,6 +373,8 @@ struct ShaftCuller::Impl {
 
 ShaftCuller::ShaftCuller(const std::vector<const Mesh*>& blockers)
     : impl_(std::make_unique<Impl>()) {
+  std::vector<std::array<Vec3, 3>> corners;
+  std::vector<std::size_t> mesh_ends;
   for (const Mesh* m : blockers) {
     for (const auto f : m->mesh.faces()) {
       const Triangle tri = triangle(m->mesh, f);
@@ -347,8 +386,13 @@ ShaftCuller::ShaftCuller(const std::vector<const Mesh*>& blockers)
       t.lo = t.v[0].cwiseMin(t.v[1]).cwiseMin(t.v[2]);
       t.hi = t.v[0].cwiseMax(t.v[1]).cwiseMax(t.v[2]);
       impl_->tris.push_back(t);
+      corners.push_back({t.v[0], t.v[1], t.v[2]});
     }
+    mesh_ends.push_back(impl_->tris.size());
   }
+  BlockerSolids found = find_solids(corners, mesh_ends);
+  for (std::size_t i = 0; i < impl_->tris.size(); ++i) impl_->tris[i].solid = found.solid_of[i];
+  impl_->solids = std::move(found.solids);
   if (!impl_->tris.empty()) {
     impl_->nodes.reserve(2 * impl_->tris.size() / kLeafSize + 2);
     impl_->build(0, int(impl_->tris.size()));
@@ -359,11 +403,96 @@ ShaftCuller::ShaftCuller(ShaftCuller&&) noexcept = default;
 ShaftCuller& ShaftCuller::operator=(ShaftCuller&&) noexcept = default;
 ShaftCuller::~ShaftCuller() = default;
 
-bool ShaftCuller::maybe_blocked(const Vec3& origin, const Vec3& surface, const Vec3& normal,
-                                const Light& light) const {
+bool ShaftCuller::tile_candidates(const Bounds3& origins, const Light& light, std::size_t max,
+                                  std::vector<std::uint32_t>& candidates) const {
+  candidates.clear();
+  Box apex;
+  apex.lo = origins.lo;
+  apex.hi = origins.hi;
+  if (!impl_->query(apex, nullptr, nullptr, light, &candidates, nullptr, max)) return false;
+  if (!candidates.empty() && candidates[0] == Impl::kAll) candidates.clear();
+  return true;
+}
+
+ShaftCuller::Polygons ShaftCuller::shaft_polygons(const Vec3& origin, const Vec3& surface,
+                                                  const Vec3& normal, const Light& light,
+                                                  const std::vector<std::uint32_t>* among,
+                                                  std::size_t max,
+                                                  std::vector<ShaftPolygon>& out) const {
+  out.clear();
   Box apex;
   apex.extend(origin);
-  return impl_->query(apex, &surface, &normal, light);
+  const Impl::Outcome outcome = impl_->visit_shaft(apex, &surface, &normal, light, among,
+                                                   [&](std::uint32_t i, const Clip& poly) {
+                                                     if (out.size() >= max) return false;
+                                                     ShaftPolygon& p = out.emplace_back();
+                                                     p.triangle = i;
+                                                     p.normal = impl_->tris[i].normal;
+                                                     p.count = poly.n;
+                                                     for (int k = 0; k < p.count; ++k)
+                                                       p.v[std::size_t(k)] = poly.v[std::size_t(k)];
+                                                     return true;
+                                                   });
+  switch (outcome) {
+    case Impl::kNone:
+      out.clear();
+      return Polygons::unreached;
+    case Impl::kStopped:
+      return Polygons::too_many;
+    case Impl::kUndecided:  // a hierarchy deeper than its stack: cannot list what it holds
+      return Polygons::too_many;
+    case Impl::kDone:
+      break;
+  }
+  return Polygons::listed;
+}
+
+bool ShaftCuller::maybe_blocked(const Vec3& origin, const Vec3& surface, const Vec3& normal,
+                                const Light& light, const std::vector<std::uint32_t>* among,
+                                const std::vector<std::uint32_t>* except) const {
+  Box apex;
+  apex.extend(origin);
+  if (!except) return impl_->query(apex, &surface, &normal, light, nullptr, among);
+  const Impl::Outcome outcome =
+      impl_->visit_shaft(apex, &surface, &normal, light, among, [&](std::uint32_t i, const Clip&) {
+        // go on past those listed
+        return std::binary_search(except->begin(), except->end(), blocker_key(i));
+      });
+  return outcome == Impl::kStopped || outcome == Impl::kUndecided;
+}
+
+const BlockerSolid* ShaftCuller::solid(std::uint32_t triangle) const {
+  const int s = impl_->tris[triangle].solid;
+  return s < 0 ? nullptr : &impl_->solids[std::size_t(s)];
+}
+
+std::uint32_t ShaftCuller::blocker_key(std::uint32_t triangle) const {
+  const int s = impl_->tris[triangle].solid;
+  return s >= 0 && impl_->solids[std::size_t(s)].convex ? kSolidKey | std::uint32_t(s) : triangle;
+}
+
+Bounds3 ShaftCuller::key_bounds(std::uint32_t key) const {
+  return key & kSolidKey ? solid_of_key(key).bounds : triangle_bounds(key);
+}
+
+const BlockerSolid& ShaftCuller::solid_of_key(std::uint32_t key) const {
+  return impl_->solids[key & ~kSolidKey];
+}
+
+const Vec3* ShaftCuller::triangle_corners(std::uint32_t triangle) const {
+  return impl_->tris[triangle].v;
+}
+
+const Vec3& ShaftCuller::triangle_normal(std::uint32_t triangle) const {
+  return impl_->tris[triangle].normal;
+}
+
+Bounds3 ShaftCuller::triangle_bounds(std::uint32_t triangle) const {
+  const Tri& t = impl_->tris[triangle];
+  Bounds3 b;
+  b.lo = t.lo;
+  b.hi = t.hi;
+  return b;
 }
 
 std::vector<std::uint8_t> ShaftCuller::maybe_blocked(const TexelSpace& space, const Light& light,

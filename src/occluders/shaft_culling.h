@@ -6,6 +6,7 @@
 // under and beside its furniture. The methods spend their work on the rest (shaft_culling.cpp).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -16,6 +17,20 @@
 #include "texels/texel_space.h"
 
 namespace sb {
+
+struct BlockerSolid;
+
+// A blocker triangle clipped to one texel's shaft: a convex polygon in world space, every point
+// of which lies between the texel's ray origin and the light.
+struct ShaftPolygon {
+  // A triangle clipped by at most 10 planes (8 sides of a disk's octagon, the light's plane, the
+  // texel's horizon) has at most 13 corners.
+  static constexpr int kMaxVertices = 16;
+  std::array<Vec3, kMaxVertices> v;
+  int count = 0;
+  std::uint32_t triangle = 0;  // its index in the culler's hierarchy
+  Vec3 normal = Vec3::Zero();  // the triangle's unit normal
+};
 
 class ShaftCuller {
  public:
@@ -32,10 +47,47 @@ class ShaftCuller {
   std::vector<std::uint8_t> maybe_blocked(const TexelSpace& space, const Light& light,
                                           double offset) const;
 
+  // The triangles a tile of texels must look at for `light`: those that may lie in the shaft of
+  // some point of `origins` (the box of the tile's ray origins). False when none may: every texel
+  // of the tile is clear of the light. True with `candidates` listing them, or with `candidates`
+  // empty when more than `max` may, or the light reaches only part of the box: then each texel
+  // searches the whole hierarchy.
+  bool tile_candidates(const Bounds3& origins, const Light& light, std::size_t max,
+                       std::vector<std::uint32_t>& candidates) const;
+
+  // Every blocker triangle in the shaft from the ray origin `origin` (above the surface point
+  // `surface`, shading normal `normal`) to `light`, clipped to that shaft, into `out`; among
+  // `among` when given (a tile's candidates), else the whole hierarchy. The same triangles, in
+  // the same order, for the same inputs.
+  enum class Polygons {
+    listed,     // `out` holds them all (none: the shaft is clear)
+    unreached,  // the light does not reach the point; `out` is empty
+    too_many    // more than `max`: `out` holds the first `max` only
+  };
+  Polygons shaft_polygons(const Vec3& origin, const Vec3& surface, const Vec3& normal,
+                          const Light& light, const std::vector<std::uint32_t>* among,
+                          std::size_t max, std::vector<ShaftPolygon>& out) const;
+
   // The same for one ray origin, above the surface point `surface` whose shading normal is
-  // `normal`: true when a blocker may lie in its shaft.
+  // `normal`: true when a blocker may lie in its shaft; among `among` when given, and counting
+  // only triangles whose blocker_key is not in `except` (sorted) when given.
   bool maybe_blocked(const Vec3& origin, const Vec3& surface, const Vec3& normal,
-                     const Light& light) const;
+                     const Light& light, const std::vector<std::uint32_t>* among = nullptr,
+                     const std::vector<std::uint32_t>* except = nullptr) const;
+
+  // A triangle's bounding box, its three corners and its unit normal (by its index in the
+  // hierarchy, as ShaftPolygon::triangle and tile_candidates give it).
+  Bounds3 triangle_bounds(std::uint32_t triangle) const;
+  const Vec3* triangle_corners(std::uint32_t triangle) const;
+  // The closed solid a triangle belongs to (blocker_solids.h), or null.
+  const BlockerSolid* solid(std::uint32_t triangle) const;
+  // What a triangle counts as where blockers are listed: its convex solid (kSolidKey | its
+  // index) when it belongs to one, else itself; and the bounds of what a key stands for.
+  static constexpr std::uint32_t kSolidKey = 0x80000000u;
+  std::uint32_t blocker_key(std::uint32_t triangle) const;
+  Bounds3 key_bounds(std::uint32_t key) const;
+  const BlockerSolid& solid_of_key(std::uint32_t key) const;
+  const Vec3& triangle_normal(std::uint32_t triangle) const;
 
  private:
   struct Impl;
