@@ -1,4 +1,5 @@
 // The registry of bake methods: a new method adds its entry here (one line) and its own files.
+#include "methods/backprojection/backprojection_method.h"
 #include "methods/baselines.h"
 #include "methods/convolution/traced_convolution.h"
 #include "methods/method.h"
@@ -8,14 +9,9 @@ namespace sb {
 
 const std::vector<MethodEntry>& method_registry() {
   static const std::vector<MethodEntry> entries = {
-      convolution_method(),
-      accumulation_method(),
-      shadow_map_method("pcf"),
-      shadow_map_method("pcss"),
-      shadow_map_method("adaptive-pcf"),
-      erosion_method(),
-      shadow_map_method("chun-oh"),
-      reference_method(),
+      backprojection_method(),  convolution_method(),         accumulation_method(),
+      shadow_map_method("pcf"), shadow_map_method("pcss"),    shadow_map_method("adaptive-pcf"),
+      erosion_method(),         shadow_map_method("chun-oh"), reference_method(),
   };
   return entries;
 }

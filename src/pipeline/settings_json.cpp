@@ -81,7 +81,11 @@ json settings_to_json(const BakeSettings& b, const OutputSettings& o) {
                {"weighting", to_string(b.weighting)},
                {"shadow_map", b.shadow_map},
                {"pcf_radius", b.pcf_radius},
-               {"erosion_factor", to_string(b.erosion_factor)}};
+               {"erosion_factor", to_string(b.erosion_factor)},
+               {"light_rows", b.light_rows},
+               {"max_polygons", b.max_polygons},
+               {"max_cell", b.max_cell},
+               {"interpolation_tolerance", b.interpolation_tolerance}};
   json output = {{"encoding", to_string(o.encoding)},
                  {"per_light", o.per_light},
                  {"shadowmask", o.shadowmask},
@@ -118,6 +122,10 @@ Status settings_from_json(const json& j, const std::string& where, BakeSettings&
   r.read("shadow_map", b.shadow_map);
   r.read("pcf_radius", b.pcf_radius);
   r.read_enum("erosion_factor", b.erosion_factor, {ErosionFactor::pcf, ErosionFactor::distance});
+  r.read("light_rows", b.light_rows);
+  r.read("max_polygons", b.max_polygons);
+  r.read("max_cell", b.max_cell);
+  r.read("interpolation_tolerance", b.interpolation_tolerance);
   Reader out(j["output"], where, status);
   const std::initializer_list<Encoding> encodings = {Encoding::linear_exr, Encoding::half_exr,
                                                      Encoding::png, Encoding::rgbm_png};

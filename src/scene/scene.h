@@ -43,7 +43,7 @@ struct BakeSettings {
   // When > 0, each receiver's lightmap side instead follows from its surface area: this many
   // texels per metre of its surface (texels/lightmap_sizes.h), times its lightmap_scale.
   double texels_per_metre = 0;
-  std::string method = "convolution";
+  std::string method = "backprojection";
   Quantity quantity = Quantity::visibility;
   int samples = 256;       // light samples per texel, for sampling methods
   int margin = 4;          // texels of dilation around UV charts
@@ -67,6 +67,13 @@ struct BakeSettings {
   double trace_error_texels = 1.0;
   BlockerCombine blocker_combine = BlockerCombine::sum;
   ConvolutionWeighting weighting = ConvolutionWeighting::irradiance;
+  // backprojection: rows of cells across each light; the blocker polygons a texel's shaft may
+  // hold before it is traced instead; the adaptive sampling's coarsest cell (texels; 1: every
+  // texel evaluated) and the largest |V| error it lets a cell's centre have before it refines
+  int light_rows = 32;
+  int max_polygons = 256;
+  int max_cell = 8;
+  double interpolation_tolerance = 2e-3;
   // shadow-map baselines (pcf, pcss, adaptive-pcf, chun-oh, erosion): the shadow map's side in
   // pixels, PCF's fixed filter radius in shadow-map pixels, and erosion's shadow factor
   int shadow_map = 2048;

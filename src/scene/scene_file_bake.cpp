@@ -28,7 +28,11 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
                       "weighting",
                       "shadow_map",
                       "pcf_radius",
-                      "erosion_factor"});
+                      "erosion_factor",
+                      "light_rows",
+                      "max_polygons",
+                      "max_cell",
+                      "interpolation_tolerance"});
   BakeSettings bake;
   const int int_max = std::numeric_limits<int>::max();
   if (auto v = r.integer("resolution", 1, 16384)) bake.resolution = static_cast<int>(*v);
@@ -105,6 +109,19 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
     } else {
       bake.light_parts = static_cast<int>(*v);
     }
+  }
+  if (auto v = r.integer("light_rows", 4, 64)) bake.light_rows = static_cast<int>(*v);
+  if (auto v = r.integer("max_polygons", 0, 1 << 20)) bake.max_polygons = static_cast<int>(*v);
+  if (auto v = r.integer("max_cell", 1, 8)) {
+    if (*v != 1 && *v != 2 && *v != 4 && *v != 8) {
+      r.fail_got("max_cell", "1, 2, 4 or 8");
+    } else {
+      bake.max_cell = static_cast<int>(*v);
+    }
+  }
+  if (auto v = r.number("interpolation_tolerance", "a number >= 0 and < 1",
+                        [](double x) { return std::isfinite(x) && x >= 0 && x < 1; })) {
+    bake.interpolation_tolerance = *v;
   }
   if (auto v = r.integer("shadow_map", 64, 16384)) bake.shadow_map = static_cast<int>(*v);
   if (auto v = r.number("pcf_radius", "a number >= 0",

@@ -115,7 +115,7 @@ TEST_F(Cli, BakesFilesAndManifest) {
   EXPECT_EQ(floor.uv_channel, 0);
   EXPECT_EQ(floor.width, 32);
   EXPECT_EQ(floor.height, 32);
-  EXPECT_EQ(floor.method, "convolution");  // the default
+  EXPECT_EQ(floor.method, "backprojection");  // the default
   EXPECT_EQ(floor.quantity, sb::Quantity::visibility);
   EXPECT_EQ(floor.samples, 16);
   EXPECT_GE(floor.seconds, 0.0);

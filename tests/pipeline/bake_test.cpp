@@ -76,7 +76,7 @@ TEST(Bake, ReportsSettingsTheMethodIgnores) {
     if (w.find("does not use it") != std::string::npos) ignored.push_back(w);
   ASSERT_EQ(ignored.size(), 1u);
   EXPECT_NE(ignored[0].find("scene.toml:7: [bake] samples: method 'pcf' does not use it (read by "
-                            "convolution, accumulation, adaptive-pcf, reference)"),
+                            "backprojection, convolution, accumulation, adaptive-pcf, reference)"),
             std::string::npos)
       << ignored[0];
   scene.bake.method = "reference";

@@ -177,7 +177,7 @@ TEST_F(SceneFile, AppliesDefaults) {
   const BakeSettings defaults;
   EXPECT_EQ(scene.bake.resolution, defaults.resolution);
   EXPECT_EQ(scene.bake.resolution, 512);
-  EXPECT_EQ(scene.bake.method, "convolution");
+  EXPECT_EQ(scene.bake.method, "backprojection");
   EXPECT_EQ(scene.bake.quantity, Quantity::visibility);
   EXPECT_EQ(scene.bake.samples, 256);
   EXPECT_EQ(scene.bake.margin, 4);
@@ -247,8 +247,8 @@ TEST_F(SceneFile, RejectsUnknownBakeKey) {
 TEST_F(SceneFile, RejectsUnknownMethod) {
   const std::string text = "[bake]\nmethod = \"foo\"\n" + object_floor + light_panel;
   expect_error(text, "method", "[bake]",
-               "unknown method 'foo' (known: convolution, accumulation, pcf, pcss, "
-               "adaptive-pcf, erosion, chun-oh, reference)");
+               "unknown method 'foo' (known: backprojection, convolution, accumulation, pcf, "
+               "pcss, adaptive-pcf, erosion, chun-oh, reference)");
 }
 
 TEST_F(SceneFile, ReadsAndChecksMethodSettings) {

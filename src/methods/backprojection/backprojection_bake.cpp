@@ -1,0 +1,370 @@
+// The `backprojection` method's bake of one receiver (backprojection_bake.h). Per light, as a
+// list of stages:
+//   1. tile shafts: each tile of 8 × 8 texels tested as one box (ShaftCuller::tile_candidates):
+//      clear, or the triangles its texels must look at;
+//   2. refinement (texel_refinement.cpp): at the samples it asks for, the exact estimate
+//      (LightPairs::evaluate: the texel's own shaft polygons, back-projected onto the light), and
+//      interpolation inside the cells it vouches for;
+//   3. the lights combined by LightMix's rule.
+// A textured light is the exception: the estimator weighs a uniform light, so its pairs the
+// shaft test does not clear take the reference's estimate (traced).
+#include "methods/backprojection/backprojection_bake.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <limits>
+
+#include "methods/backprojection/penumbra_estimator.h"
+#include "occluders/blocker_solids.h"
+#include "occluders/shadow_rays.h"
+
+namespace sb {
+
+namespace {
+
+// Whether p lies outside the box, by more than a hundredth of its size.
+bool outside(const Bounds3& box, const Vec3& p) {
+  const double margin = 0.01 * box.diagonal();
+  return ((box.lo.array() - margin) > p.array()).any() ||
+         ((box.hi.array() + margin) < p.array()).any();
+}
+
+Vec3 ray_origin(const Texel& t, double offset) {
+  return t.shadow_origin.cast<double>() + offset * t.geometric_normal.cast<double>();
+}
+
+// Stage 1: every tile's shaft, as one box of its texels' ray origins.
+TileShafts tile_shafts(const TexelSpace& space, const ShaftCuller& culler, const Light& light,
+                       double offset, std::size_t max) {
+  TileShafts tiles;
+  constexpr int k = TileShafts::kTile;
+  tiles.tiles_x = (space.width + k - 1) / k;
+  tiles.tiles_y = (space.height + k - 1) / k;
+  const std::size_t count = std::size_t(tiles.tiles_x) * std::size_t(tiles.tiles_y);
+  tiles.kind.assign(count, TileShafts::Kind::empty);
+  tiles.candidates.resize(count);
+  std::vector<Bounds3>& boxes = tiles.origins;
+  boxes.assign(count, Bounds3());
+  for (const Texel& t : space.texels)
+    if (light.reaches(t.position.cast<double>(), t.normal.cast<double>()))
+      boxes[tiles.tile_of(t.x, t.y)].extend(ray_origin(t, offset));
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 8), [&](const auto& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      if (boxes[i].empty()) continue;
+      std::vector<std::uint32_t>& list = tiles.candidates[i];
+      if (!culler.tile_candidates(boxes[i], light, max, list)) {
+        tiles.kind[i] = TileShafts::Kind::clear;
+      } else if (list.empty()) {
+        tiles.kind[i] = TileShafts::Kind::all;
+      } else {
+        tiles.kind[i] = TileShafts::Kind::listed;
+        std::sort(list.begin(), list.end());
+      }
+    }
+  });
+  return tiles;
+}
+
+// A listed tile's blockers as its texels' evaluations take them: triangles one by one, and the
+// convex solids its texels all lie outside of whole, each with the edges that may be on its
+// silhouette from some point of the tile (between faces that do not face the same way from all
+// of it) and a lower bound on the tile's distance to it.
+struct TileBlockers {
+  std::vector<BlockerPolygon> polygons;
+  std::vector<BlockerSolidRef> solids;
+  std::vector<std::vector<int>> edges;             // per solid
+  std::vector<std::vector<BlockerPolygon>> faces;  // per solid: its candidate triangles
+};
+
+TileBlockers tile_blockers(const ShaftCuller& culler, const std::vector<std::uint32_t>& candidates,
+                           const Bounds3& origins, double offset) {
+  TileBlockers out;
+  const Vec3 centre = origins.centre(), half = 0.5 * (origins.hi - origins.lo);
+  // Each convex solid among the candidates once, with how far the whole tile lies in front of
+  // its farthest face plane: a lower bound on its distance to the solid, positive where every
+  // texel lies outside it.
+  std::vector<std::uint32_t> keys;
+  std::vector<double> distances;
+  for (std::uint32_t i : candidates) {
+    const std::uint32_t key = culler.blocker_key(i);
+    if (key == i || std::find(keys.begin(), keys.end(), key) != keys.end()) continue;
+    const BlockerSolid& solid = culler.solid_of_key(key);
+    double distance = -std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < solid.faces.size(); ++k) {
+      const Vec3& n = solid.normals[k];
+      distance = std::max(distance, n.dot(centre - solid.corners[std::size_t(solid.faces[k][0])]) -
+                                        half.dot(n.cwiseAbs()));
+    }
+    keys.push_back(key);
+    distances.push_back(distance);
+  }
+  // A solid the tile's texels lie outside of (by more than the rays' offset) is taken whole;
+  // the texels on or in one (its own surface, a floor under a box) take its triangles one by one.
+  std::vector<std::uint8_t> whole(keys.size());
+  for (std::size_t k = 0; k < keys.size(); ++k) whole[k] = distances[k] > offset;
+  for (std::uint32_t i : candidates) {
+    const std::uint32_t key = culler.blocker_key(i);
+    const auto at = std::find(keys.begin(), keys.end(), key);
+    if (key == i || !whole[std::size_t(at - keys.begin())])
+      out.polygons.push_back({culler.triangle_corners(i), 3, culler.triangle_normal(i), i});
+  }
+  for (std::size_t k = 0; k < keys.size(); ++k) {
+    if (!whole[k]) continue;
+    const BlockerSolid& solid = culler.solid_of_key(keys[k]);
+    // Each face's side of the whole tile: 1 facing it from all of it, -1 from none, 0 mixed.
+    std::vector<std::int8_t> side(solid.faces.size());
+    for (std::size_t f = 0; f < solid.faces.size(); ++f) {
+      const Vec3& n = solid.normals[f];
+      const double mid = n.dot(centre - solid.corners[std::size_t(solid.faces[f][0])]);
+      const double spread = half.dot(n.cwiseAbs());
+      side[f] = mid - spread > 0 ? 1 : mid + spread < 0 ? -1 : 0;
+    }
+    std::vector<int> edges;
+    for (std::size_t e = 0; e < solid.edges.size(); ++e) {
+      const std::int8_t a = side[std::size_t(solid.edges[e][2])];
+      const std::int8_t b = side[std::size_t(solid.edges[e][3])];
+      if (a == 0 || b == 0 || a != b) edges.push_back(int(e));
+    }
+    out.edges.push_back(std::move(edges));
+    std::vector<BlockerPolygon> faces;
+    for (std::uint32_t i : candidates)
+      if (culler.blocker_key(i) == keys[k])
+        faces.push_back({culler.triangle_corners(i), 3, culler.triangle_normal(i), i});
+    out.faces.push_back(std::move(faces));
+    out.solids.push_back({&solid, keys[k], nullptr, 0, distances[k]});
+  }
+  for (std::size_t k = 0; k < out.solids.size(); ++k) {
+    out.solids[k].edges = out.edges[k].data();
+    out.solids[k].edge_count = int(out.edges[k].size());
+    out.solids[k].faces = out.faces[k].data();
+    out.solids[k].face_count = int(out.faces[k].size());
+  }
+  return out;
+}
+
+// Stage 2's exact evaluations of one uniform light (texel_refinement.h's PairSource).
+class LightPairs final : public PairSource {
+ public:
+  LightPairs(const TexelSpace& space, const Light& light, const BackprojectionInputs& in,
+             const TileShafts& tiles)
+      : space_(space),
+        light_(light),
+        in_(in),
+        tiles_(tiles),
+        offset_(in.rays->surface_offset()),
+        estimator_(light, in.light_rows, offset_),
+        prepared_(tiles.kind.size()) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tiles.kind.size(), 8), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i)
+        if (tiles.kind[i] == TileShafts::Kind::listed)
+          prepared_[i] = tile_blockers(*in.culler, tiles.candidates[i], tiles.origins[i], offset_);
+    });
+  }
+
+  bool reaches(std::size_t t) const override {
+    const Texel& tx = space_.texels[t];
+    return light_.reaches(tx.position.cast<double>(), tx.normal.cast<double>());
+  }
+
+  void evaluate(std::size_t t, PairSample& out) const override {
+    const Texel& tx = space_.texels[t];
+    const Vec3 p = tx.position.cast<double>(), n = tx.normal.cast<double>();
+    const Vec3 origin = ray_origin(tx, offset_);
+    out = PairSample();
+    const double form_factor = light_.form_factor(p, n);
+    if (!(form_factor > 0)) return;
+    // The blockers: the tile's candidates as they are (the estimator cuts what lies beyond the
+    // light or behind the origin, and ignores what projects outside the light), or, for a tile
+    // without a list, the texel's own shaft's polygons from the whole hierarchy.
+    thread_local std::vector<BlockerPolygon> blockers;
+    thread_local std::vector<ShaftPolygon> polygons;
+    blockers.clear();
+    const std::size_t tile = tiles_.tile_of(tx.x, tx.y);
+    const TileBlockers& prepared = prepared_[tile];
+    PenumbraSample sample;
+    if (tiles_.kind[tile] == TileShafts::Kind::listed) {
+      sample = estimator_.visibility(p, n, origin, prepared.polygons, prepared.solids, form_factor,
+                                     &out.triangles);
+    } else {
+      const ShaftCuller::Polygons listed = in_.culler->shaft_polygons(
+          origin, p, n, light_, nullptr, std::size_t(in_.max_polygons), polygons);
+      if (listed == ShaftCuller::Polygons::too_many) {
+        sample = estimator_.visibility_traced(p, n, origin, *in_.rays, form_factor);
+        if (!sample.contributes) return;  // no part of the light above the horizon after all
+        out.route = TexelRoute::traced;
+        out.visibility = float(sample.visibility);
+        out.nearest = float(sample.nearest_blocker);
+        return;
+      }
+      for (const ShaftPolygon& poly : polygons)
+        blockers.push_back({poly.v.data(), poly.count, poly.normal, poly.triangle});
+      // The union of what samples see is kept by key (a solid's triangles as the solid).
+      for (BlockerPolygon& b : blockers) b.triangle = in_.culler->blocker_key(b.triangle);
+      sample = estimator_.visibility(p, n, origin, blockers, {}, form_factor, &out.triangles);
+    }
+    if (!sample.contributes) {  // no part of the light above the horizon after all: left out
+      out = PairSample();
+      return;
+    }
+    // Nothing hid any of the light: exactly 1, as a clear shaft.
+    out.route = out.triangles.empty() ? TexelRoute::clear : TexelRoute::exact;
+    out.visibility = float(sample.visibility);
+    out.nearest = float(sample.nearest_blocker);
+    out.umbra = sample.umbra;
+  }
+
+  double angular_width(std::size_t t) const override {
+    const Vec3 y = space_.texels[t].position.cast<double>();
+    const Vec3 to = y - light_.centre();
+    const double distance = std::max(to.norm(), 1e-12);
+    const LightDesc& d = light_.desc();
+    switch (light_.shape()) {
+      case LightShape::rectangle:
+        return std::min(d.width, d.height) * std::abs(light_.normal().dot(to)) /
+               (distance * distance);
+      case LightShape::disk:
+        return 2 * d.radius * std::abs(light_.normal().dot(to)) / (distance * distance);
+      case LightShape::sphere:
+        return 2 * d.radius / distance;
+    }
+    return 0;
+  }
+
+  bool sees_unlisted(const std::vector<std::size_t>& texels,
+                     const std::vector<std::uint32_t>& listed) const override {
+    if (texels.empty()) return false;
+    const Texel& first = space_.texels[texels[0]];
+    const std::size_t tile = tiles_.tile_of(first.x, first.y);
+    if (tiles_.kind[tile] != TileShafts::Kind::listed) {  // the whole hierarchy, texel by texel
+      for (std::size_t t : texels) {
+        const Texel& tx = space_.texels[t];
+        if (in_.culler->maybe_blocked(ray_origin(tx, offset_), tx.position.cast<double>(),
+                                      tx.normal.cast<double>(), light_, nullptr, &listed))
+          return true;
+      }
+      return false;
+    }
+    // The tile's candidates no sample listed, but for those of a convex solid the texels lie on
+    // (their own surface: a ray that leaves it above the horizon does not come back to it, and
+    // where it grazes it the samples listed it).
+    Bounds3 origins;
+    for (std::size_t t : texels) origins.extend(ray_origin(space_.texels[t], offset_));
+    thread_local std::vector<std::uint32_t> unlisted;
+    unlisted.clear();
+    for (std::uint32_t i : tiles_.candidates[tile]) {
+      const std::uint32_t key = in_.culler->blocker_key(i);
+      if (std::binary_search(listed.begin(), listed.end(), key)) continue;
+      if (key != i) {
+        const Bounds3 box = in_.culler->key_bounds(key);
+        if (!outside(box, origins.lo) && !outside(box, origins.hi)) continue;
+      }
+      unlisted.push_back(i);
+    }
+    if (unlisted.empty()) return false;
+    for (std::size_t t : texels) {
+      const Texel& tx = space_.texels[t];
+      if (in_.culler->maybe_blocked(ray_origin(tx, offset_), tx.position.cast<double>(),
+                                    tx.normal.cast<double>(), light_, &unlisted))
+        return true;
+    }
+    return false;
+  }
+
+ private:
+  const TexelSpace& space_;
+  const Light& light_;
+  const BackprojectionInputs& in_;
+  const TileShafts& tiles_;
+  double offset_;
+  PenumbraEstimator estimator_;
+  std::vector<TileBlockers> prepared_;  // per listed tile
+};
+
+// A textured light: clear tiles and texels are 1, the rest the reference's own estimate.
+void bake_textured_light(const TexelSpace& space, const BackprojectionInputs& in, std::size_t l,
+                         LightMix& mix, RouteCounts& counts) {
+  const Light& light = (*in.lights)[l];
+  const double offset = in.rays->surface_offset();
+  const TileShafts tiles =
+      tile_shafts(space, *in.culler, light, offset, std::size_t(in.max_polygons));
+  std::atomic<std::int64_t> clear{0}, traced{0}, rays{0};
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, space.texels.size(), 64),
+                    [&](const auto& r) {
+                      ShadowRays batch(in.samples);
+                      std::vector<Vec2> strata;
+                      std::int64_t local_clear = 0, local_traced = 0, local_rays = 0;
+                      for (std::size_t t = r.begin(); t != r.end(); ++t) {
+                        const Texel& tx = space.texels[t];
+                        const Vec3 p = tx.position.cast<double>(), n = tx.normal.cast<double>();
+                        if (!light.reaches(p, n)) continue;
+                        const std::size_t tile = tiles.tile_of(tx.x, tx.y);
+                        if (tiles.kind[tile] == TileShafts::Kind::clear ||
+                            !in.culler->maybe_blocked(ray_origin(tx, offset), p, n, light,
+                                                      tiles.kind[tile] == TileShafts::Kind::listed
+                                                          ? &tiles.candidates[tile]
+                                                          : nullptr)) {
+                          mix.set(l, t, Vec3::Ones());
+                          ++local_clear;
+                          continue;
+                        }
+                        Vec3 v;
+                        if (!estimate_visibility(tx, light, *in.rays, in.samples, in.seed,
+                                                 in.stream, space.width, batch, strata, &v))
+                          continue;
+                        mix.set(l, t, v);
+                        ++local_traced;
+                        local_rays += batch.size();
+                      }
+                      clear += local_clear;
+                      traced += local_traced;
+                      rays += local_rays;
+                    });
+  counts[TexelRoute::clear] += clear;
+  counts[TexelRoute::traced] += traced;
+  counts.rays += rays;
+}
+
+}  // namespace
+
+std::int64_t RouteCounts::reached() const {
+  std::int64_t sum = 0;
+  for (TexelRoute r : kTexelRoutes) sum += (*this)[r];
+  return sum;
+}
+
+LightField backprojection_light(const TexelSpace& space, const BackprojectionInputs& in,
+                                std::size_t l) {
+  const Light& light = (*in.lights)[l];
+  const TileShafts tiles = tile_shafts(space, *in.culler, light, in.rays->surface_offset(),
+                                       std::size_t(in.max_polygons));
+  const LightPairs pairs(space, light, in, tiles);
+  return refine_light(space, TexelGrid(space), tiles, pairs, in.refinement);
+}
+
+MixedImages bake_backprojection(const TexelSpace& space, const BackprojectionInputs& in,
+                                RouteCounts* routes) {
+  const std::vector<Light>& lights = *in.lights;
+  LightMix mix(space, lights, in.quantity, LightMix::Order::light_major, in.keep_per_light);
+  RouteCounts counts;
+  for (std::size_t l = 0; l < lights.size(); ++l) {
+    if (lights[l].textured()) {
+      bake_textured_light(space, in, l, mix, counts);
+      continue;
+    }
+    const LightField field = backprojection_light(space, in, l);
+    for (std::size_t t = 0; t < space.texels.size(); ++t) {
+      const TexelRoute route = field.route[t];
+      if (route == TexelRoute::none) continue;
+      mix.set(l, t, Vec3::Constant(double(field.visibility[t])));
+      ++counts[route];
+      if (route == TexelRoute::traced) counts.rays += in.light_rows * LightRows::kCells / 2;
+    }
+  }
+  if (routes) *routes = counts;
+  return mix.finish();
+}
+
+}  // namespace sb

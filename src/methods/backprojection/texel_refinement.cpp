@@ -1,0 +1,266 @@
+// Adaptive texel sampling (texel_refinement.h).
+//
+// A cell is a square of S × S texels of the lightmap (S = 8, 4, 2) that owns the texels
+// [x0, x0 + S) × [y0, y0 + S); its samples are its four corners (lattice points of spacing S,
+// shared with its neighbours) and its centre. Cells start as the non-clear shaft tiles, level by
+// level: the samples of every cell of a level are evaluated exactly (in parallel, each once),
+// then each cell either interpolates the texels it owns or splits into four. A cell interpolates
+// only when
+//   1. its five samples are all valued (covered, reached by the light);
+//   2. the centre's exact V is within `tolerance` of the mean of the corners, the bilinear
+//      prediction there (a kink — the edge of a penumbra or umbra — crossing the cell moves the
+//      centre by at least half the error it causes anywhere in the cell);
+//   3. its texels lie on one smooth piece of surface: each within `position_texels` of the
+//      bilinear surface through the corners' positions and with a normal within 15° of the
+//      centre's (no UV chart border, crease or horizon change inside);
+//   4. no blocker reaches a texel's shaft that no sample saw (a thin post standing between the
+//      samples would otherwise vanish), and every blocker the samples saw is far enough from the
+//      cell that no penumbra it casts is narrower than `feature_cells` cells: a blocker at
+//      distance d from a texel casts a penumbra at least d·θ wide (θ the light's narrowest
+//      apparent width), so shadows near contact refine down to single texels.
+// Inside a cell that passes, V is interpolated linearly over the four triangles the centre makes
+// with the cell's sides, so it is exact at all five samples and continuous across cells. Texels
+// of a cell that fails at S = 2 are each evaluated. Every decision depends on exact values and
+// the geometry alone, so the result is the same for any thread count and from run to run.
+#include "methods/backprojection/texel_refinement.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+
+namespace sb {
+
+namespace {
+
+enum State : std::uint8_t { kUnknown, kQueued, kValued };
+
+struct Cell {
+  int x0 = 0, y0 = 0, size = 0;
+};
+
+}  // namespace
+
+TexelGrid::TexelGrid(const TexelSpace& space)
+    : width(space.width),
+      height(space.height),
+      at(std::size_t(space.width) * std::size_t(space.height), -1) {
+  for (std::size_t t = 0; t < space.texels.size(); ++t)
+    at[std::size_t(space.texels[t].y) * std::size_t(width) + std::size_t(space.texels[t].x)] =
+        std::int32_t(t);
+}
+
+LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const TileShafts& tiles,
+                        const PairSource& source, const RefinementSettings& settings) {
+  const std::size_t n = space.texels.size();
+  LightField field;
+  field.visibility.assign(n, 1.0f);
+  field.route.assign(n, TexelRoute::none);
+  std::vector<std::uint8_t> reached(n, 0), state(n, kUnknown);
+  std::vector<float> nearest(n, std::numeric_limits<float>::infinity());
+  std::vector<std::vector<std::uint32_t>> triangles(n);
+  std::vector<std::uint32_t> umbra(n, PairSample().umbra);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& r) {
+    for (std::size_t t = r.begin(); t != r.end(); ++t) {
+      reached[t] = source.reaches(t);
+      const Texel& tx = space.texels[t];
+      if (reached[t] && tiles.kind[tiles.tile_of(tx.x, tx.y)] == TileShafts::Kind::clear) {
+        field.route[t] = TexelRoute::clear;
+        state[t] = kValued;
+      }
+    }
+  });
+
+  const auto evaluate_all = [&](const std::vector<std::size_t>& queue) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queue.size(), 8), [&](const auto& r) {
+      PairSample sample;
+      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        const std::size_t t = queue[i];
+        source.evaluate(t, sample);
+        field.visibility[t] = sample.visibility;
+        field.route[t] = sample.route;
+        nearest[t] = sample.nearest;
+        triangles[t] = sample.triangles;
+        umbra[t] = sample.umbra;
+        state[t] = kValued;
+      }
+    });
+  };
+
+  // The first cells: the tiles that are neither clear nor empty.
+  std::vector<Cell> cells;
+  const int top = std::min(settings.max_cell, TileShafts::kTile);
+  for (int ty = 0; ty < tiles.tiles_y; ++ty)
+    for (int tx = 0; tx < tiles.tiles_x; ++tx) {
+      const TileShafts::Kind k = tiles.kind[std::size_t(ty) * std::size_t(tiles.tiles_x) + tx];
+      if (k != TileShafts::Kind::listed && k != TileShafts::Kind::all) continue;
+      for (int y = 0; y < TileShafts::kTile; y += top)
+        for (int x = 0; x < TileShafts::kTile; x += top)
+          cells.push_back({tx * TileShafts::kTile + x, ty * TileShafts::kTile + y, top});
+    }
+
+  // Whether cell c may interpolate the texels it owns (the file's opening comment, 1–4).
+  const auto passes = [&](const Cell& c) {
+    const int s = c.size, h = s / 2;
+    const std::array<std::int32_t, 5> at = {
+        grid.texel(c.x0, c.y0), grid.texel(c.x0 + s, c.y0), grid.texel(c.x0, c.y0 + s),
+        grid.texel(c.x0 + s, c.y0 + s), grid.texel(c.x0 + h, c.y0 + h)};
+    for (std::int32_t t : at)
+      if (t < 0 || !reached[std::size_t(t)] || state[std::size_t(t)] != kValued) return false;
+    const auto v = [&](int k) { return double(field.visibility[std::size_t(at[std::size_t(k)])]); };
+    if (std::abs(v(4) - 0.25 * (v(0) + v(1) + v(2) + v(3))) > settings.tolerance) return false;
+    // One smooth piece of surface.
+    const auto pos = [&](int k) {
+      return Vec3(space.texels[std::size_t(at[std::size_t(k)])].position.cast<double>());
+    };
+    const Vec3 p00 = pos(0), p10 = pos(1), p01 = pos(2), p11 = pos(3);
+    const double texel_size =
+        std::max({(p10 - p00).norm(), (p01 - p00).norm(), (p11 - p10).norm(), (p11 - p01).norm()}) /
+        s;
+    const Vec3f centre_normal = space.texels[std::size_t(at[4])].normal;
+    for (int k = 0; k < 4; ++k)
+      if (space.texels[std::size_t(at[std::size_t(k)])].normal.dot(centre_normal) <
+          settings.normal_cos)
+        return false;
+    Bounds3 box;
+    for (int k = 0; k < 5; ++k) box.extend(pos(k));
+    for (int y = c.y0; y < c.y0 + s; ++y)
+      for (int x = c.x0; x < c.x0 + s; ++x) {
+        const std::int32_t t = grid.texel(x, y);
+        if (t < 0 || !reached[std::size_t(t)] || state[std::size_t(t)] == kValued) continue;
+        const Texel& tx = space.texels[std::size_t(t)];
+        const double u = double(x - c.x0) / s, w = double(y - c.y0) / s;
+        const Vec3 bilinear = (1 - w) * ((1 - u) * p00 + u * p10) + w * ((1 - u) * p01 + u * p11);
+        const Vec3 p = tx.position.cast<double>();
+        if ((p - bilinear).norm() > settings.position_texels * texel_size) return false;
+        if (tx.normal.dot(centre_normal) < settings.normal_cos) return false;
+        box.extend(p);
+      }
+    // In the umbra of one convex solid at all five samples: so is every point between them (a
+    // convex blocker's umbra under a convex light is convex), whatever the distance.
+    bool one_umbra = umbra[std::size_t(at[0])] != PairSample().umbra;
+    for (int k = 1; k < 5; ++k)
+      one_umbra = one_umbra && umbra[std::size_t(at[std::size_t(k)])] == umbra[std::size_t(at[0])];
+    if (one_umbra) return true;
+    // Every blocker the samples saw, far enough away for penumbrae at least feature_cells wide:
+    // a texel of the cell lies at most its diagonal nearer to a blocker than the sample that saw
+    // it (and every blocker of the cell's texels is one a sample saw, below).
+    std::vector<std::uint32_t> seen;
+    double width = std::numeric_limits<double>::infinity();
+    double distance = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 5; ++k) {
+      const std::size_t t = std::size_t(at[std::size_t(k)]);
+      seen.insert(seen.end(), triangles[t].begin(), triangles[t].end());
+      width = std::min(width, source.angular_width(t));
+      distance = std::min(distance, double(nearest[t]));
+    }
+    std::sort(seen.begin(), seen.end());
+    seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
+    if (std::isfinite(distance) &&
+        (distance - box.diagonal()) * width < settings.feature_cells * s * texel_size)
+      return false;
+    // A traced sample lists nothing: the distance bound above is all there is to go on.
+    for (int k = 0; k < 5; ++k)
+      if (field.route[std::size_t(at[std::size_t(k)])] == TexelRoute::traced) return true;
+    thread_local std::vector<std::size_t> inside;
+    inside.clear();
+    for (int y = c.y0; y < c.y0 + s; ++y)
+      for (int x = c.x0; x < c.x0 + s; ++x) {
+        const std::int32_t t = grid.texel(x, y);
+        if (t >= 0 && reached[std::size_t(t)] && state[std::size_t(t)] != kValued)
+          inside.push_back(std::size_t(t));
+      }
+    return !source.sees_unlisted(inside, seen);
+  };
+
+  // Linear over the four triangles the centre makes with the cell's sides.
+  const auto interpolate = [&](const Cell& c) {
+    const int s = c.size, h = s / 2;
+    const double v00 = field.visibility[std::size_t(grid.texel(c.x0, c.y0))];
+    const double v10 = field.visibility[std::size_t(grid.texel(c.x0 + s, c.y0))];
+    const double v01 = field.visibility[std::size_t(grid.texel(c.x0, c.y0 + s))];
+    const double v11 = field.visibility[std::size_t(grid.texel(c.x0 + s, c.y0 + s))];
+    const double vc = field.visibility[std::size_t(grid.texel(c.x0 + h, c.y0 + h))];
+    for (int y = c.y0; y < c.y0 + s; ++y)
+      for (int x = c.x0; x < c.x0 + s; ++x) {
+        const std::int32_t t = grid.texel(x, y);
+        if (t < 0 || !reached[std::size_t(t)] || state[std::size_t(t)] == kValued) continue;
+        const double u = double(x - c.x0) / s, w = double(y - c.y0) / s;
+        // (a, b, corner_a, corner_b): the triangle's coordinates and its two corners, so that
+        // V = 2b·vc + (a − b)·corner_b + (1 − a − b)·corner_a.
+        double a, b, ca, cb;
+        if (w <= u && w <= 1 - u) {
+          a = u, b = w, ca = v00, cb = v10;
+        } else if (u >= w && u >= 1 - w) {
+          a = w, b = 1 - u, ca = v10, cb = v11;
+        } else if (w >= u && w >= 1 - u) {
+          a = 1 - u, b = 1 - w, ca = v11, cb = v01;
+        } else {
+          a = 1 - w, b = u, ca = v01, cb = v00;
+        }
+        const double v = 2 * b * vc + (a - b) * cb + (1 - a - b) * ca;
+        field.visibility[std::size_t(t)] = float(std::clamp(v, 0.0, 1.0));
+        field.route[std::size_t(t)] = TexelRoute::interpolated;
+      }
+  };
+
+  for (int s = top; s >= 2 && !cells.empty(); s /= 2) {
+    // Their samples, each evaluated once; an interpolated one is evaluated now, being a corner.
+    std::vector<std::size_t> queue;
+    for (const Cell& c : cells) {
+      const int h = c.size / 2;
+      const int xs[5] = {c.x0, c.x0 + c.size, c.x0, c.x0 + c.size, c.x0 + h};
+      const int ys[5] = {c.y0, c.y0, c.y0 + c.size, c.y0 + c.size, c.y0 + h};
+      for (int k = 0; k < 5; ++k) {
+        const std::int32_t t = grid.texel(xs[k], ys[k]);
+        if (t < 0 || !reached[std::size_t(t)] || state[std::size_t(t)] == kQueued) continue;
+        if (state[std::size_t(t)] == kValued &&
+            field.route[std::size_t(t)] != TexelRoute::interpolated)
+          continue;
+        state[std::size_t(t)] = kQueued;
+        queue.push_back(std::size_t(t));
+      }
+    }
+    evaluate_all(queue);
+    // Each cell interpolates what it owns, or splits.
+    std::vector<std::uint8_t> pass(cells.size(), 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 4), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) pass[i] = passes(cells[i]);
+    });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 16), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i)
+        if (pass[i]) interpolate(cells[i]);
+    });
+    std::vector<Cell> next;
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      if (pass[i]) continue;
+      const Cell& c = cells[i];
+      if (c.size == 2) continue;  // its texels are evaluated one by one, below
+      const int h = c.size / 2;
+      for (int k = 0; k < 4; ++k) next.push_back({c.x0 + (k & 1) * h, c.y0 + (k >> 1) * h, h});
+    }
+    // Mark what the cells that passed interpolated as valued, for the next level's checks.
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      if (!pass[i]) continue;
+      const Cell& c = cells[i];
+      for (int y = c.y0; y < c.y0 + c.size; ++y)
+        for (int x = c.x0; x < c.x0 + c.size; ++x) {
+          const std::int32_t t = grid.texel(x, y);
+          if (t >= 0 && field.route[std::size_t(t)] == TexelRoute::interpolated)
+            state[std::size_t(t)] = kValued;
+        }
+    }
+    cells = std::move(next);
+  }
+
+  // Every texel the light reaches that no cell valued (cells of 2 that failed; tiles of a
+  // lightmap too small for one cell): evaluated.
+  std::vector<std::size_t> rest;
+  for (std::size_t t = 0; t < n; ++t)
+    if (reached[t] && state[t] != kValued) rest.push_back(t);
+  evaluate_all(rest);
+  return field;
+}
+
+}  // namespace sb

@@ -1,0 +1,96 @@
+// Adaptive texel sampling for one light over one receiver (texel_refinement.cpp): the exact
+// estimate at the corners and centres of cells of 8, 4 and 2 texels, interpolated inside a cell
+// only where its checks pass, and evaluated texel by texel where they fail. Possible only because
+// the estimates have no noise: a sample that disagrees with its neighbours' prediction is a real
+// change in the field, not chance.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "core/geometry.h"
+#include "methods/backprojection/texel_routes.h"
+#include "texels/texel_space.h"
+
+namespace sb {
+
+// Texel indices by pixel, -1 where no texel is covered.
+struct TexelGrid {
+  int width = 0, height = 0;
+  std::vector<std::int32_t> at;
+  explicit TexelGrid(const TexelSpace& space);
+  std::int32_t texel(int x, int y) const {
+    return x < 0 || y < 0 || x >= width || y >= height
+               ? -1
+               : at[std::size_t(y) * width + std::size_t(x)];
+  }
+};
+
+// The shaft test of each tile of kTile × kTile texels (ShaftCuller::tile_candidates) for one
+// light: what the refinement's cells start from.
+struct TileShafts {
+  static constexpr int kTile = 8;
+  enum class Kind : std::uint8_t {
+    empty,   // no covered texel the light reaches
+    clear,   // nothing can block the light from any of its texels
+    listed,  // `candidates` holds every triangle that may
+    all      // too many to list, or the light reaches only part of it: each texel searches all
+  };
+  int tiles_x = 0, tiles_y = 0;
+  std::vector<Kind> kind;
+  std::vector<std::vector<std::uint32_t>> candidates;
+  std::vector<Bounds3> origins;  // the box of each tile's texels' ray origins
+  std::size_t tile_of(int x, int y) const {
+    return std::size_t(y / kTile) * std::size_t(tiles_x) + std::size_t(x / kTile);
+  }
+};
+
+// One exact evaluation of the light at a texel.
+struct PairSample {
+  float visibility = 1;
+  TexelRoute route = TexelRoute::none;  // clear, exact or traced; none: the light does not reach
+  // Lower bound on the distance to the nearest blocker of its shaft, metres (infinity: none).
+  float nearest = std::numeric_limits<float>::infinity();
+  // The blockers (ShaftCuller::blocker_key: triangles, or convex solids) that reach the light
+  // from the texel, sorted, when listed.
+  std::vector<std::uint32_t> triangles;
+  // A convex solid that hides all of the light by itself, or PenumbraSample::kNoUmbra.
+  std::uint32_t umbra = 0xffffffffu;
+};
+
+// What the refinement asks of the light and the blockers (the bake implements it).
+class PairSource {
+ public:
+  virtual ~PairSource() = default;
+  // Whether the light reaches texel t at all (H0 > 0).
+  virtual bool reaches(std::size_t t) const = 0;
+  virtual void evaluate(std::size_t t, PairSample& out) const = 0;
+  // The light's narrowest apparent width seen from texel t, radians: a blocker at distance d
+  // from the texel casts no penumbra on it narrower than this times d.
+  virtual double angular_width(std::size_t t) const = 0;
+  // Whether a blocker not among `listed` (keys, sorted) may lie in the shaft of one of `texels`
+  // (a cell's, all in one tile): one that none of the cell's samples saw.
+  virtual bool sees_unlisted(const std::vector<std::size_t>& texels,
+                             const std::vector<std::uint32_t>& listed) const = 0;
+};
+
+struct RefinementSettings {
+  int max_cell = 8;         // texels between the coarsest samples (a power of two, ≤ kTile)
+  double tolerance = 2e-3;  // largest |V(centre) − V predicted from the corners| interpolated
+  double normal_cos = std::cos(15.0 * 3.14159265358979 / 180.0);  // normals of one smooth piece
+  double position_texels = 1.0;  // a texel's distance from the cell's bilinear surface, in texels
+  double feature_cells = 2.0;    // the narrowest penumbra allowed, in cells
+};
+
+// One light's visibility at every covered texel of a receiver, and the route each came by.
+struct LightField {
+  std::vector<float> visibility;  // per texel; 1 where the route is none
+  std::vector<TexelRoute> route;
+};
+
+LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const TileShafts& tiles,
+                        const PairSource& source, const RefinementSettings& settings);
+
+}  // namespace sb

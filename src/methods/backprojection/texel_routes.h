@@ -1,0 +1,62 @@
+// Where a (light, texel) pair's visibility comes from in the `backprojection` method: the one
+// place that names the routes, what each one computes, and in which order a pair is offered to
+// them (backprojection_bake.cpp follows it; the manifest's method_stats and --explain count
+// pairs by route).
+//
+//   clear         The shaft test (occluders/shaft_culling.cpp) finds no blocker triangle between
+//                 the texel and the light, for its tile of 8 × 8 texels or for the texel alone:
+//                 V = 1 exactly, nothing else is computed.
+//   convolved     The convolution (methods/convolution) where it is exact: a planar receiver
+//                 parallel to the light and blockers in planes parallel to both, so its penumbra
+//                 error bound is zero and its value stands in the penumbra too.
+//   exact         The back-projection estimator (penumbra_estimator.cpp): the blockers of the
+//                 texel's own shaft projected onto the light and integrated with the irradiance
+//                 weight in closed form; no noise.
+//   interpolated  Inside a cell of 2, 4 or 8 texels whose corners and centre are exact, where the
+//                 centre agrees with what the corners predict, the surface is one smooth piece,
+//                 every blocker of its texels' shafts is among the samples' and far enough away
+//                 that no penumbra is narrower than two cells (texel_refinement.cpp).
+//   traced        The same estimate with the blocking of each pair of cells found by a shadow ray
+//                 to a fixed point of the light, where a shaft holds more polygons than listing
+//                 them is worth; or, for a textured light, the reference's own estimate at
+//                 `samples` rays (the estimator weighs a uniform light only).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string_view>
+
+namespace sb {
+
+enum class TexelRoute : std::uint8_t {
+  none,  // the light does not reach the texel (H0 = 0), or the texel is not covered
+  clear,
+  convolved,
+  exact,
+  interpolated,
+  traced
+};
+
+constexpr std::array<TexelRoute, 5> kTexelRoutes = {TexelRoute::clear, TexelRoute::convolved,
+                                                    TexelRoute::exact, TexelRoute::interpolated,
+                                                    TexelRoute::traced};
+
+constexpr std::string_view to_string(TexelRoute r) {
+  switch (r) {
+    case TexelRoute::none:
+      return "none";
+    case TexelRoute::clear:
+      return "clear";
+    case TexelRoute::convolved:
+      return "convolved";
+    case TexelRoute::exact:
+      return "exact";
+    case TexelRoute::interpolated:
+      return "interpolated";
+    case TexelRoute::traced:
+      return "traced";
+  }
+  return "none";
+}
+
+}  // namespace sb

@@ -1,0 +1,210 @@
+// Tests of the back-projection estimator (penumbra_estimator.cpp) against an exact oracle
+// (tests/support/exact_visibility.h: inclusion–exclusion over Lambert's formula) on random
+// triangles between a texel and a rectangle, a disk and a sphere's silhouette, and a check that
+// a wrong estimator (a triangle dropped, a weight off by a percent) fails that comparison.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <random>
+
+#include "methods/backprojection/penumbra_estimator.h"
+#include "support/exact_visibility.h"
+
+namespace sb {
+namespace {
+
+using exact_visibility::PlaneFrame;
+using exact_visibility::Polygon2;
+using Triangle3 = std::array<Vec3, 3>;
+
+LightDesc rectangle_light() {
+  LightDesc d;
+  d.name = "panel";
+  d.shape = LightShape::rectangle;
+  d.position = Vec3(0.1, -0.2, 2.0);
+  d.normal = Vec3(0, 0, -1);
+  d.up = Vec3(0, 1, 0);
+  d.width = 1.2;
+  d.height = 0.6;
+  d.power = 100;
+  return d;
+}
+
+LightDesc disk_light() {
+  LightDesc d = rectangle_light();
+  d.name = "disk";
+  d.shape = LightShape::disk;
+  d.radius = 0.4;
+  return d;
+}
+
+// The light's outline as the oracle takes it (a disk as a 1024-gon of equal area).
+Polygon2 outline(const Light& light) {
+  Polygon2 p;
+  if (light.shape() == LightShape::rectangle) {
+    const double w = 0.5 * light.desc().width, h = 0.5 * light.desc().height;
+    p = {Vec2(-w, -h), Vec2(w, -h), Vec2(w, h), Vec2(-w, h)};
+  } else {
+    const int sides = 1024;
+    const double r =
+        light.desc().radius *
+        std::sqrt(2 * std::numbers::pi / (sides * std::sin(2 * std::numbers::pi / sides)));
+    for (int k = 0; k < sides; ++k) {
+      const double a = 2 * std::numbers::pi * k / sides;
+      p.push_back(Vec2(r * std::cos(a), r * std::sin(a)));
+    }
+  }
+  return p;
+}
+
+struct Case {
+  Vec3 y, n;
+  std::vector<Triangle3> triangles;
+};
+
+// A texel on or near the floor with 1 to 4 triangles between it and the light, most of them
+// across the line from the texel to the light's centre, so that most cases are penumbra.
+Case random_case(std::mt19937& rng, const Light& light) {
+  std::uniform_real_distribution<double> u(0, 1);
+  Case c;
+  c.y = Vec3(-1.5 + 3 * u(rng), -1.5 + 3 * u(rng), 0.2 * u(rng));
+  const double tilt = 0.6 * u(rng), turn = 2 * std::numbers::pi * u(rng);
+  c.n = Vec3(std::sin(tilt) * std::cos(turn), std::sin(tilt) * std::sin(turn), std::cos(tilt));
+  const int count = 1 + int(4 * u(rng));
+  const Vec3 to_light = light.centre() - c.y;
+  for (int k = 0; k < count; ++k) {
+    const double along = 0.1 + 0.8 * u(rng);
+    const Vec3 centre = c.y + along * to_light +
+                        Vec3(0.6 * (u(rng) - 0.5), 0.6 * (u(rng) - 0.5), 0.0) * (0.3 + along);
+    Triangle3 t;
+    const double size = 0.1 + 0.5 * u(rng);
+    for (Vec3& p : t) {
+      p = centre + size * Vec3(u(rng) - 0.5, u(rng) - 0.5, 0.3 * (u(rng) - 0.5));
+      // Strictly between the texel's height and the light's plane.
+      p.z() = std::clamp(p.z(), c.y.z() + 0.05, light.centre().z() - 0.05);
+    }
+    c.triangles.push_back(t);
+  }
+  return c;
+}
+
+// The triangles as the estimator takes them (pointing into `triangles`, which must outlive them).
+std::vector<BlockerPolygon> polygons(const std::vector<Triangle3>& triangles) {
+  std::vector<BlockerPolygon> out;
+  for (std::size_t i = 0; i < triangles.size(); ++i) {
+    const Triangle3& t = triangles[i];
+    out.push_back({t.data(), 3, (t[1] - t[0]).cross(t[2] - t[0]).normalized(), std::uint32_t(i)});
+  }
+  return out;
+}
+
+double oracle(const Light& light, const Case& c) {
+  const PlaneFrame frame{light.centre(), light.right(), light.up(), light.normal()};
+  return exact_visibility::visibility(frame, outline(light), c.y, c.n, c.triangles);
+}
+
+struct Errors {
+  double rmse = 0, max = 0;
+  int penumbra = 0;
+};
+
+// Over `count` random cases whose exact V is strictly between 0.01 and 0.99.
+Errors compare(const Light& light, const PenumbraEstimator& estimator, int count,
+               bool drop_one = false) {
+  std::mt19937 rng(7);
+  Errors e;
+  double sum = 0;
+  while (e.penumbra < count) {
+    Case c = random_case(rng, light);
+    const double truth = oracle(light, c);
+    if (truth <= 0.01 || truth >= 0.99) continue;
+    if (drop_one) c.triangles.pop_back();
+    const PenumbraSample s = estimator.visibility(c.y, c.n, c.y, polygons(c.triangles));
+    EXPECT_TRUE(s.contributes);
+    const double d = s.visibility - truth;
+    sum += d * d;
+    e.max = std::max(e.max, std::abs(d));
+    ++e.penumbra;
+  }
+  e.rmse = std::sqrt(sum / e.penumbra);
+  return e;
+}
+
+TEST(PenumbraEstimator, UnblockedIsOneAndCoveredIsZeroExactly) {
+  const Light light(rectangle_light());
+  const PenumbraEstimator estimator(light, 32, 1e-4);
+  const Vec3 y(0.3, 0.2, 0), n(0, 0, 1);
+  EXPECT_EQ(estimator.visibility(y, n, y, {}).visibility, 1.0);
+  // A large square between the texel and the light hides all of it.
+  const std::vector<Triangle3> cover = {Triangle3{Vec3(-3, -3, 1), Vec3(3, -3, 1), Vec3(3, 3, 1)},
+                                        Triangle3{Vec3(-3, -3, 1), Vec3(3, 3, 1), Vec3(-3, 3, 1)}};
+  EXPECT_EQ(estimator.visibility(y, n, y, polygons(cover)).visibility, 0.0);
+  // Behind the light: nothing arrives.
+  EXPECT_FALSE(estimator.visibility(Vec3(0, 0, 3), n, Vec3(0, 0, 3), {}).contributes);
+}
+
+// The bake's 32 rows, and 64 (rows are the estimator's one approximation that matters: its error
+// falls about threefold per doubling).
+TEST(PenumbraEstimator, MatchesTheExactOracleOnRandomTriangles) {
+  for (const LightDesc& desc : {rectangle_light(), disk_light()})
+    for (const int rows : {32, 64}) {
+      const Light light(desc);
+      const PenumbraEstimator estimator(light, rows, 1e-4);
+      const Errors e = compare(light, estimator, 400);
+      std::printf("%s, %d rows: %d penumbra cases, RMSE %.5f, max %.5f\n", desc.name.c_str(), rows,
+                  e.penumbra, e.rmse, e.max);
+      EXPECT_LT(e.rmse, rows == 32 ? 0.002 : 0.0007) << desc.name << " " << rows;
+      EXPECT_LT(e.max, rows == 32 ? 0.02 : 0.007) << desc.name << " " << rows;
+    }
+}
+
+// At 64 rows, where the estimator's own RMSE is under 0.0007, a triangle dropped from every shaft
+// is far beyond it.
+TEST(PenumbraEstimator, ATriangleDroppedFailsTheComparison) {
+  const Light light(rectangle_light());
+  const PenumbraEstimator estimator(light, 64, 1e-4);
+  const Errors right = compare(light, estimator, 400);
+  const Errors dropped = compare(light, estimator, 400, /*drop_one=*/true);
+  std::printf("right: RMSE %.5f; one triangle dropped: %.5f\n", right.rmse, dropped.rmse);
+  EXPECT_LT(right.rmse, 0.0007);
+  EXPECT_GT(dropped.rmse, 0.01);
+}
+
+// A straight edge across the light, through its centre along the rows' direction, hides half of
+// it from texels below: no row holds a corner of the blocker, so the estimator is exact but for
+// the light's own corners, and a weight off by 1 % on half the light (which shifts V by about
+// 0.01·V·(1 − V)) is 20 times its error.
+TEST(PenumbraEstimator, AWeightOffByAPercentFailsOnAStraightEdge) {
+  const Light light(rectangle_light());
+  PenumbraEstimator estimator(light, 32, 1e-4);
+  const double c = std::cos(kRowAngle), s = std::sin(kRowAngle);
+  const Vec3 s_axis = c * light.right() + s * light.up(),
+             t_axis = -s * light.right() + c * light.up();
+  const auto worst = [&](const PenumbraEstimator& e) {
+    double out = 0;
+    for (const Vec3& y : {Vec3(0.1, -0.2, 0), Vec3(0.6, 0.3, 0.1), Vec3(-0.7, -0.9, 0)}) {
+      const Vec3 n(0, 0, 1), centre = light.centre();
+      // The half s < 0 of the light's plane, lifted half way towards the texel.
+      const Triangle3 shadow = {centre + 5 * t_axis, centre - 5 * t_axis, centre - 5 * s_axis};
+      Triangle3 blocker;
+      for (int k = 0; k < 3; ++k) blocker[std::size_t(k)] = y + 0.5 * (shadow[std::size_t(k)] - y);
+      const Case cs{y, n, {blocker}};
+      const double v = e.visibility(y, n, y, polygons(cs.triangles)).visibility;
+      out = std::max(out, std::abs(v - oracle(light, cs)));
+    }
+    return out;
+  };
+  const double right = worst(estimator);
+  estimator.weight_bias = 1.01;
+  const double biased = worst(estimator);
+  std::printf("straight edge: worst error %.6f; weight off by 1 %% on half the light: %.6f\n",
+              right, biased);
+  EXPECT_LT(right, 1e-4);
+  EXPECT_GT(biased, 20 * right);
+  EXPECT_GT(biased, 1e-3);
+}
+
+}  // namespace
+}  // namespace sb
