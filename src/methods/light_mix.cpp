@@ -72,6 +72,22 @@ void LightMix::set(std::size_t light, std::size_t texel, const Vec3& v) {
 }
 
 MixedImages LightMix::finish() {
+  // One light's visibility is its own V wherever it reaches: H0·V / H0, without the closed form
+  // per texel (a light-major method sets only the pairs the light reaches).
+  if (!set_values_.empty() && lights_.size() == 1 && quantity_ == Quantity::visibility &&
+      !keep_.any()) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, space_.texels.size(), 4096),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        for (std::size_t t = range.begin(); t != range.end(); ++t) {
+                          if (!set_flags_[0][t]) continue;
+                          const Texel& tx = space_.texels[t];
+                          float* px = out_.image.at(tx.x, tx.y);
+                          for (int c = 0; c < 3; ++c)
+                            px[c] = lights_[0].exitance()[c] > 0 ? set_values_[0][t][c] : 0.0f;
+                        }
+                      });
+    return std::move(out_);
+  }
   if (!set_values_.empty()) {
     // Texels are independent: the closed forms of every light at every texel, on all threads.
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, space_.texels.size(), 1024),

@@ -29,6 +29,8 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <tuple>
+#include <unordered_map>
 
 namespace sb {
 
@@ -66,6 +68,8 @@ struct Tri {
   // Of a closed component whose normals point out (its index in Impl::solids), or -1: from a
   // point outside the solid's box, a triangle facing away is never the first thing a ray meets.
   int solid = -1;
+  int mesh = 0;                 // which blocker mesh it is of
+  std::array<int, 3> across{};  // the triangle across edge (v[k], v[k+1]), or -1
 };
 
 // A convex polygon being clipped: a triangle cut by at most 13 planes keeps at most 16 corners.
@@ -99,6 +103,56 @@ struct ShaftCuller::Impl {
   std::vector<Tri> tris;
   std::vector<Node> nodes;
   std::vector<BlockerSolid> solids;  // the closed, outward components (blocker_solids.h)
+  struct MeshInfo {
+    Bounds3 bounds;
+    std::size_t count = 0;
+  };
+  std::vector<MeshInfo> meshes;  // per blocker mesh
+
+  // Each triangle's neighbour across each edge: the triangle of the same mesh that has the edge
+  // the other way round (corners welded on a grid of 1e-6 of the mesh's size, so that UV seams
+  // do not part them); -1 at a border, or where more than two triangles meet.
+  void link_neighbours() {
+    std::vector<Bounds3> boxes;
+    for (const Tri& t : tris) {
+      if (std::size_t(t.mesh) >= boxes.size()) boxes.resize(std::size_t(t.mesh) + 1);
+      for (const Vec3& v : t.v) boxes[std::size_t(t.mesh)].extend(v);
+    }
+    using Corner = std::array<std::int64_t, 3>;
+    const auto corner = [&](const Tri& t, int k) {
+      const Bounds3& box = boxes[std::size_t(t.mesh)];
+      const Vec3 q = (t.v[k] - box.lo) / std::max(box.diagonal() * 1e-6, 1e-300);
+      return Corner{std::llround(q.x()), std::llround(q.y()), std::llround(q.z())};
+    };
+    struct Hash {
+      std::size_t operator()(const std::tuple<int, Corner, Corner>& e) const {
+        std::uint64_t h = std::uint64_t(std::get<0>(e)) * 0x9E3779B97F4A7C15ull;
+        for (const Corner* c : {&std::get<1>(e), &std::get<2>(e)})
+          for (std::int64_t x : *c) h = (h ^ std::uint64_t(x)) * 0xBF58476D1CE4E5B9ull + (h >> 29);
+        return std::size_t(h);
+      }
+    };
+    std::unordered_map<std::tuple<int, Corner, Corner>, int, Hash> directed;
+    std::unordered_map<std::tuple<int, Corner, Corner>, int, Hash> repeated;
+    for (std::size_t i = 0; i < tris.size(); ++i) {
+      tris[i].across = {-1, -1, -1};
+      for (int k = 0; k < 3; ++k) {
+        const auto key =
+            std::make_tuple(tris[i].mesh, corner(tris[i], k), corner(tris[i], (k + 1) % 3));
+        if (!directed.try_emplace(key, int(i)).second) repeated[key] = 1;
+      }
+    }
+    for (std::size_t i = 0; i < tris.size(); ++i)
+      for (int k = 0; k < 3; ++k) {
+        const auto key =
+            std::make_tuple(tris[i].mesh, corner(tris[i], (k + 1) % 3), corner(tris[i], k));
+        const auto it = directed.find(key);
+        const auto own =
+            std::make_tuple(tris[i].mesh, corner(tris[i], k), corner(tris[i], (k + 1) % 3));
+        if (it != directed.end() && !repeated.count(key) && !repeated.count(own))
+          tris[i].across[std::size_t(k)] = it->second;
+      }
+  }
 
   int build(int first, int count) {
     Node node;
@@ -259,9 +313,11 @@ struct ShaftCuller::Impl {
   }
 
   // Whether a triangle may lie in the shaft (planes, base) from `apex`, clipped to it in `poly`.
+  // Unclipped (clip_it false: what a tile lists), it may keep a dense mesh's triangle near the
+  // shaft that misses it.
   bool in_shaft(const Tri& t, const Box& apex, const std::vector<Plane>& planes,
                 const std::array<Vec3, 8>& base, int corners, const Light& light, Clip& poly,
-                Clip& scratch) const {
+                Clip& scratch, bool clip_it = true) const {
     if (t.normal.isZero()) return false;
     // The triangle's box wholly outside one plane: nothing of it is in the shaft.
     for (const Plane& pl : planes) {
@@ -280,6 +336,13 @@ struct ShaftCuller::Impl {
       if (outside && t.normal.dot(p - t.v[0]) + spread < 0) return false;
     }
     if (same_side(t, apex, base, corners, light)) return false;
+    if (!clip_it && meshes[std::size_t(t.mesh)].count > ShaftCuller::kDenseMesh) {
+      // Listed only, of a dense mesh (whose union's outline is taken, not its triangles): kept
+      // unless its corners all lie outside one plane (conservative, and much cheaper).
+      for (const Plane& pl : planes)
+        if (pl.eval(t.v[0]) > 0 && pl.eval(t.v[1]) > 0 && pl.eval(t.v[2]) > 0) return false;
+      return true;
+    }
     poly.n = 3;
     for (int k = 0; k < 3; ++k) poly.v[std::size_t(k)] = t.v[k];
     for (const Plane& pl : planes) {
@@ -297,7 +360,8 @@ struct ShaftCuller::Impl {
   enum Outcome { kNone, kUndecided, kStopped, kDone };
   template <class Visit>
   Outcome visit_shaft(const Box& apex, const Vec3* surface, const Vec3* n, const Light& light,
-                      const std::vector<std::uint32_t>* among, Visit&& visit) const {
+                      const std::vector<std::uint32_t>* among, Visit&& visit,
+                      bool clip_it = true) const {
     std::vector<Plane> planes;
     std::array<Vec3, 8> base;
     int corners = 0;
@@ -307,7 +371,8 @@ struct ShaftCuller::Impl {
     Clip poly, scratch;
     if (among) {
       for (std::uint32_t i : *among)
-        if (in_shaft(tris[i], apex, planes, base, corners, light, poly, scratch) && !visit(i, poly))
+        if (in_shaft(tris[i], apex, planes, base, corners, light, poly, scratch, clip_it) &&
+            !visit(i, poly))
           return kStopped;
       return kDone;
     }
@@ -335,7 +400,8 @@ struct ShaftCuller::Impl {
         continue;
       }
       for (int i = node.first; i < node.first + node.count; ++i)
-        if (in_shaft(tris[std::size_t(i)], apex, planes, base, corners, light, poly, scratch) &&
+        if (in_shaft(tris[std::size_t(i)], apex, planes, base, corners, light, poly, scratch,
+                     clip_it) &&
             !visit(std::uint32_t(i), poly))
           return kStopped;
     }
@@ -350,13 +416,15 @@ struct ShaftCuller::Impl {
              const std::vector<std::uint32_t>* among = nullptr,
              std::size_t max = kMaxCandidates) const {
     bool found = false;
-    const Outcome outcome =
-        visit_shaft(apex, surface, n, light, among, [&](std::uint32_t i, const auto&) {
+    const Outcome outcome = visit_shaft(
+        apex, surface, n, light, among,
+        [&](std::uint32_t i, const auto&) {
           found = true;
           if (!candidates) return false;
           candidates->push_back(i);
           return candidates->size() <= max;
-        });
+        },
+        /*clip_it=*/candidates == nullptr);
     if (outcome == kNone) return false;
     if (outcome == kUndecided || (outcome == kStopped && candidates)) {
       // A busy tile, or one the light reaches only in part: search each texel afresh.
@@ -379,6 +447,7 @@ ShaftCuller::ShaftCuller(const std::vector<const Mesh*>& blockers)
     for (const auto f : m->mesh.faces()) {
       const Triangle tri = triangle(m->mesh, f);
       Tri t;
+      t.mesh = int(mesh_ends.size());
       for (int k = 0; k < 3; ++k) t.v[k] = tri.p[k];
       const Vec3 cross = (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]);
       const double len = cross.norm();
@@ -396,6 +465,13 @@ ShaftCuller::ShaftCuller(const std::vector<const Mesh*>& blockers)
   if (!impl_->tris.empty()) {
     impl_->nodes.reserve(2 * impl_->tris.size() / kLeafSize + 2);
     impl_->build(0, int(impl_->tris.size()));
+  }
+  impl_->link_neighbours();
+  impl_->meshes.resize(mesh_ends.size());
+  for (const Tri& t : impl_->tris) {
+    Impl::MeshInfo& m = impl_->meshes[std::size_t(t.mesh)];
+    for (const Vec3& v : t.v) m.bounds.extend(v);
+    ++m.count;
   }
 }
 
@@ -467,16 +543,28 @@ const BlockerSolid* ShaftCuller::solid(std::uint32_t triangle) const {
 }
 
 std::uint32_t ShaftCuller::blocker_key(std::uint32_t triangle) const {
-  const int s = impl_->tris[triangle].solid;
-  return s >= 0 && impl_->solids[std::size_t(s)].convex ? kSolidKey | std::uint32_t(s) : triangle;
+  const Tri& t = impl_->tris[triangle];
+  if (t.solid >= 0 && impl_->solids[std::size_t(t.solid)].convex)
+    return kSolidKey | std::uint32_t(t.solid);
+  if (impl_->meshes[std::size_t(t.mesh)].count > kDenseMesh)
+    return kMeshKey | std::uint32_t(t.mesh);
+  return triangle;
 }
 
 Bounds3 ShaftCuller::key_bounds(std::uint32_t key) const {
-  return key & kSolidKey ? solid_of_key(key).bounds : triangle_bounds(key);
+  if (key & kSolidKey) return solid_of_key(key).bounds;
+  if (key & kMeshKey) return impl_->meshes[key & ~kMeshKey].bounds;
+  return triangle_bounds(key);
 }
 
 const BlockerSolid& ShaftCuller::solid_of_key(std::uint32_t key) const {
   return impl_->solids[key & ~kSolidKey];
+}
+
+std::size_t ShaftCuller::triangle_count() const { return impl_->tris.size(); }
+
+int ShaftCuller::neighbour(std::uint32_t triangle, int edge) const {
+  return impl_->tris[triangle].across[std::size_t(edge)];
 }
 
 const Vec3* ShaftCuller::triangle_corners(std::uint32_t triangle) const {

@@ -79,11 +79,19 @@ class ShaftCuller {
   // hierarchy, as ShaftPolygon::triangle and tile_candidates give it).
   Bounds3 triangle_bounds(std::uint32_t triangle) const;
   const Vec3* triangle_corners(std::uint32_t triangle) const;
+  // The triangle across a triangle's edge (corners[edge], corners[edge + 1]) that has that edge
+  // the other way round, or -1 (a border, or more than two triangles on it).
+  int neighbour(std::uint32_t triangle, int edge) const;
+  std::size_t triangle_count() const;
   // The closed solid a triangle belongs to (blocker_solids.h), or null.
   const BlockerSolid* solid(std::uint32_t triangle) const;
   // What a triangle counts as where blockers are listed: its convex solid (kSolidKey | its
-  // index) when it belongs to one, else itself; and the bounds of what a key stands for.
+  // index) when it belongs to one; else its mesh (kMeshKey | its index) when that is dense (more
+  // than kDenseMesh triangles, taken through their outline); else itself. And the bounds of
+  // what a key stands for.
   static constexpr std::uint32_t kSolidKey = 0x80000000u;
+  static constexpr std::uint32_t kMeshKey = 0x40000000u;
+  static constexpr std::size_t kDenseMesh = 256;
   std::uint32_t blocker_key(std::uint32_t triangle) const;
   Bounds3 key_bounds(std::uint32_t key) const;
   const BlockerSolid& solid_of_key(std::uint32_t key) const;

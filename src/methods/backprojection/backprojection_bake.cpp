@@ -48,9 +48,18 @@ TileShafts tile_shafts(const TexelSpace& space, const ShaftCuller& culler, const
   tiles.candidates.resize(count);
   std::vector<Bounds3>& boxes = tiles.origins;
   boxes.assign(count, Bounds3());
-  for (const Texel& t : space.texels)
-    if (light.reaches(t.position.cast<double>(), t.normal.cast<double>()))
-      boxes[tiles.tile_of(t.x, t.y)].extend(ray_origin(t, offset));
+  tiles.reached.assign(space.texels.size(), 0);
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, space.texels.size(), 4096), [&](const auto& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+          const Texel& t = space.texels[i];
+          tiles.reached[i] = light.reaches(t.position.cast<double>(), t.normal.cast<double>());
+        }
+      });
+  for (std::size_t i = 0; i < space.texels.size(); ++i)
+    if (tiles.reached[i])
+      boxes[tiles.tile_of(space.texels[i].x, space.texels[i].y)].extend(
+          ray_origin(space.texels[i], offset));
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 8), [&](const auto& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
       if (boxes[i].empty()) continue;
@@ -68,19 +77,27 @@ TileShafts tile_shafts(const TexelSpace& space, const ShaftCuller& culler, const
   return tiles;
 }
 
+// A dense mesh's triangles in a tile's list are taken through their outline from this many on
+// (fewer, each exact interval beats cells).
+constexpr std::size_t kOutlineTriangles = 32;
+// The most candidates a tile lists before its texels search the hierarchy one by one.
+constexpr std::size_t kTileCandidates = 1 << 16;
+
 // A listed tile's blockers as its texels' evaluations take them: triangles one by one, and the
 // convex solids its texels all lie outside of whole, each with the edges that may be on its
 // silhouette from some point of the tile (between faces that do not face the same way from all
 // of it) and a lower bound on the tile's distance to it.
 struct TileBlockers {
   std::vector<BlockerPolygon> polygons;
+  std::vector<BlockerOutline> outlines;
   std::vector<BlockerSolidRef> solids;
   std::vector<std::vector<int>> edges;             // per solid
   std::vector<std::vector<BlockerPolygon>> faces;  // per solid: its candidate triangles
 };
 
-TileBlockers tile_blockers(const ShaftCuller& culler, const std::vector<std::uint32_t>& candidates,
-                           const Bounds3& origins, double offset) {
+TileBlockers tile_blockers(const ShaftCuller& culler, const Light& light,
+                           const std::vector<std::uint32_t>& candidates, const Bounds3& origins,
+                           double offset) {
   TileBlockers out;
   const Vec3 centre = origins.centre(), half = 0.5 * (origins.hi - origins.lo);
   // Each convex solid among the candidates once, with how far the whole tile lies in front of
@@ -90,7 +107,8 @@ TileBlockers tile_blockers(const ShaftCuller& culler, const std::vector<std::uin
   std::vector<double> distances;
   for (std::uint32_t i : candidates) {
     const std::uint32_t key = culler.blocker_key(i);
-    if (key == i || std::find(keys.begin(), keys.end(), key) != keys.end()) continue;
+    if (!(key & ShaftCuller::kSolidKey) || std::find(keys.begin(), keys.end(), key) != keys.end())
+      continue;
     const BlockerSolid& solid = culler.solid_of_key(key);
     double distance = -std::numeric_limits<double>::infinity();
     for (std::size_t k = 0; k < solid.faces.size(); ++k) {
@@ -103,13 +121,37 @@ TileBlockers tile_blockers(const ShaftCuller& culler, const std::vector<std::uin
   }
   // A solid the tile's texels lie outside of (by more than the rays' offset) is taken whole;
   // the texels on or in one (its own surface, a floor under a box) take its triangles one by one.
+  // So do a dense mesh's triangles, but through the outline of their union where the tile holds
+  // enough of them for that to pay.
   std::vector<std::uint8_t> whole(keys.size());
   for (std::size_t k = 0; k < keys.size(); ++k) whole[k] = distances[k] > offset;
+  std::vector<std::uint32_t> dense;  // dense meshes' keys, in order of first candidate
+  std::vector<std::vector<std::uint32_t>> dense_triangles;
   for (std::uint32_t i : candidates) {
     const std::uint32_t key = culler.blocker_key(i);
+    if (key & ShaftCuller::kMeshKey) {
+      auto at = std::find(dense.begin(), dense.end(), key);
+      if (at == dense.end()) {
+        dense.push_back(key);
+        dense_triangles.emplace_back();
+        at = dense.end() - 1;
+      }
+      dense_triangles[std::size_t(at - dense.begin())].push_back(i);
+      continue;
+    }
     const auto at = std::find(keys.begin(), keys.end(), key);
-    if (key == i || !whole[std::size_t(at - keys.begin())])
-      out.polygons.push_back({culler.triangle_corners(i), 3, culler.triangle_normal(i), i});
+    if (at == keys.end() || !whole[std::size_t(at - keys.begin())])
+      out.polygons.push_back({culler.triangle_corners(i), 3, culler.triangle_normal(i), key});
+  }
+  for (std::size_t k = 0; k < dense.size(); ++k) {
+    std::vector<std::uint32_t>& list = dense_triangles[k];
+    if (list.size() < kOutlineTriangles) {
+      for (std::uint32_t i : list)
+        out.polygons.push_back(
+            {culler.triangle_corners(i), 3, culler.triangle_normal(i), dense[k]});
+      continue;
+    }
+    out.outlines.push_back(prepare_outline(culler, light, list, dense[k], origins, offset));
   }
   for (std::size_t k = 0; k < keys.size(); ++k) {
     if (!whole[k]) continue;
@@ -160,13 +202,9 @@ class LightPairs final : public PairSource {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tiles.kind.size(), 8), [&](const auto& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i)
         if (tiles.kind[i] == TileShafts::Kind::listed)
-          prepared_[i] = tile_blockers(*in.culler, tiles.candidates[i], tiles.origins[i], offset_);
+          prepared_[i] =
+              tile_blockers(*in.culler, light, tiles.candidates[i], tiles.origins[i], offset_);
     });
-  }
-
-  bool reaches(std::size_t t) const override {
-    const Texel& tx = space_.texels[t];
-    return light_.reaches(tx.position.cast<double>(), tx.normal.cast<double>());
   }
 
   void evaluate(std::size_t t, PairSample& out) const override {
@@ -186,8 +224,9 @@ class LightPairs final : public PairSource {
     const TileBlockers& prepared = prepared_[tile];
     PenumbraSample sample;
     if (tiles_.kind[tile] == TileShafts::Kind::listed) {
-      sample = estimator_.visibility(p, n, origin, prepared.polygons, prepared.solids, form_factor,
-                                     &out.triangles);
+      sample = estimator_.visibility(
+          p, n, origin, Blockers{&prepared.polygons, &prepared.solids, &prepared.outlines},
+          form_factor, &out.triangles);
     } else {
       const ShaftCuller::Polygons listed = in_.culler->shaft_polygons(
           origin, p, n, light_, nullptr, std::size_t(in_.max_polygons), polygons);
@@ -203,7 +242,8 @@ class LightPairs final : public PairSource {
         blockers.push_back({poly.v.data(), poly.count, poly.normal, poly.triangle});
       // The union of what samples see is kept by key (a solid's triangles as the solid).
       for (BlockerPolygon& b : blockers) b.triangle = in_.culler->blocker_key(b.triangle);
-      sample = estimator_.visibility(p, n, origin, blockers, {}, form_factor, &out.triangles);
+      sample = estimator_.visibility(p, n, origin, Blockers{&blockers, nullptr, nullptr},
+                                     form_factor, &out.triangles);
     }
     if (!sample.contributes) {  // no part of the light above the horizon after all: left out
       out = PairSample();
@@ -288,8 +328,7 @@ void bake_textured_light(const TexelSpace& space, const BackprojectionInputs& in
                          LightMix& mix, RouteCounts& counts) {
   const Light& light = (*in.lights)[l];
   const double offset = in.rays->surface_offset();
-  const TileShafts tiles =
-      tile_shafts(space, *in.culler, light, offset, std::size_t(in.max_polygons));
+  const TileShafts tiles = tile_shafts(space, *in.culler, light, offset, kTileCandidates);
   std::atomic<std::int64_t> clear{0}, traced{0}, rays{0};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, space.texels.size(), 64),
                     [&](const auto& r) {
@@ -338,8 +377,8 @@ std::int64_t RouteCounts::reached() const {
 LightField backprojection_light(const TexelSpace& space, const BackprojectionInputs& in,
                                 std::size_t l) {
   const Light& light = (*in.lights)[l];
-  const TileShafts tiles = tile_shafts(space, *in.culler, light, in.rays->surface_offset(),
-                                       std::size_t(in.max_polygons));
+  const TileShafts tiles =
+      tile_shafts(space, *in.culler, light, in.rays->surface_offset(), kTileCandidates);
   const LightPairs pairs(space, light, in, tiles);
   return refine_light(space, TexelGrid(space), tiles, pairs, in.refinement);
 }

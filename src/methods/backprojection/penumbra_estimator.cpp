@@ -44,6 +44,8 @@
 // same form with h the plane's distance.
 #include "methods/backprojection/penumbra_estimator.h"
 
+#include "methods/backprojection/light_rows.h"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -57,26 +59,37 @@ namespace sb {
 
 namespace {
 
-constexpr int kCells = LightRows::kCells;
-constexpr std::uint64_t kAllCells = ~std::uint64_t(0);
-// Intervals a row keeps exactly before it falls back to cells: the rows of a shaft with a few
-// polygons are exact, those of a dense mesh's many are cells.
-constexpr int kExactIntervals = 6;
-constexpr double kInfinity = std::numeric_limits<double>::infinity();
-// A shaft polygon cut by up to 8 more lines, and by the light's plane.
-constexpr int kPieceVertices = 32;
-
-Vec3 any_orthogonal(const Vec3& m) {
-  const Vec3 a = std::abs(m.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
-  return (a - a.dot(m) * m).normalized();
+// The closed-form integral of the weight along one row (the file's opening comment).
+// atan to within 2e-8 (Abramowitz & Stegun 4.4.49 on [0, 1], and π/2 − atan(1/x) beyond): the
+// rows' integrals take hundreds per texel, and std::atan is four times slower.
+double fast_atan(double x) {
+  const double a = std::abs(x);
+  const bool beyond = a > 1;
+  const double z = beyond ? 1 / a : a, z2 = z * z;
+  double p = 0.0028662257;
+  p = p * z2 - 0.0161657367;
+  p = p * z2 + 0.0429096138;
+  p = p * z2 - 0.0752896400;
+  p = p * z2 + 0.1065626393;
+  p = p * z2 - 0.1420889944;
+  p = p * z2 + 0.1999355085;
+  p = p * z2 - 0.3333314528;
+  p = p * z2 + 1;
+  const double r = beyond ? std::numbers::pi / 2 - p * z : p * z;
+  return std::copysign(r, x);
 }
 
-// The closed-form integral of the weight along one row (the file's opening comment).
 struct RowWeight {
   double a = 0, b = 0, g = 1, sg = 1;
+  double half_over_g = 0.5, half_over_g_sg = 0.5, over_sg = 1;  // 1/(2γ), 1/(2γ√γ), 1/√γ
+  void set(double a_, double b_, double gamma) {
+    a = a_, b = b_, g = gamma, sg = std::sqrt(gamma);
+    half_over_g = 0.5 / g, half_over_g_sg = half_over_g / sg, over_sg = 1 / sg;
+  }
   double primitive(double tau) const {
-    const double q = g + tau * tau;
-    return a * (tau / (2 * g * q) + std::atan(tau / sg) / (2 * g * sg)) - b / (2 * q);
+    const double over_q = 1 / (g + tau * tau);
+    return a * (tau * half_over_g * over_q + fast_atan(tau * over_sg) * half_over_g_sg) -
+           0.5 * b * over_q;
   }
   // ∫ over τ ∈ [t0, t1] where the light is above the horizon (a + b·τ > 0).
   double integral(double t0, double t1) const {
@@ -107,25 +120,6 @@ std::pair<double, double> polygon_chord(const std::array<Vec2, 4>& p, double t) 
 }
 
 }  // namespace
-
-struct PenumbraEstimator::Frame {
-  Vec3 centre;  // of the light, or of a sphere's silhouette disk
-  Vec3 normal;  // of its plane, towards the texel
-  Vec3 s_axis, t_axis;
-  double radius = 0;       // a disk's or a sphere's silhouette's (0 for a rectangle)
-  double clip_height = 0;  // blocker points nearer the plane than this do not block
-};
-
-// What each row's centre line has blocked: up to kExactIntervals intervals kept exactly, beyond
-// that the cells whose centres they cover.
-struct PenumbraEstimator::Blocked {
-  struct Row {
-    int count = 0;  // intervals given; above kExactIntervals, `cells` holds them all
-    std::array<std::pair<double, double>, kExactIntervals> intervals;
-    std::uint64_t cells = 0;
-  };
-  std::array<Row, LightRows::kMaxRows> rows;
-};
 
 PenumbraEstimator::PenumbraEstimator(const Light& light, int rows, double light_offset)
     : light_(&light),
@@ -196,7 +190,7 @@ double PenumbraEstimator::chord_half(double t, double radius) const {
   return std::sqrt(std::max(0.0, radius * radius - t * t));
 }
 
-bool PenumbraEstimator::frame(const Vec3& origin, Frame& f) const {
+bool PenumbraEstimator::frame(const Vec3& origin, LightFrame& f) const {
   const Light& light = *light_;
   if (light.shape() != LightShape::sphere) {
     f.centre = light.centre();
@@ -224,7 +218,7 @@ bool PenumbraEstimator::frame(const Vec3& origin, Frame& f) const {
   return true;
 }
 
-const LightRows& PenumbraEstimator::rows_for(const Frame& f, const Vec3& position,
+const LightRows& PenumbraEstimator::rows_for(const LightFrame& f, const Vec3& position,
                                              const Vec3& normal, LightRows& scratch) const {
   // The horizon in the light's plane: visible where α·s + β·t + γ > 0.
   const double alpha = normal.dot(f.s_axis), beta = normal.dot(f.t_axis);
@@ -301,330 +295,9 @@ const LightRows& PenumbraEstimator::rows_for(const Frame& f, const Vec3& positio
   return scratch;
 }
 
-void PenumbraEstimator::rasterise(const Frame& f, const LightRows& rows, const Vec3& origin,
-                                  const Vec3& position, const Vec3& normal,
-                                  const std::vector<BlockerPolygon>& polygons,
-                                  const std::vector<BlockerSolidRef>& solids, Blocked& blocked,
-                                  PenumbraSample& out, std::vector<std::uint32_t>* blocking) const {
-  double& nearest = out.nearest_blocker;
-  const int n = rows.count;
-  const double h_origin = f.normal.dot(origin - f.centre);
-  if (!(h_origin > f.clip_height) || n == 0) return;  // the origin is on or behind the light
-  const double s_origin = f.s_axis.dot(origin - f.centre);
-  const double t_origin = f.t_axis.dot(origin - f.centre);
-  const double h_top = h_origin * (1 - 1e-9);  // blockers above this are behind the origin
-  // The texel's horizon in the light's plane: above it where x·s + y·t + z > 0.
-  const Vec3 horizon(normal.dot(f.s_axis), normal.dot(f.t_axis), normal.dot(f.centre - position));
-  const auto is_above = [&](const Vec2& p) {
-    return horizon.x() * p.x() + horizon.y() * p.y() + horizon.z() > 0;
-  };
-  double extent_lo = kInfinity, extent_hi = -kInfinity;  // the rows' s-range
-  for (int r = 0; r < n; ++r) {
-    extent_lo = std::min(extent_lo, rows.enter[std::size_t(r)]);
-    extent_hi = std::max(extent_hi, rows.leave[std::size_t(r)]);
-  }
-  const double t_first = rows.first - 0.5 * rows.pitch;
-  const double t_last = rows.first + (n - 0.5) * rows.pitch;
-  const auto project = [&](const Vec3& point) {
-    const Vec3 d = point - origin;
-    const double scale = h_origin / std::max(-f.normal.dot(d), 1e-12 * h_origin);
-    return Vec2(s_origin + scale * f.s_axis.dot(d), t_origin + scale * f.t_axis.dot(d));
-  };
-  // The cells of row r whose centres [a, b] covers.
-  const auto cells = [&](int r, double a, double b) -> std::uint64_t {
-    const double enter = rows.enter[std::size_t(r)];
-    const double width = rows.leave[std::size_t(r)] - enter;
-    if (!(width > 0)) return 0;
-    // The centre of cell c lies at enter + (c + 1/2)·width/64.
-    const double c0 = std::ceil((a - enter) / width * kCells - 0.5);
-    const double c1 = std::floor((b - enter) / width * kCells - 0.5);
-    if (c1 < 0 || c0 > kCells - 1 || c0 > c1) return 0;
-    const int from = int(std::max(0.0, c0)), to = int(std::min(double(kCells - 1), c1));
-    const int count = to - from + 1;
-    return (count == kCells ? kAllCells : ((std::uint64_t(1) << count) - 1)) << from;
-  };
-
-  // One convex region of the light's plane, given by its outline's edges: the rows its t-range
-  // holds (begin), each edge's crossing of them (edge), then each row's chord within the light
-  // kept (commit), which says whether any of it lies above the horizon.
-  std::array<double, LightRows::kMaxRows> lo, hi;
-  int r0 = 0, r1 = -1;
-  const auto begin = [&](double t_lo, double t_hi) {
-    const double r_from = std::ceil((t_lo - rows.first) / rows.pitch);
-    const double r_to = std::floor((t_hi - rows.first) / rows.pitch);
-    r0 = 0, r1 = -1;
-    if (!(r_to >= 0 && r_from <= n - 1 && r_from <= r_to)) return;  // (and not NaN)
-    r0 = int(std::max(0.0, r_from)), r1 = int(std::min(double(n - 1), r_to));
-    for (int r = r0; r <= r1; ++r) {
-      lo[std::size_t(r)] = kInfinity;
-      hi[std::size_t(r)] = -kInfinity;
-    }
-  };
-  const auto edge = [&](Vec2 p, Vec2 q) {
-    if (p.y() == q.y() || r1 < r0) return;
-    if (p.y() > q.y()) std::swap(p, q);
-    // Clamped in double: an edge far beyond the rows would overflow an int.
-    const int a =
-        int(std::clamp(std::ceil((p.y() - rows.first) / rows.pitch), double(r0), double(r1 + 1)));
-    const int b =
-        int(std::clamp(std::floor((q.y() - rows.first) / rows.pitch), double(r0 - 1), double(r1)));
-    const double slope = (q.x() - p.x()) / (q.y() - p.y());
-    for (int r = a; r <= b; ++r) {
-      const double x = p.x() + (rows.first + r * rows.pitch - p.y()) * slope;
-      lo[std::size_t(r)] = std::min(lo[std::size_t(r)], x);
-      hi[std::size_t(r)] = std::max(hi[std::size_t(r)], x);
-    }
-  };
-  bool covers = false;  // the last region committed covered every row from end to end
-  const auto commit = [&] {
-    bool reaches = false;
-    covers = r0 == 0 && r1 == n - 1;
-    for (int r = r0; r <= r1; ++r) {
-      covers = covers && lo[std::size_t(r)] <= rows.enter[std::size_t(r)] &&
-               hi[std::size_t(r)] >= rows.leave[std::size_t(r)];
-      const double a = std::max(lo[std::size_t(r)], rows.enter[std::size_t(r)]);
-      const double b = std::min(hi[std::size_t(r)], rows.leave[std::size_t(r)]);
-      if (!(a < b)) continue;
-      const double t = rows.first + r * rows.pitch;
-      reaches = reaches || is_above(Vec2(a, t)) || is_above(Vec2(b, t));
-      Blocked::Row& row = blocked.rows[std::size_t(r)];
-      if (row.count < kExactIntervals) {
-        row.intervals[std::size_t(row.count++)] = {a, b};
-        continue;
-      }
-      if (row.count == kExactIntervals) {  // too many to keep exactly: to cells from here on
-        for (const auto& [x, y] : row.intervals) row.cells |= cells(r, x, y);
-        ++row.count;
-      }
-      row.cells |= cells(r, a, b);
-    }
-    return reaches;
-  };
-  // Whether a projected point lies in the light's box above the horizon: a sliver between two
-  // rows' centre lines reaches the light by that.
-  const auto in_light = [&](const Vec2& p) {
-    return p.y() >= t_first && p.y() <= t_last && p.x() >= extent_lo && p.x() <= extent_hi &&
-           is_above(p);
-  };
-
-  // A convex polygon: its part between the light's plane (clip_height above it) and the
-  // origin's height, projected from the origin. Whether it reaches the light above the horizon
-  // (what lies in the texel's shaft, and may hide some of the light).
-  std::array<Vec2, kPieceVertices> projected;
-  std::array<Vec3, kPieceVertices> clipped, below;
-  const auto add = [&](const Vec3* v, int count) {
-    // Heights over the light's plane: a polygon wholly within the slab is taken as it is.
-    std::array<double, kPieceVertices> height;
-    bool inside = true, beyond = true, behind = true;
-    for (int k = 0; k < count; ++k) {
-      height[std::size_t(k)] = f.normal.dot(v[k] - f.centre);
-      inside = inside && height[std::size_t(k)] >= f.clip_height && height[std::size_t(k)] <= h_top;
-      beyond = beyond && height[std::size_t(k)] < f.clip_height;
-      behind = behind && height[std::size_t(k)] > h_top;
-    }
-    if (beyond || behind) return false;
-    const Vec3* poly = v;
-    int m = count;
-    if (!inside) {
-      int k0 = 0;
-      for (int k = 0; k < count; ++k) {  // at least clip_height above the light's plane
-        const double da = height[std::size_t(k)] - f.clip_height;
-        const double db = height[std::size_t((k + 1) % count)] - f.clip_height;
-        if (k0 + 2 > kPieceVertices) return false;  // not convex: cannot happen
-        if (da >= 0) below[std::size_t(k0++)] = v[k];
-        if ((da < 0 && db > 0) || (da > 0 && db < 0))
-          below[std::size_t(k0++)] = v[k] + (v[(k + 1) % count] - v[k]) * (da / (da - db));
-      }
-      m = 0;
-      for (int k = 0; k < k0; ++k) {  // below the origin's height
-        const Vec3& a = below[std::size_t(k)];
-        const Vec3& b = below[std::size_t((k + 1) % k0)];
-        const double da = h_top - f.normal.dot(a - f.centre);
-        const double db = h_top - f.normal.dot(b - f.centre);
-        if (m + 2 > kPieceVertices) return false;
-        if (da >= 0) clipped[std::size_t(m++)] = a;
-        if ((da < 0 && db > 0) || (da > 0 && db < 0))
-          clipped[std::size_t(m++)] = a + (b - a) * (da / (da - db));
-      }
-      poly = clipped.data();
-    }
-    if (m < 3) return false;
-    double t_lo = kInfinity, t_hi = -kInfinity, s_lo = kInfinity, s_hi = -kInfinity;
-    bool above = false, corner_in_light = false;
-    for (int k = 0; k < m; ++k) {
-      const Vec2 p = project(poly[k]);
-      projected[std::size_t(k)] = p;
-      t_lo = std::min(t_lo, p.y());
-      t_hi = std::max(t_hi, p.y());
-      s_lo = std::min(s_lo, p.x());
-      s_hi = std::max(s_hi, p.x());
-      above = above || is_above(p);
-      corner_in_light = corner_in_light || in_light(p);
-    }
-    // Wholly beside the light, or below the horizon: it hides nothing that arrives.
-    if (!above || t_hi < t_first || t_lo > t_last || s_hi < extent_lo || s_lo > extent_hi)
-      return false;
-    begin(t_lo, t_hi);
-    for (int k = 0; k < m; ++k)
-      edge(projected[std::size_t(k)], projected[std::size_t((k + 1) % m)]);
-    return commit() || corner_in_light;
-  };
-
-  // A polygon of a blocker. A shadow ray ignores what it meets within the surface offset of its
-  // origin (RayScene): the polygon's points within that distance (a disk of its plane, taken as
-  // the octagon around it) block nothing. What is left is convex in pieces: the part beyond
-  // each side of the octagon and within the sides before it.
-  std::array<Vec3, kPieceVertices> piece, scratch;
-  const auto add_blocker = [&](const Vec3* v, int count, const Vec3& plane_normal, double gap) {
-    const double plane = plane_normal.dot(origin - v[0]);
-    const double radius2 = light_offset_ * light_offset_ - plane * plane;
-    if (gap >= light_offset_ || !(radius2 > 0)) return add(v, count);
-    bool reaches = false;
-    const Vec3 foot = origin - plane * plane_normal;
-    const Vec3 u = any_orthogonal(plane_normal), w = plane_normal.cross(u);
-    const double reach = std::sqrt(radius2);  // the octagon's inradius: the disk's radius
-    for (int side = 0; side < 8; ++side) {
-      int m = count;
-      std::copy_n(v, m, piece.begin());
-      // Keep where (x − foot)·dir ≥ reach for this side, and ≤ reach for the sides before it.
-      const auto keep = [&](const Vec3& dir, bool outside) {
-        int out = 0;
-        for (int k = 0; k < m; ++k) {
-          const Vec3& a = piece[std::size_t(k)];
-          const Vec3& b = piece[std::size_t((k + 1) % m)];
-          const double da = (outside ? 1 : -1) * (dir.dot(a - foot) - reach);
-          const double db = (outside ? 1 : -1) * (dir.dot(b - foot) - reach);
-          if (out + 2 > kPieceVertices) break;
-          if (da >= 0) scratch[std::size_t(out++)] = a;
-          if ((da < 0 && db > 0) || (da > 0 && db < 0))
-            scratch[std::size_t(out++)] = a + (b - a) * (da / (da - db));
-        }
-        m = out;
-        std::copy_n(scratch.begin(), m, piece.begin());
-      };
-      for (int k = 0; k <= side && m >= 3; ++k) {
-        const double angle = k * std::numbers::pi / 4;
-        keep(std::cos(angle) * u + std::sin(angle) * w, k == side);
-      }
-      if (m >= 3) reaches = add(piece.data(), m) || reaches;
-    }
-    return reaches;
-  };
-  const auto gap_to = [&](const Vec3& lo_corner, const Vec3& hi_corner) {
-    return (lo_corner - origin).cwiseMax(origin - hi_corner).cwiseMax(Vec3::Zero()).norm();
-  };
-  const auto found = [&](bool reaches, double gap, std::uint32_t key) {
-    if (!reaches) return;
-    nearest = std::min(nearest, std::max(gap, light_offset_));
-    if (blocking) blocking->push_back(key);
-  };
-
-  for (const BlockerPolygon& poly : polygons) {
-    Vec3 box_lo = poly.v[0], box_hi = poly.v[0];
-    for (int k = 1; k < poly.count; ++k) {
-      box_lo = box_lo.cwiseMin(poly.v[k]);
-      box_hi = box_hi.cwiseMax(poly.v[k]);
-    }
-    const double gap = gap_to(box_lo, box_hi);
-    found(add_blocker(poly.v, poly.count, poly.normal, gap), gap, poly.triangle);
-  }
-
-  // Convex solids by their silhouettes: seen from the origin, the edges between a face that
-  // faces it and one that does not outline the solid's projection, one convex polygon, whose
-  // chord in a row runs between the outline's leftmost and rightmost crossings of it.
-  thread_local std::vector<std::int8_t> front;  // per face: -1 not yet known, else 0 or 1
-  thread_local std::vector<Vec2> at;
-  thread_local std::vector<std::uint8_t> known;
-  for (const BlockerSolidRef& ref : solids) {
-    const BlockerSolid& solid = *ref.solid;
-    const double gap = std::max(gap_to(solid.bounds.lo, solid.bounds.hi), ref.distance);
-    // All of it between the light's plane and the origin's height (its box's corners are), and
-    // away from the origin.
-    bool within = gap >= light_offset_;
-    for (int k = 0; k < 8 && within; ++k) {
-      const Vec3 c((k & 1 ? solid.bounds.hi : solid.bounds.lo).x(),
-                   (k & 2 ? solid.bounds.hi : solid.bounds.lo).y(),
-                   (k & 4 ? solid.bounds.hi : solid.bounds.lo).z());
-      const double height = f.normal.dot(c - f.centre);
-      within = height >= f.clip_height && height <= h_top;
-    }
-    if (!within) {  // face by face (those facing the origin), each cut where it must be
-      bool reaches = false;
-      if (ref.faces) {
-        for (int k = 0; k < ref.face_count; ++k) {
-          const BlockerPolygon& face = ref.faces[k];
-          if (face.normal.dot(origin - face.v[0]) < 0 && gap > 0) continue;
-          reaches = add_blocker(face.v, face.count, face.normal, gap) || reaches;
-        }
-      } else {
-        for (std::size_t k = 0; k < solid.faces.size(); ++k) {
-          const Vec3 corners[3] = {solid.corners[std::size_t(solid.faces[k][0])],
-                                   solid.corners[std::size_t(solid.faces[k][1])],
-                                   solid.corners[std::size_t(solid.faces[k][2])]};
-          if (solid.normals[k].dot(origin - corners[0]) < 0 && gap > 0) continue;
-          reaches = add_blocker(corners, 3, solid.normals[k], gap) || reaches;
-        }
-      }
-      found(reaches, gap, ref.key);
-      continue;
-    }
-    front.assign(solid.faces.size(), -1);
-    known.assign(solid.corners.size(), 0);
-    at.resize(solid.corners.size());
-    const auto facing = [&](int face) {
-      std::int8_t& v = front[std::size_t(face)];
-      if (v < 0)
-        v = solid.normals[std::size_t(face)].dot(
-                origin - solid.corners[std::size_t(solid.faces[std::size_t(face)][0])]) > 0;
-      return v;
-    };
-    double t_lo = kInfinity, t_hi = -kInfinity, s_lo = kInfinity, s_hi = -kInfinity;
-    const auto corner = [&](int c) -> const Vec2& {
-      if (!known[std::size_t(c)]) {
-        at[std::size_t(c)] = project(solid.corners[std::size_t(c)]);
-        known[std::size_t(c)] = 1;
-        const Vec2& p = at[std::size_t(c)];
-        t_lo = std::min(t_lo, p.y());
-        t_hi = std::max(t_hi, p.y());
-        s_lo = std::min(s_lo, p.x());
-        s_hi = std::max(s_hi, p.x());
-      }
-      return at[std::size_t(c)];
-    };
-    const int edge_count = ref.edges ? ref.edge_count : int(solid.edges.size());
-    thread_local std::vector<int> silhouette;
-    silhouette.clear();
-    for (int k = 0; k < edge_count; ++k) {
-      const int e = ref.edges ? ref.edges[k] : k;
-      const auto& edge_faces = solid.edges[std::size_t(e)];
-      if (facing(edge_faces[2]) == facing(edge_faces[3])) continue;
-      silhouette.push_back(e);
-      corner(edge_faces[0]);
-      corner(edge_faces[1]);
-    }
-    if (silhouette.empty() || t_hi < t_first || t_lo > t_last || s_hi < extent_lo ||
-        s_lo > extent_hi)
-      continue;
-    begin(t_lo, t_hi);
-    bool corner_in_light = false;
-    for (const int e : silhouette) {
-      const Vec2& p = at[std::size_t(solid.edges[std::size_t(e)][0])];
-      const Vec2& q = at[std::size_t(solid.edges[std::size_t(e)][1])];
-      edge(p, q);
-      corner_in_light = corner_in_light || in_light(p);
-    }
-    found(commit() || corner_in_light, gap, ref.key);
-    if (covers) out.umbra = ref.key;
-  }
-  if (blocking) {
-    std::sort(blocking->begin(), blocking->end());
-    blocking->erase(std::unique(blocking->begin(), blocking->end()), blocking->end());
-  }
-}
-
-void PenumbraEstimator::integrate(const Frame& f, const LightRows& rows, const Vec3& position,
-                                  const Vec3& normal, const Blocked& blocked, double form_factor,
-                                  PenumbraSample& out) const {
+void PenumbraEstimator::integrate(const LightFrame& f, const LightRows& rows, const Vec3& position,
+                                  const Vec3& normal, const BlockedRows& blocked,
+                                  double form_factor, PenumbraSample& out) const {
   const double h = f.normal.dot(position - f.centre);  // the texel's height over the plane
   if (!(h > 0) || rows.count == 0) return;
   const Vec3 rel = position - f.centre;
@@ -638,7 +311,7 @@ void PenumbraEstimator::integrate(const Frame& f, const LightRows& rows, const V
   double hidden = 0, total = 0;
   bool any = false, every = true;  // some part blocked; every row blocked from end to end
   for (int r = 0; r < rows.count; ++r) {
-    const Blocked::Row& row = blocked.rows[std::size_t(r)];
+    const BlockedRows::Row& row = blocked.rows[std::size_t(r)];
     const double enter = rows.enter[std::size_t(r)], leave = rows.leave[std::size_t(r)];
     if (!(leave > enter) || (row.count == 0 && exact_total)) {
       every = every && !(leave > enter);
@@ -646,10 +319,7 @@ void PenumbraEstimator::integrate(const Frame& f, const LightRows& rows, const V
     }
     const double dt = rows.first + r * rows.pitch - t_y;
     RowWeight w;
-    w.g = h * h + dt * dt;
-    w.sg = std::sqrt(w.g);
-    w.a = n_t * dt - h * n_n;
-    w.b = n_s;
+    w.set(n_t * dt - h * n_n, n_s, h * h + dt * dt);
     // ∫ over [s0, s1] (light coordinates), with the test's bias on s > 0.
     const auto integral = [&](double s0, double s1) {
       if (!biased || s1 <= 0) return w.integral(s0 - s_y, s1 - s_y);
@@ -716,20 +386,29 @@ void PenumbraEstimator::integrate(const Frame& f, const LightRows& rows, const V
 }
 
 PenumbraSample PenumbraEstimator::visibility(const Vec3& position, const Vec3& normal,
-                                             const Vec3& origin,
-                                             const std::vector<BlockerPolygon>& polygons,
-                                             const std::vector<BlockerSolidRef>& solids,
+                                             const Vec3& origin, const Blockers& blockers,
                                              double form_factor,
                                              std::vector<std::uint32_t>* blocking) const {
   PenumbraSample out;
   out.nearest_blocker = kInfinity;
-  Frame f;
+  LightFrame f;
   if (!frame(origin, f)) return out;
   LightRows scratch;
   const LightRows& rows = rows_for(f, position, normal, scratch);
-  Blocked blocked;
+  BlockedRows blocked;
   if (blocking) blocking->clear();
-  rasterise(f, rows, origin, position, normal, polygons, solids, blocked, out, blocking);
+  const RasterTarget target{&f,       &rows, origin,  position, normal, light_offset_,
+                            &blocked, &out,  blocking};
+  static const std::vector<BlockerPolygon> no_polygons;
+  static const std::vector<BlockerSolidRef> no_solids;
+  rasterise_polygons_and_solids(target, blockers.polygons ? *blockers.polygons : no_polygons,
+                                blockers.solids ? *blockers.solids : no_solids);
+  if (blockers.outlines)
+    for (const BlockerOutline& outline : *blockers.outlines) rasterise_outline(target, outline);
+  if (blocking) {
+    std::sort(blocking->begin(), blocking->end());
+    blocking->erase(std::unique(blocking->begin(), blocking->end()), blocking->end());
+  }
   integrate(f, rows, position, normal, blocked, form_factor, out);
   return out;
 }
@@ -738,7 +417,7 @@ PenumbraSample PenumbraEstimator::visibility_traced(const Vec3& position, const 
                                                     const Vec3& origin, const RayScene& scene,
                                                     double form_factor) const {
   PenumbraSample out;
-  Frame f;
+  LightFrame f;
   if (!frame(origin, f)) return out;
   LightRows scratch;
   const LightRows& rows = rows_for(f, position, normal, scratch);
@@ -792,9 +471,9 @@ PenumbraSample PenumbraEstimator::visibility_traced(const Vec3& position, const 
   for (std::size_t i = 0; i < t_hit.size(); ++i)
     if (t_hit[i] >= 0)
       out.nearest_blocker = std::min(out.nearest_blocker, t_hit[i] * probe_directions[i].norm());
-  Blocked blocked;
+  BlockedRows blocked;
   for (int r = 0; r < n; ++r) {
-    Blocked::Row& row = blocked.rows[std::size_t(r)];
+    BlockedRows::Row& row = blocked.rows[std::size_t(r)];
     row.count = kExactIntervals + 1;
     for (int k = 0; k < kPairs; ++k)
       if (hits[std::size_t(r) * kPairs + std::size_t(k)]) row.cells |= std::uint64_t(3) << (2 * k);

@@ -14,6 +14,9 @@
 namespace sb {
 
 class RayScene;
+class ShaftCuller;
+struct LightFrame;
+struct BlockedRows;
 struct BlockerSolid;
 
 // A blocker polygon as the estimator takes it: convex, in world space (a triangle of the scene,
@@ -55,6 +58,50 @@ struct LightRows {
   std::array<double, kMaxRows> enter{}, leave{};
 };
 
+// One edge of a dense mesh's triangle that may bound the union of a tile's triangles of it.
+struct OutlineEdge {
+  std::uint32_t triangle = 0;
+  std::int8_t edge = 0;  // from corner `edge` to the next
+  // Whether the triangle faces every ray origin of the tile (1) or none (0); -1: some, so
+  // decided per texel.
+  std::int8_t facing = -1;
+  // The triangle across the edge when the edge bounds the union only where the two face
+  // different ways and that is decided per texel (one of them faces some origins of the tile
+  // only); -1: it bounds it for every texel of the tile.
+  std::int32_t across = -1;
+  std::int8_t across_facing = -1;  // as `facing`, for `across`
+};
+
+// Many triangles of a dense mesh, taken at once through the outline of their union: an edge two
+// of them share, both facing the same way, bounds neither. Made per tile by prepare_outline.
+// They report `key` as reaching the light; `distance` is a lower bound on the texel's distance
+// to them.
+struct BlockerOutline {
+  const ShaftCuller* culler = nullptr;
+  std::vector<OutlineEdge> edges;
+  // Triangles taken one by one: reaching past the light's plane or the origins' height, or
+  // passing within the rays' offset of the tile.
+  std::vector<BlockerPolygon> apart;
+  // For a sphere light, whose plane changes from texel to texel: every triangle, each decided
+  // per texel (edges and apart are then empty).
+  std::vector<std::uint32_t> triangles;
+  double distance = 0;
+  std::uint32_t key = 0;
+};
+
+// A tile's triangles of one dense mesh (`key`) as its texels' evaluations take them, given the
+// box of the tile's ray origins and the rays' surface offset.
+BlockerOutline prepare_outline(const ShaftCuller& culler, const Light& light,
+                               const std::vector<std::uint32_t>& triangles, std::uint32_t key,
+                               const Bounds3& origins, double offset);
+
+// What may block a texel's view of the light, as the estimator takes it.
+struct Blockers {
+  const std::vector<BlockerPolygon>* polygons = nullptr;  // one by one
+  const std::vector<BlockerSolidRef>* solids = nullptr;   // convex solids, by silhouette
+  const std::vector<BlockerOutline>* outlines = nullptr;  // dense meshes, by outline
+};
+
 // What a texel's evaluation found, beside V.
 struct PenumbraSample {
   double visibility = 1;     // V = H / H0 of this light at the texel, [0, 1]
@@ -89,9 +136,14 @@ class PenumbraEstimator {
   // some of it.
   // V = 1 exactly where nothing is blocked, 0 where every row is blocked from end to end.
   PenumbraSample visibility(const Vec3& position, const Vec3& normal, const Vec3& origin,
-                            const std::vector<BlockerPolygon>& polygons,
-                            const std::vector<BlockerSolidRef>& solids = {}, double form_factor = 0,
+                            const Blockers& blockers, double form_factor = 0,
                             std::vector<std::uint32_t>* blocking = nullptr) const;
+  // The same for polygons alone.
+  PenumbraSample visibility(const Vec3& position, const Vec3& normal, const Vec3& origin,
+                            const std::vector<BlockerPolygon>& polygons,
+                            double form_factor = 0) const {
+    return visibility(position, normal, origin, Blockers{&polygons, nullptr, nullptr}, form_factor);
+  }
 
   // The same estimate with each pair of cells' blocking found by one shadow ray (32 per row:
   // 1024 at 32 rows) instead of from listed polygons: for shafts that hold too many polygons to
@@ -105,20 +157,15 @@ class PenumbraEstimator {
   double weight_bias = 1.0;
 
  private:
-  struct Frame;
-  struct Blocked;
-  bool frame(const Vec3& origin, Frame& f) const;
+  bool frame(const Vec3& origin, LightFrame& f) const;
   // The rows for a texel: the light's own where all of it is above the texel's horizon, else
   // rows spread over the part above (so a sliver of light near the horizon has all of them).
-  const LightRows& rows_for(const Frame& f, const Vec3& position, const Vec3& normal,
+  const LightRows& rows_for(const LightFrame& f, const Vec3& position, const Vec3& normal,
                             LightRows& scratch) const;
   double chord_half(double t, double radius) const;  // a disk's half chord
-  void rasterise(const Frame& f, const LightRows& rows, const Vec3& origin, const Vec3& position,
-                 const Vec3& normal, const std::vector<BlockerPolygon>& polygons,
-                 const std::vector<BlockerSolidRef>& solids, Blocked& blocked, PenumbraSample& out,
-                 std::vector<std::uint32_t>* blocking) const;
-  void integrate(const Frame& f, const LightRows& rows, const Vec3& position, const Vec3& normal,
-                 const Blocked& blocked, double form_factor, PenumbraSample& out) const;
+  void integrate(const LightFrame& f, const LightRows& rows, const Vec3& position,
+                 const Vec3& normal, const BlockedRows& blocked, double form_factor,
+                 PenumbraSample& out) const;
 
   const Light* light_;
   int row_count_;

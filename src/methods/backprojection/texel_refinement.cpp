@@ -10,7 +10,8 @@
 //   2. the centre's exact V is within `tolerance` of the mean of the corners, the bilinear
 //      prediction there (a kink — the edge of a penumbra or umbra — crossing the cell moves the
 //      centre by at least half the error it causes anywhere in the cell);
-//   3. its texels lie on one smooth piece of surface: each within `position_texels` of the
+//   3. its texels lie on one smooth piece of surface: its sides on the surface within a factor 3
+//      of each other, each texel within `position_texels` (of the shorter side's texels) of the
 //      bilinear surface through the corners' positions and with a normal within 15° of the
 //      centre's (no UV chart border, crease or horizon change inside);
 //   4. no blocker reaches a texel's shaft that no sample saw (a thin post standing between the
@@ -57,13 +58,14 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
   LightField field;
   field.visibility.assign(n, 1.0f);
   field.route.assign(n, TexelRoute::none);
-  std::vector<std::uint8_t> reached(n, 0), state(n, kUnknown);
-  std::vector<float> nearest(n, std::numeric_limits<float>::infinity());
-  std::vector<std::vector<std::uint32_t>> triangles(n);
-  std::vector<std::uint32_t> umbra(n, PairSample().umbra);
+  const std::vector<std::uint8_t>& reached = tiles.reached;
+  std::vector<std::uint8_t> state(n, kUnknown);
+  // The evaluated texels' samples, in order of evaluation (a level's at a time), and each
+  // texel's: what the cells' checks read beyond V.
+  std::vector<PairSample> samples;
+  std::vector<std::int32_t> sample_of(n, -1);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& r) {
     for (std::size_t t = r.begin(); t != r.end(); ++t) {
-      reached[t] = source.reaches(t);
       const Texel& tx = space.texels[t];
       if (reached[t] && tiles.kind[tiles.tile_of(tx.x, tx.y)] == TileShafts::Kind::clear) {
         field.route[t] = TexelRoute::clear;
@@ -73,19 +75,23 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
   });
 
   const auto evaluate_all = [&](const std::vector<std::size_t>& queue) {
+    const std::size_t first = samples.size();
+    samples.resize(first + queue.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queue.size(), 8), [&](const auto& r) {
-      PairSample sample;
       for (std::size_t i = r.begin(); i != r.end(); ++i) {
         const std::size_t t = queue[i];
+        PairSample& sample = samples[first + i];
         source.evaluate(t, sample);
         field.visibility[t] = sample.visibility;
         field.route[t] = sample.route;
-        nearest[t] = sample.nearest;
-        triangles[t] = sample.triangles;
-        umbra[t] = sample.umbra;
+        sample_of[t] = std::int32_t(first + i);
         state[t] = kValued;
       }
     });
+  };
+  const PairSample none;  // what a texel valued without evaluation (clear tile) holds
+  const auto sample_at = [&](std::size_t t) -> const PairSample& {
+    return sample_of[t] < 0 ? none : samples[std::size_t(sample_of[t])];
   };
 
   // The first cells: the tiles that are neither clear nor empty.
@@ -115,9 +121,13 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
       return Vec3(space.texels[std::size_t(at[std::size_t(k)])].position.cast<double>());
     };
     const Vec3 p00 = pos(0), p10 = pos(1), p01 = pos(2), p11 = pos(3);
-    const double texel_size =
-        std::max({(p10 - p00).norm(), (p01 - p00).norm(), (p11 - p10).norm(), (p11 - p01).norm()}) /
-        s;
+    // The cell's sides on the surface: much unequal, a corner lies across a chart border.
+    const double side_min =
+        std::min({(p10 - p00).norm(), (p01 - p00).norm(), (p11 - p10).norm(), (p11 - p01).norm()});
+    const double side_max =
+        std::max({(p10 - p00).norm(), (p01 - p00).norm(), (p11 - p10).norm(), (p11 - p01).norm()});
+    if (!(side_max <= 3 * side_min)) return false;
+    const double texel_size = side_min / s, texel_extent = side_max / s;
     const Vec3f centre_normal = space.texels[std::size_t(at[4])].normal;
     for (int k = 0; k < 4; ++k)
       if (space.texels[std::size_t(at[std::size_t(k)])].normal.dot(centre_normal) <
@@ -139,9 +149,10 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
       }
     // In the umbra of one convex solid at all five samples: so is every point between them (a
     // convex blocker's umbra under a convex light is convex), whatever the distance.
-    bool one_umbra = umbra[std::size_t(at[0])] != PairSample().umbra;
+    const std::uint32_t umbra = sample_at(std::size_t(at[0])).umbra;
+    bool one_umbra = umbra != none.umbra;
     for (int k = 1; k < 5; ++k)
-      one_umbra = one_umbra && umbra[std::size_t(at[std::size_t(k)])] == umbra[std::size_t(at[0])];
+      one_umbra = one_umbra && sample_at(std::size_t(at[std::size_t(k)])).umbra == umbra;
     if (one_umbra) return true;
     // Every blocker the samples saw, far enough away for penumbrae at least feature_cells wide:
     // a texel of the cell lies at most its diagonal nearer to a blocker than the sample that saw
@@ -151,14 +162,15 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
     double distance = std::numeric_limits<double>::infinity();
     for (int k = 0; k < 5; ++k) {
       const std::size_t t = std::size_t(at[std::size_t(k)]);
-      seen.insert(seen.end(), triangles[t].begin(), triangles[t].end());
+      const PairSample& sample = sample_at(t);
+      seen.insert(seen.end(), sample.triangles.begin(), sample.triangles.end());
       width = std::min(width, source.angular_width(t));
-      distance = std::min(distance, double(nearest[t]));
+      distance = std::min(distance, double(sample.nearest));
     }
     std::sort(seen.begin(), seen.end());
     seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
     if (std::isfinite(distance) &&
-        (distance - box.diagonal()) * width < settings.feature_cells * s * texel_size)
+        (distance - box.diagonal()) * width < settings.feature_cells * s * texel_extent)
       return false;
     // A traced sample lists nothing: the distance bound above is all there is to go on.
     for (int k = 0; k < 5; ++k)

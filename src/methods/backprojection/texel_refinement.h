@@ -41,7 +41,8 @@ struct TileShafts {
   int tiles_x = 0, tiles_y = 0;
   std::vector<Kind> kind;
   std::vector<std::vector<std::uint32_t>> candidates;
-  std::vector<Bounds3> origins;  // the box of each tile's texels' ray origins
+  std::vector<Bounds3> origins;       // the box of each tile's texels' ray origins (those reached)
+  std::vector<std::uint8_t> reached;  // per texel: 1 where the light reaches it (H0 > 0)
   std::size_t tile_of(int x, int y) const {
     return std::size_t(y / kTile) * std::size_t(tiles_x) + std::size_t(x / kTile);
   }
@@ -64,8 +65,6 @@ struct PairSample {
 class PairSource {
  public:
   virtual ~PairSource() = default;
-  // Whether the light reaches texel t at all (H0 > 0).
-  virtual bool reaches(std::size_t t) const = 0;
   virtual void evaluate(std::size_t t, PairSample& out) const = 0;
   // The light's narrowest apparent width seen from texel t, radians: a blocker at distance d
   // from the texel casts no penumbra on it narrower than this times d.

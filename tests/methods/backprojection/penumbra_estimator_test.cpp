@@ -136,13 +136,13 @@ TEST(PenumbraEstimator, UnblockedIsOneAndCoveredIsZeroExactly) {
   const Light light(rectangle_light());
   const PenumbraEstimator estimator(light, 32, 1e-4);
   const Vec3 y(0.3, 0.2, 0), n(0, 0, 1);
-  EXPECT_EQ(estimator.visibility(y, n, y, {}).visibility, 1.0);
+  EXPECT_EQ(estimator.visibility(y, n, y, Blockers{}).visibility, 1.0);
   // A large square between the texel and the light hides all of it.
   const std::vector<Triangle3> cover = {Triangle3{Vec3(-3, -3, 1), Vec3(3, -3, 1), Vec3(3, 3, 1)},
                                         Triangle3{Vec3(-3, -3, 1), Vec3(3, 3, 1), Vec3(-3, 3, 1)}};
   EXPECT_EQ(estimator.visibility(y, n, y, polygons(cover)).visibility, 0.0);
   // Behind the light: nothing arrives.
-  EXPECT_FALSE(estimator.visibility(Vec3(0, 0, 3), n, Vec3(0, 0, 3), {}).contributes);
+  EXPECT_FALSE(estimator.visibility(Vec3(0, 0, 3), n, Vec3(0, 0, 3), Blockers{}).contributes);
 }
 
 // The bake's 32 rows, and 64 (rows are the estimator's one approximation that matters: its error

@@ -1,0 +1,75 @@
+// The back-projection estimator's working types (penumbra_estimator.cpp): a light seen from one
+// texel (its plane and turned frame), and what the blockers hide of each of its rows; and the
+// rasterisers that fill them (blocker_rasteriser.cpp: polygons and convex solids one by one;
+// outline_rasteriser.cpp: many triangles at once through the outline of their union).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "core/geometry.h"
+#include "methods/backprojection/penumbra_estimator.h"
+
+namespace sb {
+
+constexpr int kCells = LightRows::kCells;
+constexpr std::uint64_t kAllCells = ~std::uint64_t(0);
+// Intervals a row keeps exactly before it falls back to cells: the rows of a shaft with a few
+// polygons are exact, those of a dense mesh's many are cells.
+constexpr int kExactIntervals = 6;
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+// The light as one texel sees it: the plane its rows lie in (the light's own, or a sphere's
+// silhouette disk seen from the texel's ray origin) with the normal towards the texel, and the
+// rows' turned axes.
+struct LightFrame {
+  Vec3 centre;  // of the light, or of a sphere's silhouette disk
+  Vec3 normal;  // of its plane, towards the texel
+  Vec3 s_axis, t_axis;
+  double radius = 0;       // a disk's or a sphere's silhouette's (0 for a rectangle)
+  double clip_height = 0;  // blocker points nearer the plane than this do not block
+};
+
+// What each row's centre line has blocked: up to kExactIntervals intervals kept exactly, beyond
+// that the cells whose centres they cover (cell c of row r centred at enter + (c + ½)·width/64).
+struct BlockedRows {
+  struct Row {
+    int count = 0;  // intervals given; above kExactIntervals, `cells` holds them all
+    std::array<std::pair<double, double>, kExactIntervals> intervals;
+    std::uint64_t cells = 0;
+  };
+  std::array<Row, LightRows::kMaxRows> rows;
+
+  // The cells of a row (of chord enter..leave) whose centres [a, b] covers.
+  static std::uint64_t cells_of(double enter, double leave, double a, double b);
+  // Adds [a, b] (within the row's chord) to row r.
+  void add(const LightRows& lights, int r, double a, double b);
+  // Adds cells to row r, which holds cells from then on.
+  void add_cells(const LightRows& lights, int r, std::uint64_t cells);
+};
+
+Vec3 any_orthogonal(const Vec3& m);
+
+// Everything a rasteriser needs of one texel's evaluation.
+struct RasterTarget {
+  const LightFrame* frame = nullptr;
+  const LightRows* rows = nullptr;
+  Vec3 origin, position, normal;  // the ray origin; the surface point and its shading normal
+  double light_offset = 0;        // RayScene::surface_offset
+  BlockedRows* blocked = nullptr;
+  PenumbraSample* out = nullptr;                   // nearest_blocker and umbra are updated
+  std::vector<std::uint32_t>* blocking = nullptr;  // keys that reach the light, unsorted
+};
+
+// Polygons one by one, and convex solids by their silhouette edges (blocker_rasteriser.cpp).
+void rasterise_polygons_and_solids(const RasterTarget& target,
+                                   const std::vector<BlockerPolygon>& polygons,
+                                   const std::vector<BlockerSolidRef>& solids);
+
+// Many triangles through the outline of their union (outline_rasteriser.cpp).
+void rasterise_outline(const RasterTarget& target, const BlockerOutline& outline);
+
+}  // namespace sb

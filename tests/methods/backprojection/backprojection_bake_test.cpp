@@ -1,0 +1,126 @@
+// The `backprojection` method through the whole pipeline: the exact parallel case against its
+// closed form; the same bytes for any thread count and from run to run; routes counted; and
+// against the reference on the configurations the method must get right (a light flush with a
+// ceiling, a receiver shadowing itself, a blocker across the light's plane, lights of every
+// shape).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <string>
+
+#include "pipeline/bake.h"
+#include "support/closed_forms.h"
+#include "support/image_errors.h"
+#include "support/test_scenes.h"
+
+namespace sb {
+namespace {
+
+Scene scene_of(const std::string& name, int resolution, const std::string& file = "scene.toml") {
+  auto scene = load_scene(std::string(SB_SOURCE_DIR) + "/scenes/" + name + "/" + file);
+  EXPECT_TRUE(scene) << scene.error().message;
+  if (!scene) throw std::runtime_error(scene.error().message);
+  scene->bake.resolution = resolution;
+  scene->bake.method = "backprojection";
+  scene->bake.margin = 0;
+  return *scene;
+}
+
+double stat(const ReceiverBake& r, const std::string& name) {
+  for (const auto& [key, value] : r.report.stats)
+    if (key == name) return value;
+  ADD_FAILURE() << "no " << name;
+  return 0;
+}
+
+// Three parallel planes (docs/design.md §2): the closed form is exact (the light's weight less
+// its hidden part's, square_light_weighted_visibility), and so is the estimator but for its
+// rows; interpolation may add to that only where it checked.
+TEST(BackprojectionBake, ExactParallelCaseIsWithinAThousandthOfTheClosedForm) {
+  const Scene scene = scene_of("parallel", 512);
+  auto result = bake(scene);
+  ASSERT_TRUE(result) << result.error().message;
+  const Image& img = result->receivers[0].image;
+  const image_errors::Errors e = image_errors::errors_against(img, 0, [&](int x, int y) {
+    const double u = (x + 0.5) / img.width, v = 1.0 - (y + 0.5) / img.height;
+    return closed_forms::square_light_weighted_visibility(2 * u - 1, 2 * v - 1, 0, 0, 0.5);
+  });
+  std::printf("parallel planes at 512²: RMSE %.5f, max %.4f; interpolated %.3f of pairs\n", e.rmse,
+              e.max, stat(result->receivers[0], "interpolated_fraction"));
+  EXPECT_LT(e.rmse, 0.001);
+  EXPECT_LT(e.max, 0.02);
+  EXPECT_GT(stat(result->receivers[0], "interpolated_fraction"), 0.05);
+}
+
+TEST(BackprojectionBake, SameBytesForAnyThreadCountAndRun) {
+  Scene scene = scene_of("showcase", 96);
+  BakeOptions one, two;
+  one.threads = 1;
+  two.threads = 2;
+  auto a = bake(scene, one), b = bake(scene, two), c = bake(scene, two);
+  ASSERT_TRUE(a && b && c);
+  for (std::size_t r = 0; r < a->receivers.size(); ++r) {
+    EXPECT_EQ(a->receivers[r].image.pixels, b->receivers[r].image.pixels) << r;
+    EXPECT_EQ(b->receivers[r].image.pixels, c->receivers[r].image.pixels) << r;
+  }
+}
+
+TEST(BackprojectionBake, CountsEveryPairByItsRoute) {
+  const Scene scene = scene_of("showcase", 128);
+  auto result = bake(scene);
+  ASSERT_TRUE(result) << result.error().message;
+  for (const ReceiverBake& r : result->receivers) {
+    double sum = 0;
+    for (const char* route : {"clear_fraction", "convolved_fraction", "exact_fraction",
+                              "interpolated_fraction", "traced_fraction"})
+      sum += stat(r, route);
+    EXPECT_NEAR(sum, 1.0, 1e-9) << r.name;
+  }
+  // The floor has shadows from every kind of route but the convolution's.
+  const ReceiverBake& floor = result->receivers[0];
+  EXPECT_GT(stat(floor, "clear_fraction"), 0.3);
+  EXPECT_GT(stat(floor, "exact_fraction"), 0.0);
+  EXPECT_GT(stat(floor, "interpolated_fraction"), 0.0);
+}
+
+// Against the reference at 1024 samples, pooled over receivers: within the error the reference
+// itself has at 256 samples (and a little noise of the truth's own).
+void expect_as_accurate_as_reference_256(Scene scene, const std::string& what) {
+  Scene reference = scene;
+  reference.bake.method = "reference";
+  reference.bake.samples = 1024;
+  reference.bake.seed = 4321;
+  Scene ref256 = reference;
+  ref256.bake.samples = 256;
+  ref256.bake.seed = 0;
+  auto truth = bake(reference), coarse = bake(ref256), ours = bake(scene);
+  ASSERT_TRUE(truth && coarse && ours);
+  const double e_ours = image_errors::errors(*ours, *truth).rmse;
+  const double e_ref = image_errors::errors(*coarse, *truth).rmse;
+  std::printf("%s: backprojection RMSE %.5f, reference-256 %.5f (against reference-1024)\n",
+              what.c_str(), e_ours, e_ref);
+  EXPECT_LE(e_ours, e_ref * 1.05 + 2e-4) << what;
+}
+
+TEST(BackprojectionBake, LightFlushWithACeilingAndCurvedReceivers) {
+  // The atrium's panel, 1.5 cm under the ceiling slab (a blocker), over columns and benches.
+  Scene scene = scene_of("atrium", 64);
+  expect_as_accurate_as_reference_256(scene, "atrium (panel under the ceiling)");
+}
+
+TEST(BackprojectionBake, ReceiverShadowingItself) {
+  expect_as_accurate_as_reference_256(scene_of("bracket", 96), "bracket");
+}
+
+TEST(BackprojectionBake, BlockerAcrossTheLightsPlaneAndADiskLight) {
+  // The room's back wall rises past the window's plane; the disk variant of the same room.
+  expect_as_accurate_as_reference_256(scene_of("room", 64), "room (wall past the light's plane)");
+  expect_as_accurate_as_reference_256(scene_of("room", 64, "scene_disk.toml"), "room, disk light");
+}
+
+TEST(BackprojectionBake, SphereLightsLowAmongObjects) {
+  expect_as_accurate_as_reference_256(scene_of("atrium", 64, "scene_bulb.toml"), "atrium, bulb");
+}
+
+}  // namespace
+}  // namespace sb

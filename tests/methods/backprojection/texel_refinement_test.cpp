@@ -1,0 +1,176 @@
+// Tests of adaptive texel sampling (texel_refinement.cpp) on synthetic fields over a flat 64²
+// lightmap: where it interpolates, what it checks before it does, and what it must not miss (a
+// kink between samples, a thin shadow no sample falls on, a UV chart border).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+
+#include "methods/backprojection/texel_refinement.h"
+
+namespace sb {
+namespace {
+
+constexpr int kSide = 64;
+
+// A flat 1 m² receiver, every texel covered: texel (x, y) at (x/64, y/64, 0), normal up; with
+// `border_at` ≥ 0, the texels from that column on lie 1 m away (another UV chart beside it).
+TexelSpace flat_space(int border_at = -1) {
+  TexelSpace space;
+  space.width = space.height = kSide;
+  space.covered.assign(kSide * kSide, 1);
+  for (int y = 0; y < kSide; ++y)
+    for (int x = 0; x < kSide; ++x) {
+      Texel t;
+      t.x = x, t.y = y;
+      t.position = Vec3f((x + 0.5f) / kSide + (border_at >= 0 && x >= border_at ? 1.0f : 0.0f),
+                         (y + 0.5f) / kSide, 0);
+      t.normal = t.geometric_normal = Vec3f::UnitZ();
+      t.shadow_origin = t.position;
+      space.texels.push_back(t);
+    }
+  return space;
+}
+
+// Every tile listed (one candidate), every texel reached.
+TileShafts listed_tiles() {
+  TileShafts tiles;
+  tiles.tiles_x = tiles.tiles_y = kSide / TileShafts::kTile;
+  tiles.kind.assign(std::size_t(tiles.tiles_x * tiles.tiles_y), TileShafts::Kind::listed);
+  tiles.candidates.assign(tiles.kind.size(), {7});
+  tiles.origins.assign(tiles.kind.size(), Bounds3());
+  tiles.reached.assign(kSide * kSide, 1);
+  return tiles;
+}
+
+// A field V(x, y) the source evaluates exactly, counting evaluations; blockers as the test says.
+class FieldSource final : public PairSource {
+ public:
+  FieldSource(const TexelSpace& space, std::function<double(int, int)> field)
+      : space_(space), field_(std::move(field)) {}
+  void evaluate(std::size_t t, PairSample& out) const override {
+    ++evaluations;
+    const Texel& tx = space_.texels[t];
+    out = PairSample();
+    out.visibility = float(field_(tx.x, tx.y));
+    out.route = TexelRoute::exact;
+    out.nearest = float(nearest);
+    out.triangles = {7};
+    out.umbra =
+        umbra_where ? (umbra_where(tx.x, tx.y) ? 99u : PairSample().umbra) : PairSample().umbra;
+  }
+  double angular_width(std::size_t) const override { return 0.5; }
+  bool sees_unlisted(const std::vector<std::size_t>& texels,
+                     const std::vector<std::uint32_t>&) const override {
+    if (!unlisted_where) return false;
+    for (std::size_t t : texels)
+      if (unlisted_where(space_.texels[t].x, space_.texels[t].y)) return true;
+    return false;
+  }
+  mutable int evaluations = 0;
+  double nearest = 10.0;  // metres: far, for penumbrae far wider than any cell
+  std::function<bool(int, int)> unlisted_where, umbra_where;
+
+ private:
+  const TexelSpace& space_;
+  std::function<double(int, int)> field_;
+};
+
+struct Outcome {
+  double max_error = 0;
+  int evaluations = 0, interpolated = 0;
+};
+
+Outcome refine(const TexelSpace& space, FieldSource& source,
+               const std::function<double(int, int)>& truth) {
+  const LightField field = refine_light(space, TexelGrid(space), listed_tiles(), source, {});
+  Outcome o;
+  o.evaluations = source.evaluations;
+  for (std::size_t t = 0; t < space.texels.size(); ++t) {
+    o.max_error = std::max(
+        o.max_error, std::abs(field.visibility[t] - truth(space.texels[t].x, space.texels[t].y)));
+    o.interpolated += field.route[t] == TexelRoute::interpolated;
+  }
+  return o;
+}
+
+TEST(TexelRefinement, InterpolatesASmoothFieldExactlyWithFewSamples) {
+  const TexelSpace space = flat_space();
+  const auto linear = [](int x, int y) { return 0.2 + 0.01 * x + 0.002 * y; };
+  FieldSource source(space, linear);
+  const Outcome o = refine(space, source, linear);
+  EXPECT_LT(o.max_error, 1e-6);
+  EXPECT_LT(o.evaluations, kSide * kSide / 6);  // the last column and row lack their corners
+  EXPECT_GT(o.interpolated, kSide * kSide / 2);
+}
+
+// The edge of a penumbra: V flat, then a ramp (a kink in V along a line). Cells across it see
+// their centre disagree with their corners and refine; what is interpolated is within the
+// tolerance (a kink moves the centre by at least half the error it causes).
+TEST(TexelRefinement, FindsAKinkBetweenItsSamples) {
+  const TexelSpace space = flat_space();
+  const auto kink = [](int x, int) { return std::clamp((x - 21.3) / 12.0, 0.0, 1.0); };
+  FieldSource source(space, kink);
+  const Outcome o = refine(space, source, kink);
+  EXPECT_LT(o.max_error, 1.5 * RefinementSettings().tolerance);
+  EXPECT_GT(o.interpolated, 0);
+}
+
+// A shadow one texel wide on a column no sample of an 8-cell falls on: only the check for
+// blockers no sample saw finds it; without that check the cells would interpolate 1 over it.
+TEST(TexelRefinement, DoesNotMissAThinShadowNoSampleSees) {
+  const TexelSpace space = flat_space();
+  const auto line = [](int x, int) { return x == 13 ? 0.0 : 1.0; };
+  FieldSource source(space, line);
+  source.unlisted_where = [](int x, int) { return x == 13; };
+  EXPECT_EQ(refine(space, source, line).max_error, 0.0);
+  FieldSource blind(space, line);
+  EXPECT_EQ(refine(space, blind, line).max_error, 1.0);  // what the check is for
+}
+
+// Blockers near the receiver cast penumbrae narrower than a cell: no cell interpolates across
+// them, however well its samples agree.
+TEST(TexelRefinement, DoesNotInterpolateNearContact) {
+  const TexelSpace space = flat_space();
+  const auto flat = [](int, int) { return 0.5; };
+  FieldSource source(space, flat);
+  source.nearest = 0.001;  // 1 mm: penumbrae ~0.5 mm wide, a texel is 16 mm
+  const Outcome o = refine(space, source, flat);
+  EXPECT_EQ(o.interpolated, 0);
+  EXPECT_EQ(o.evaluations, kSide * kSide);
+}
+
+// In the umbra of one convex solid at every sample, a cell interpolates even near contact (that
+// umbra is convex); in two different solids' umbrae it does not.
+TEST(TexelRefinement, InterpolatesInsideOneConvexSolidsUmbra) {
+  const TexelSpace space = flat_space();
+  const auto dark = [](int, int) { return 0.0; };
+  FieldSource one(space, dark);
+  one.nearest = 0.001;
+  one.umbra_where = [](int, int) { return true; };
+  EXPECT_GT(refine(space, one, dark).interpolated, kSide * kSide / 2);
+  FieldSource none(space, dark);
+  none.nearest = 0.001;
+  EXPECT_EQ(refine(space, none, dark).interpolated, 0);
+}
+
+// Two UV charts side by side in the lightmap, far apart on the surface: no cell interpolates
+// across their border, where the field jumps.
+TEST(TexelRefinement, DoesNotInterpolateAcrossAChartBorder) {
+  const TexelSpace space = flat_space(/*border_at=*/28);
+  const auto jump = [](int x, int) { return x < 28 ? 0.2 + 0.001 * x : 0.9 - 0.001 * x; };
+  FieldSource source(space, jump);
+  const Outcome o = refine(space, source, jump);
+  EXPECT_LT(o.max_error, 1e-6);
+  // Column 27 is chart A's last: no cell it belongs to has all its corners in A.
+  FieldSource again(space, jump);
+  const LightField field = refine_light(space, TexelGrid(space), listed_tiles(), again, {});
+  for (std::size_t t = 0; t < space.texels.size(); ++t) {
+    if (space.texels[t].x == 27) {
+      EXPECT_NE(field.route[t], TexelRoute::interpolated) << space.texels[t].y;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace sb
