@@ -93,6 +93,7 @@ struct TileBlockers {
   std::vector<BlockerSolidRef> solids;
   std::vector<std::vector<int>> edges;             // per solid
   std::vector<std::vector<BlockerPolygon>> faces;  // per solid: its candidate triangles
+  std::vector<std::vector<int>> cut_faces;         // per solid: faces across the slab's planes
 };
 
 TileBlockers tile_blockers(const ShaftCuller& culler, const Light& light,
@@ -153,9 +154,36 @@ TileBlockers tile_blockers(const ShaftCuller& culler, const Light& light,
     }
     out.outlines.push_back(prepare_outline(culler, light, list, dense[k], origins, offset));
   }
+  // A whole solid that reaches past the light's plane or below the tile's origins (a wall up to
+  // the ceiling a panel hangs from, a ball resting on the floor) has no silhouette every texel
+  // can take: with many faces in the tile, they go through the outline of their union instead.
+  double h_top = std::numeric_limits<double>::infinity();
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 p((c & 1 ? origins.hi : origins.lo).x(), (c & 2 ? origins.hi : origins.lo).y(),
+                 (c & 4 ? origins.hi : origins.lo).z());
+    h_top = std::min(h_top, light.normal().dot(p - light.centre()) * (1 - 1e-9));
+  }
+  const auto within_slab = [&](const Bounds3& b) {
+    if (light.shape() == LightShape::sphere) return true;  // decided per texel
+    for (int c = 0; c < 8; ++c) {
+      const Vec3 p((c & 1 ? b.hi : b.lo).x(), (c & 2 ? b.hi : b.lo).y(), (c & 4 ? b.hi : b.lo).z());
+      const double height = light.normal().dot(p - light.centre());
+      if (height < offset || height > h_top) return false;
+    }
+    return true;
+  };
   for (std::size_t k = 0; k < keys.size(); ++k) {
     if (!whole[k]) continue;
     const BlockerSolid& solid = culler.solid_of_key(keys[k]);
+    if (!within_slab(solid.bounds)) {
+      std::vector<std::uint32_t> faces;
+      for (std::uint32_t i : candidates)
+        if (culler.blocker_key(i) == keys[k]) faces.push_back(i);
+      if (faces.size() >= kOutlineTriangles) {
+        out.outlines.push_back(prepare_outline(culler, light, faces, keys[k], origins, offset));
+        continue;
+      }
+    }
     // Each face's side of the whole tile: 1 facing it from all of it, -1 from none, 0 mixed.
     std::vector<std::int8_t> side(solid.faces.size());
     for (std::size_t f = 0; f < solid.faces.size(); ++f) {
@@ -171,6 +199,28 @@ TileBlockers tile_blockers(const ShaftCuller& culler, const Light& light,
       if (a == 0 || b == 0 || a != b) edges.push_back(int(e));
     }
     out.edges.push_back(std::move(edges));
+    // The faces that may cross the light's plane (at the rays' offset) or the height of some
+    // origin of the tile: those that cut the outline of the solid's part in a texel's slab.
+    std::vector<int> cuts;
+    if (light.shape() != LightShape::sphere) {
+      double h_lo = std::numeric_limits<double>::infinity(), h_hi = -h_lo;
+      for (int c = 0; c < 8; ++c) {
+        const Vec3 p((c & 1 ? origins.hi : origins.lo).x(), (c & 2 ? origins.hi : origins.lo).y(),
+                     (c & 4 ? origins.hi : origins.lo).z());
+        const double h = light.normal().dot(p - light.centre());
+        h_lo = std::min(h_lo, h * (1 - 1e-9)), h_hi = std::max(h_hi, h);
+      }
+      for (std::size_t f = 0; f < solid.faces.size(); ++f) {
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        for (int j = 0; j < 3; ++j) {
+          const double h = light.normal().dot(solid.corners[std::size_t(solid.faces[f][std::size_t(j)])] -
+                                              light.centre());
+          lo = std::min(lo, h), hi = std::max(hi, h);
+        }
+        if ((lo < offset && hi > offset) || (lo < h_hi && hi > h_lo)) cuts.push_back(int(f));
+      }
+    }
+    out.cut_faces.push_back(std::move(cuts));
     std::vector<BlockerPolygon> faces;
     for (std::uint32_t i : candidates)
       if (culler.blocker_key(i) == keys[k])
@@ -183,6 +233,10 @@ TileBlockers tile_blockers(const ShaftCuller& culler, const Light& light,
     out.solids[k].edge_count = int(out.edges[k].size());
     out.solids[k].faces = out.faces[k].data();
     out.solids[k].face_count = int(out.faces[k].size());
+    if (light.shape() != LightShape::sphere) {
+      out.solids[k].cut_faces = out.cut_faces[k].data();
+      out.solids[k].cut_count = int(out.cut_faces[k].size());
+    }
   }
   return out;
 }
@@ -254,6 +308,12 @@ class LightPairs final : public PairSource {
     out.visibility = float(sample.visibility);
     out.nearest = float(sample.nearest_blocker);
     out.umbra = sample.umbra;
+    // All of the light hidden, by one convex solid alone: its umbra, however the estimator took
+    // it (a ball resting on the floor, by its faces where its silhouette reaches below the
+    // texel's origin).
+    if (out.visibility == 0 && out.triangles.size() == 1 &&
+        (out.triangles[0] & ShaftCuller::kSolidKey))
+      out.umbra = out.triangles[0];
   }
 
   double angular_width(std::size_t t) const override {

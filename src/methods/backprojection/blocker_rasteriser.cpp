@@ -20,7 +20,6 @@ namespace {
 
 // A shaft polygon cut by up to 8 more lines, and by the light's plane.
 constexpr int kPieceVertices = 32;
-
 }  // namespace
 
 Vec3 any_orthogonal(const Vec3& m) {
@@ -292,17 +291,9 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
   for (const BlockerSolidRef& ref : solids) {
     const BlockerSolid& solid = *ref.solid;
     const double gap = std::max(gap_to(solid.bounds.lo, solid.bounds.hi), ref.distance);
-    // All of it between the light's plane and the origin's height (its box's corners are), and
-    // away from the origin.
-    bool within = gap >= light_offset;
-    for (int k = 0; k < 8 && within; ++k) {
-      const Vec3 c((k & 1 ? solid.bounds.hi : solid.bounds.lo).x(),
-                   (k & 2 ? solid.bounds.hi : solid.bounds.lo).y(),
-                   (k & 4 ? solid.bounds.hi : solid.bounds.lo).z());
-      const double height = f.normal.dot(c - f.centre);
-      within = height >= f.clip_height && height <= h_top;
-    }
-    if (!within) {  // face by face (those facing the origin), each cut where it must be
+    // Face by face (those facing the origin), each cut where it must be: where the silhouette
+    // would reach past the light's plane or behind the origin, or the origin lies on the solid.
+    const auto by_faces = [&] {
       bool reaches = false;
       if (ref.faces) {
         for (int k = 0; k < ref.face_count; ++k) {
@@ -320,7 +311,22 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
         }
       }
       found(reaches, gap, ref.key);
+    };
+    if (gap < light_offset) {
+      by_faces();
       continue;
+    }
+    // Its box between the light's plane and the origin's height: every corner is, else each
+    // silhouette corner must be (a ball resting on the floor reaches below a floor texel's
+    // origin, but from most of the floor not on its silhouette: a ray from the origin inside the
+    // tangent cone meets the ball at once, however low the ball's bottom).
+    bool box_within = true;
+    for (int k = 0; k < 8 && box_within; ++k) {
+      const Vec3 c((k & 1 ? solid.bounds.hi : solid.bounds.lo).x(),
+                   (k & 2 ? solid.bounds.hi : solid.bounds.lo).y(),
+                   (k & 4 ? solid.bounds.hi : solid.bounds.lo).z());
+      const double height = f.normal.dot(c - f.centre);
+      box_within = height >= f.clip_height && height <= h_top;
     }
     front.assign(solid.faces.size(), -1);
     known.assign(solid.corners.size(), 0);
@@ -333,9 +339,15 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
       return v;
     };
     double t_lo = kInfinity, t_hi = -kInfinity, s_lo = kInfinity, s_hi = -kInfinity;
+    bool corners_within = true;
     const auto corner = [&](int c) -> const Vec2& {
       if (!known[std::size_t(c)]) {
-        at[std::size_t(c)] = project(solid.corners[std::size_t(c)]);
+        const Vec3& point = solid.corners[std::size_t(c)];
+        if (!box_within) {
+          const double height = f.normal.dot(point - f.centre);
+          corners_within = corners_within && height >= f.clip_height && height <= h_top;
+        }
+        at[std::size_t(c)] = project(point);
         known[std::size_t(c)] = 1;
         const Vec2& p = at[std::size_t(c)];
         t_lo = std::min(t_lo, p.y());
@@ -356,19 +368,97 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
       corner(edge_faces[0]);
       corner(edge_faces[1]);
     }
+    if (!corners_within) {
+      // A solid reaching past the slab (a crate on the floor a texel is on, a wall up to the
+      // ceiling): its part within the slab is convex, outlined by its silhouette edges cut to
+      // the slab and by the cuts of its faces across the slab's planes (those the tile says may
+      // cross them, or all): a ray inside that outline enters the part.
+      thread_local std::vector<std::pair<Vec2, Vec2>> outline;
+      outline.clear();
+      const auto levels = {f.clip_height, h_top};
+      for (const int e : silhouette) {
+        Vec3 a = solid.corners[std::size_t(solid.edges[std::size_t(e)][0])];
+        Vec3 b = solid.corners[std::size_t(solid.edges[std::size_t(e)][1])];
+        double ha = f.normal.dot(a - f.centre), hb = f.normal.dot(b - f.centre);
+        if ((ha < f.clip_height && hb < f.clip_height) || (ha > h_top && hb > h_top)) continue;
+        for (const double level : levels) {
+          if ((ha - level) * (hb - level) >= 0) continue;
+          const Vec3 cut = a + (b - a) * ((level - ha) / (hb - ha));
+          // Keep the part on the slab's side of this level.
+          if ((level == h_top) == (ha > level)) {
+            a = cut, ha = level;
+          } else {
+            b = cut, hb = level;
+          }
+        }
+        outline.emplace_back(project(a), project(b));
+      }
+      const int cuts = ref.cut_faces ? ref.cut_count : int(solid.faces.size());
+      for (int k = 0; k < cuts; ++k) {
+        const auto& face = solid.faces[std::size_t(ref.cut_faces ? ref.cut_faces[k] : k)];
+        std::array<double, 3> h;
+        for (int j = 0; j < 3; ++j)
+          h[std::size_t(j)] = f.normal.dot(solid.corners[std::size_t(face[std::size_t(j)])] - f.centre);
+        for (const double level : levels) {
+          Vec3 ends[2];
+          int found_ends = 0;
+          for (int j = 0; j < 3 && found_ends < 2; ++j) {
+            const double ha = h[std::size_t(j)], hb = h[std::size_t((j + 1) % 3)];
+            if ((ha - level) * (hb - level) >= 0) continue;
+            const Vec3& a = solid.corners[std::size_t(face[std::size_t(j)])];
+            const Vec3& b = solid.corners[std::size_t(face[std::size_t((j + 1) % 3)])];
+            ends[found_ends++] = a + (b - a) * ((level - ha) / (hb - ha));
+          }
+          if (found_ends == 2) outline.emplace_back(project(ends[0]), project(ends[1]));
+        }
+      }
+      if (outline.empty()) continue;
+      double lo_t = kInfinity, hi_t = -kInfinity, lo_s = kInfinity, hi_s = -kInfinity;
+      bool outline_in_light = false;
+      for (const auto& [p, q] : outline)
+        for (const Vec2& x : {p, q}) {
+          lo_t = std::min(lo_t, x.y()), hi_t = std::max(hi_t, x.y());
+          lo_s = std::min(lo_s, x.x()), hi_s = std::max(hi_s, x.x());
+          outline_in_light = outline_in_light || in_light(x);
+        }
+      if (hi_t < t_first || lo_t > t_last || hi_s < extent_lo || lo_s > extent_hi) continue;
+      begin(lo_t, hi_t);
+      for (const auto& [p, q] : outline) edge(p, q);
+      const bool reaches = commit() || outline_in_light;
+      if (covers) out.umbra = ref.key;
+      found(reaches, gap, ref.key);
+      continue;
+    }
     if (silhouette.empty() || t_hi < t_first || t_lo > t_last || s_hi < extent_lo ||
         s_lo > extent_hi)
       continue;
     begin(t_lo, t_hi);
     bool corner_in_light = false;
+    // How near the silhouette's edges that cross the light's box lie: they, not the solid's
+    // nearest point (a ball's contact with the floor), set how fast V changes here.
+    double edge_distance = kInfinity;
     for (const int e : silhouette) {
-      const Vec2& p = at[std::size_t(solid.edges[std::size_t(e)][0])];
-      const Vec2& q = at[std::size_t(solid.edges[std::size_t(e)][1])];
+      const auto& ends = solid.edges[std::size_t(e)];
+      const Vec2& p = at[std::size_t(ends[0])];
+      const Vec2& q = at[std::size_t(ends[1])];
       edge(p, q);
       corner_in_light = corner_in_light || in_light(p);
+      if (std::max(p.y(), q.y()) < t_first || std::min(p.y(), q.y()) > t_last ||
+          std::max(p.x(), q.x()) < extent_lo || std::min(p.x(), q.x()) > extent_hi)
+        continue;
+      const Vec3& a = solid.corners[std::size_t(ends[0])];
+      const Vec3 ab = solid.corners[std::size_t(ends[1])] - a;
+      const double along = std::clamp((origin - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300),
+                                      0.0, 1.0);
+      edge_distance = std::min(edge_distance, (a + along * ab - origin).norm());
     }
-    found(commit() || corner_in_light, gap, ref.key);
-    if (covers) out.umbra = ref.key;
+    const bool reaches = commit() || corner_in_light;
+    if (covers) {
+      out.umbra = ref.key;
+      found(reaches, gap, ref.key);
+    } else {
+      found(reaches, std::max(gap, std::isfinite(edge_distance) ? edge_distance : gap), ref.key);
+    }
   }
 }
 

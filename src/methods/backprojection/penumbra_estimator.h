@@ -44,6 +44,9 @@ struct BlockerSolidRef {
   double distance = 0;
   const BlockerPolygon* faces = nullptr;
   int face_count = 0;
+  // The faces that may cross the light's plane or a texel's origin height, when the tile knows.
+  const int* cut_faces = nullptr;
+  int cut_count = 0;
 };
 
 // Rows across (the visible part of) a light, in the light's turned frame (s across rows, t along
