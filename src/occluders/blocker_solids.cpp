@@ -51,19 +51,18 @@ BlockerSolids find_solids(const std::vector<std::array<Vec3, 3>>& triangles,
                           const std::vector<std::size_t>& mesh_ends) {
   BlockerSolids out;
   out.solid_of.assign(triangles.size(), -1);
+  out.across.assign(triangles.size(), {-1, -1, -1});
   std::size_t first = 0;
   for (const std::size_t end : mesh_ends) {
     const std::size_t count = end - first;
-    if (count < 4) {
-      first = end;
-      continue;
-    }
+    if (count == 0) continue;
     // Corners welded on the mesh's grid, and each triangle's three.
     Bounds3 box;
     for (std::size_t i = first; i < end; ++i)
       for (const Vec3& v : triangles[i]) box.extend(v);
     const double cell = std::max(box.diagonal(), 1e-300) * 1e-6;
     std::unordered_map<Key, int, KeyHash> index;
+    index.reserve(3 * count);
     std::vector<Vec3> corners;
     std::vector<std::array<int, 3>> tri(count);
     std::vector<std::uint8_t> usable(count, 1);
@@ -79,49 +78,67 @@ BlockerSolids find_solids(const std::vector<std::array<Vec3, 3>>& triangles,
       usable[i] = tri[i][0] != tri[i][1] && tri[i][1] != tri[i][2] && tri[i][0] != tri[i][2] &&
                   (t[1] - t[0]).cross(t[2] - t[0]).squaredNorm() > 0;
     }
-    // Components: triangles joined through shared edges (not corners alone: boxes that touch
-    // at a corner are two solids, and only a surface joined edge to edge is convex where it is
-    // convex at every edge).
-    std::vector<int> parent(count);
-    std::iota(parent.begin(), parent.end(), 0);
-    std::unordered_map<std::uint64_t, int> by_edge;  // undirected edge → a triangle of it
+    // Directed edges (a, b) sorted, each with its triangle and side: an edge's neighbour is the
+    // one triangle holding it the other way round, where neither direction is repeated.
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> directed(3 * count);
+    for (std::size_t i = 0; i < count; ++i)
+      for (int k = 0; k < 3; ++k)
+        directed[3 * i + std::size_t(k)] = {
+            edge_key(tri[i][std::size_t(k)], tri[i][std::size_t((k + 1) % 3)]),
+            std::uint32_t(3 * i + std::size_t(k))};
+    std::sort(directed.begin(), directed.end());
+    const auto unique_holder = [&](std::uint64_t key) -> int {
+      const auto it = std::lower_bound(directed.begin(), directed.end(),
+                                       std::pair<std::uint64_t, std::uint32_t>(key, 0));
+      if (it == directed.end() || it->first != key) return -1;
+      if (std::next(it) != directed.end() && std::next(it)->first == key) return -2;
+      return int(it->second);
+    };
+    std::vector<std::uint8_t> repeated(count, 0);  // a directed edge held twice: not closed
     for (std::size_t i = 0; i < count; ++i)
       for (int k = 0; k < 3; ++k) {
         const int a = tri[i][std::size_t(k)], b = tri[i][std::size_t((k + 1) % 3)];
-        const auto [it, added] =
-            by_edge.try_emplace(edge_key(std::min(a, b), std::max(a, b)), int(i));
-        if (added) continue;
-        const int x = find(parent, int(i)), y = find(parent, it->second);
+        const int own = unique_holder(edge_key(a, b)), other = unique_holder(edge_key(b, a));
+        if (own == -2) repeated[i] = 1;
+        if (own >= 0 && other >= 0) out.across[first + i][std::size_t(k)] = int(first) + other / 3;
+      }
+    // Components: triangles joined through shared edges (not corners alone: boxes that touch
+    // at a corner are two solids, and only a surface joined edge to edge is convex where it is
+    // convex at every edge), whichever way the edge runs in each.
+    std::vector<int> parent(count);
+    std::iota(parent.begin(), parent.end(), 0);
+    {
+      std::vector<std::pair<std::uint64_t, std::uint32_t>> undirected(directed);
+      for (auto& [key, at] : undirected) {
+        const int a = int(key >> 32), b = int(key & 0xffffffffu);
+        key = edge_key(std::min(a, b), std::max(a, b));
+      }
+      std::sort(undirected.begin(), undirected.end());
+      for (std::size_t j = 1; j < undirected.size(); ++j) {
+        if (undirected[j].first != undirected[j - 1].first) continue;
+        const int x = find(parent, int(undirected[j].second / 3)),
+                  y = find(parent, int(undirected[j - 1].second / 3));
         if (x != y) parent[std::size_t(std::max(x, y))] = std::min(x, y);
       }
-    std::unordered_map<int, std::vector<std::size_t>> members;
-    for (std::size_t i = 0; i < count; ++i) members[find(parent, int(i))].push_back(i);
-    std::vector<int> roots;
-    for (const auto& [root, list] : members) roots.push_back(root);
-    std::sort(roots.begin(), roots.end());  // a fixed order, whatever the hash's
-    for (const int root : roots) {
+    }
+    std::vector<std::vector<std::size_t>> members(count);
+    std::vector<int> position(count, -1);  // a triangle's place in its component's list
+    for (std::size_t i = 0; i < count; ++i) members[std::size_t(find(parent, int(i)))].push_back(i);
+    for (std::size_t root = 0; root < count; ++root) {  // in a fixed order
       const std::vector<std::size_t>& list = members[root];
       if (list.size() < 4) continue;
-      // Closed and consistently oriented: each directed edge once, its reverse present.
-      std::unordered_map<std::uint64_t, int> directed;  // edge → its triangle (position in list)
+      // Closed and consistently oriented: each directed edge once, its reverse present (then
+      // in the same component).
       bool closed = true;
       double volume = 0;
       for (std::size_t j = 0; j < list.size() && closed; ++j) {
         const std::size_t i = list[j];
-        closed = usable[i];
+        closed = usable[i] && !repeated[i];
+        for (int k = 0; k < 3 && closed; ++k) closed = out.across[first + i][std::size_t(k)] >= 0;
         const auto& t = triangles[first + i];
         volume += t[0].dot(t[1].cross(t[2]));
-        for (int k = 0; k < 3 && closed; ++k) {
-          const int a = tri[i][std::size_t(k)], b = tri[i][std::size_t((k + 1) % 3)];
-          closed = directed.try_emplace(edge_key(a, b), int(j)).second;
-        }
+        position[i] = int(j);
       }
-      if (closed)
-        for (const auto& [key, j] : directed)
-          if (!directed.count((key << 32) | (key >> 32))) {
-            closed = false;
-            break;
-          }
       if (!closed || !(volume > 0)) continue;
       BlockerSolid solid;
       for (std::size_t i : list)
@@ -137,21 +154,23 @@ BlockerSolids find_solids(const std::vector<std::array<Vec3, 3>>& triangles,
       }
       bool convex = true;
       std::vector<std::array<int, 4>> edges;
-      for (const auto& [key, j] : directed) {
-        const int a = int(key >> 32), b = int(key & 0xffffffffu);
-        if (a > b) continue;  // each undirected edge once, from its (a < b) direction
-        const int other = directed.at(edge_key(b, a));
-        const auto& far = tri[list[std::size_t(other)]];
-        const int c = far[0] != a && far[0] != b   ? far[0]
-                      : far[1] != a && far[1] != b ? far[1]
-                                                   : far[2];
-        if (normals[std::size_t(j)].dot(corners[std::size_t(c)] - corners[std::size_t(a)]) >
-            tolerance) {
-          convex = false;
-          break;
+      for (std::size_t j = 0; j < list.size() && convex; ++j)
+        for (int k = 0; k < 3; ++k) {
+          const std::size_t i = list[j];
+          const int a = tri[i][std::size_t(k)], b = tri[i][std::size_t((k + 1) % 3)];
+          if (a > b) continue;  // each undirected edge once, from its (a < b) direction
+          const std::size_t across = std::size_t(out.across[first + i][std::size_t(k)]) - first;
+          const int other = position[across];
+          const auto& far = tri[across];
+          const int c = far[0] != a && far[0] != b   ? far[0]
+                        : far[1] != a && far[1] != b ? far[1]
+                                                     : far[2];
+          if (normals[j].dot(corners[std::size_t(c)] - corners[std::size_t(a)]) > tolerance) {
+            convex = false;
+            break;
+          }
+          edges.push_back({a, b, int(j), other});
         }
-        edges.push_back({a, b, j, other});
-      }
       const int id = int(out.solids.size());
       for (std::size_t i : list) out.solid_of[first + i] = id;
       if (convex) {

@@ -30,9 +30,13 @@ struct BlockerSolid {
 struct BlockerSolids {
   std::vector<BlockerSolid> solids;
   std::vector<int> solid_of;  // per triangle given: the solid it belongs to, or -1
+  // Per triangle given, its neighbour across each edge (corners k, k + 1): the triangle of the
+  // same mesh holding that edge the other way round; -1 at a border, or where more than two
+  // triangles meet at the edge or two hold it the same way round.
+  std::vector<std::array<int, 3>> across;
 };
 
-// The solids among `triangles`, which come as consecutive ranges, one per mesh
+// The solids among `triangles` and their neighbours, which come as consecutive ranges, one per mesh
 // (mesh_ends[i]: one past mesh i's last triangle); a component never spans two meshes.
 // Positions are welded on a grid of 1e-6 of each mesh's size, so that UV seams do not open a
 // surface; a zero-area triangle belongs to no solid.

@@ -29,8 +29,6 @@
 #include <array>
 #include <cmath>
 #include <numbers>
-#include <tuple>
-#include <unordered_map>
 
 namespace sb {
 
@@ -59,6 +57,7 @@ struct Node {
   Box box;
   int first = 0, count = 0;  // leaf: triangles [first, first + count)
   int left = -1, right = -1;
+  int size = 0;  // triangles under it: [first, first + size)
 };
 
 struct Tri {
@@ -70,6 +69,7 @@ struct Tri {
   int solid = -1;
   int mesh = 0;                 // which blocker mesh it is of
   std::array<int, 3> across{};  // the triangle across edge (v[k], v[k+1]), or -1
+  int source = 0;               // its index before the hierarchy's build reordered them
 };
 
 // A convex polygon being clipped: a triangle cut by at most 13 planes keeps at most 16 corners.
@@ -109,51 +109,6 @@ struct ShaftCuller::Impl {
   };
   std::vector<MeshInfo> meshes;  // per blocker mesh
 
-  // Each triangle's neighbour across each edge: the triangle of the same mesh that has the edge
-  // the other way round (corners welded on a grid of 1e-6 of the mesh's size, so that UV seams
-  // do not part them); -1 at a border, or where more than two triangles meet.
-  void link_neighbours() {
-    std::vector<Bounds3> boxes;
-    for (const Tri& t : tris) {
-      if (std::size_t(t.mesh) >= boxes.size()) boxes.resize(std::size_t(t.mesh) + 1);
-      for (const Vec3& v : t.v) boxes[std::size_t(t.mesh)].extend(v);
-    }
-    using Corner = std::array<std::int64_t, 3>;
-    const auto corner = [&](const Tri& t, int k) {
-      const Bounds3& box = boxes[std::size_t(t.mesh)];
-      const Vec3 q = (t.v[k] - box.lo) / std::max(box.diagonal() * 1e-6, 1e-300);
-      return Corner{std::llround(q.x()), std::llround(q.y()), std::llround(q.z())};
-    };
-    struct Hash {
-      std::size_t operator()(const std::tuple<int, Corner, Corner>& e) const {
-        std::uint64_t h = std::uint64_t(std::get<0>(e)) * 0x9E3779B97F4A7C15ull;
-        for (const Corner* c : {&std::get<1>(e), &std::get<2>(e)})
-          for (std::int64_t x : *c) h = (h ^ std::uint64_t(x)) * 0xBF58476D1CE4E5B9ull + (h >> 29);
-        return std::size_t(h);
-      }
-    };
-    std::unordered_map<std::tuple<int, Corner, Corner>, int, Hash> directed;
-    std::unordered_map<std::tuple<int, Corner, Corner>, int, Hash> repeated;
-    for (std::size_t i = 0; i < tris.size(); ++i) {
-      tris[i].across = {-1, -1, -1};
-      for (int k = 0; k < 3; ++k) {
-        const auto key =
-            std::make_tuple(tris[i].mesh, corner(tris[i], k), corner(tris[i], (k + 1) % 3));
-        if (!directed.try_emplace(key, int(i)).second) repeated[key] = 1;
-      }
-    }
-    for (std::size_t i = 0; i < tris.size(); ++i)
-      for (int k = 0; k < 3; ++k) {
-        const auto key =
-            std::make_tuple(tris[i].mesh, corner(tris[i], (k + 1) % 3), corner(tris[i], k));
-        const auto it = directed.find(key);
-        const auto own =
-            std::make_tuple(tris[i].mesh, corner(tris[i], k), corner(tris[i], (k + 1) % 3));
-        if (it != directed.end() && !repeated.count(key) && !repeated.count(own))
-          tris[i].across[std::size_t(k)] = it->second;
-      }
-  }
-
   int build(int first, int count) {
     Node node;
     Box centroids;
@@ -165,6 +120,7 @@ struct ShaftCuller::Impl {
     }
     node.first = first;
     node.count = count;
+    node.size = count;
     const int index = int(nodes.size());
     nodes.push_back(node);
     if (count <= kLeafSize) return index;
@@ -317,14 +273,15 @@ struct ShaftCuller::Impl {
   // shaft that misses it.
   bool in_shaft(const Tri& t, const Box& apex, const std::vector<Plane>& planes,
                 const std::array<Vec3, 8>& base, int corners, const Light& light, Clip& poly,
-                Clip& scratch, bool clip_it = true) const {
+                Clip& scratch, bool clip_it = true, bool inside = false) const {
     if (t.normal.isZero()) return false;
     // The triangle's box wholly outside one plane: nothing of it is in the shaft.
-    for (const Plane& pl : planes) {
-      const Vec3 near(pl.n.x() >= 0 ? t.lo.x() : t.hi.x(), pl.n.y() >= 0 ? t.lo.y() : t.hi.y(),
-                      pl.n.z() >= 0 ? t.lo.z() : t.hi.z());
-      if (pl.eval(near) > 0) return false;
-    }
+    if (!inside)
+      for (const Plane& pl : planes) {
+        const Vec3 near(pl.n.x() >= 0 ? t.lo.x() : t.hi.x(), pl.n.y() >= 0 ? t.lo.y() : t.hi.y(),
+                        pl.n.z() >= 0 ? t.lo.z() : t.hi.z());
+        if (pl.eval(near) > 0) return false;
+      }
     if (t.solid >= 0) {
       // Of a closed solid, seen from outside its box: a ray enters it through a triangle facing
       // the ray's origin before it meets one facing away, so those facing away add nothing.
@@ -336,6 +293,7 @@ struct ShaftCuller::Impl {
       if (outside && t.normal.dot(p - t.v[0]) + spread < 0) return false;
     }
     if (same_side(t, apex, base, corners, light)) return false;
+    if (inside && !clip_it) return true;  // within every plane: listed
     if (!clip_it && meshes[std::size_t(t.mesh)].count > ShaftCuller::kDenseMesh) {
       // Listed only, of a dense mesh (whose union's outline is taken, not its triangles): kept
       // unless its corners all lie outside one plane (conservative, and much cheaper).
@@ -381,9 +339,9 @@ struct ShaftCuller::Impl {
     stack[top++] = 0;
     while (top > 0) {
       const Node& node = nodes[std::size_t(stack[--top])];
-      bool outside = false;
+      bool outside = false, inside = true;
       for (const Plane& pl : planes) {
-        // The box's corner least far along the plane's normal.
+        // The box's corner least far along the plane's normal, and the farthest.
         const Vec3 near(pl.n.x() >= 0 ? node.box.lo.x() : node.box.hi.x(),
                         pl.n.y() >= 0 ? node.box.lo.y() : node.box.hi.y(),
                         pl.n.z() >= 0 ? node.box.lo.z() : node.box.hi.z());
@@ -391,12 +349,23 @@ struct ShaftCuller::Impl {
           outside = true;
           break;
         }
+        if (inside) inside = pl.eval(node.box.lo + node.box.hi - near) <= 0;
       }
       if (outside) continue;
+      if (inside && !clip_it) {
+        // Listing a tile's candidates: all of the node lies within the planes, so only the
+        // tests of facing and side remain, triangle by triangle.
+        for (int i = node.first; i < node.first + node.size; ++i)
+          if (in_shaft(tris[std::size_t(i)], apex, planes, base, corners, light, poly, scratch,
+                       clip_it, /*inside=*/true) &&
+              !visit(std::uint32_t(i), poly))
+            return kStopped;
+        continue;
+      }
       if (node.count == 0) {
         if (top + 2 > 64) return kUndecided;  // deeper than any balanced tree: keep, to be safe
-        stack[top++] = node.left;
         stack[top++] = node.right;
+        stack[top++] = node.left;  // first: triangles are visited in the order of their index
         continue;
       }
       for (int i = node.first; i < node.first + node.count; ++i)
@@ -448,6 +417,7 @@ ShaftCuller::ShaftCuller(const std::vector<const Mesh*>& blockers)
       const Triangle tri = triangle(m->mesh, f);
       Tri t;
       t.mesh = int(mesh_ends.size());
+      t.source = int(impl_->tris.size());
       for (int k = 0; k < 3; ++k) t.v[k] = tri.p[k];
       const Vec3 cross = (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]);
       const double len = cross.norm();
@@ -466,12 +436,29 @@ ShaftCuller::ShaftCuller(const std::vector<const Mesh*>& blockers)
     impl_->nodes.reserve(2 * impl_->tris.size() / kLeafSize + 2);
     impl_->build(0, int(impl_->tris.size()));
   }
-  impl_->link_neighbours();
+  // Neighbours across edges, renumbered to where the build put each triangle.
+  std::vector<int> where(impl_->tris.size());
+  for (std::size_t i = 0; i < impl_->tris.size(); ++i)
+    where[std::size_t(impl_->tris[i].source)] = int(i);
+  for (Tri& t : impl_->tris)
+    for (int k = 0; k < 3; ++k) {
+      const int n = found.across[std::size_t(t.source)][std::size_t(k)];
+      t.across[std::size_t(k)] = n < 0 ? -1 : where[std::size_t(n)];
+    }
   impl_->meshes.resize(mesh_ends.size());
   for (const Tri& t : impl_->tris) {
     Impl::MeshInfo& m = impl_->meshes[std::size_t(t.mesh)];
     for (const Vec3& v : t.v) m.bounds.extend(v);
     ++m.count;
+  }
+  keys_.reserve(impl_->tris.size());
+  for (std::size_t i = 0; i < impl_->tris.size(); ++i) {
+    const Tri& t = impl_->tris[i];
+    keys_.push_back(t.solid >= 0 && impl_->solids[std::size_t(t.solid)].convex
+                        ? kSolidKey | std::uint32_t(t.solid)
+                    : impl_->meshes[std::size_t(t.mesh)].count > kDenseMesh
+                        ? kMeshKey | std::uint32_t(t.mesh)
+                        : std::uint32_t(i));
   }
 }
 
@@ -540,15 +527,6 @@ bool ShaftCuller::maybe_blocked(const Vec3& origin, const Vec3& surface, const V
 const BlockerSolid* ShaftCuller::solid(std::uint32_t triangle) const {
   const int s = impl_->tris[triangle].solid;
   return s < 0 ? nullptr : &impl_->solids[std::size_t(s)];
-}
-
-std::uint32_t ShaftCuller::blocker_key(std::uint32_t triangle) const {
-  const Tri& t = impl_->tris[triangle];
-  if (t.solid >= 0 && impl_->solids[std::size_t(t.solid)].convex)
-    return kSolidKey | std::uint32_t(t.solid);
-  if (impl_->meshes[std::size_t(t.mesh)].count > kDenseMesh)
-    return kMeshKey | std::uint32_t(t.mesh);
-  return triangle;
 }
 
 Bounds3 ShaftCuller::key_bounds(std::uint32_t key) const {

@@ -92,7 +92,7 @@ class ShaftCuller {
   static constexpr std::uint32_t kSolidKey = 0x80000000u;
   static constexpr std::uint32_t kMeshKey = 0x40000000u;
   static constexpr std::size_t kDenseMesh = 256;
-  std::uint32_t blocker_key(std::uint32_t triangle) const;
+  std::uint32_t blocker_key(std::uint32_t triangle) const { return keys_[triangle]; }
   Bounds3 key_bounds(std::uint32_t key) const;
   const BlockerSolid& solid_of_key(std::uint32_t key) const;
   const Vec3& triangle_normal(std::uint32_t triangle) const;
@@ -100,6 +100,7 @@ class ShaftCuller {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  std::vector<std::uint32_t> keys_;  // per triangle, its blocker_key (read in inner loops)
 };
 
 }  // namespace sb

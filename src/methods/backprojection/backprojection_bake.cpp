@@ -213,8 +213,8 @@ TileBlockers tile_blockers(const ShaftCuller& culler, const Light& light,
       for (std::size_t f = 0; f < solid.faces.size(); ++f) {
         double lo = std::numeric_limits<double>::infinity(), hi = -lo;
         for (int j = 0; j < 3; ++j) {
-          const double h = light.normal().dot(solid.corners[std::size_t(solid.faces[f][std::size_t(j)])] -
-                                              light.centre());
+          const double h = light.normal().dot(
+              solid.corners[std::size_t(solid.faces[f][std::size_t(j)])] - light.centre());
           lo = std::min(lo, h), hi = std::max(hi, h);
         }
         if ((lo < offset && hi > offset) || (lo < h_hi && hi > h_lo)) cuts.push_back(int(f));

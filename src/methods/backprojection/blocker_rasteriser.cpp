@@ -375,6 +375,21 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
       // cross them, or all): a ray inside that outline enters the part.
       thread_local std::vector<std::pair<Vec2, Vec2>> outline;
       outline.clear();
+      // How near the outline's segments that cross the light's box lie (as for a silhouette,
+      // below): a crate beside a texel on the floor is near, but its outline's edges that hide
+      // some of the light may not be.
+      double edge_distance = kInfinity;
+      const auto add_segment = [&](const Vec3& a, const Vec3& b) {
+        const Vec2 p = project(a), q = project(b);
+        outline.emplace_back(p, q);
+        if (std::max(p.y(), q.y()) < t_first || std::min(p.y(), q.y()) > t_last ||
+            std::max(p.x(), q.x()) < extent_lo || std::min(p.x(), q.x()) > extent_hi)
+          return;
+        const Vec3 ab = b - a;
+        const double along =
+            std::clamp((origin - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
+        edge_distance = std::min(edge_distance, (a + along * ab - origin).norm());
+      };
       const auto levels = {f.clip_height, h_top};
       for (const int e : silhouette) {
         Vec3 a = solid.corners[std::size_t(solid.edges[std::size_t(e)][0])];
@@ -391,14 +406,15 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
             b = cut, hb = level;
           }
         }
-        outline.emplace_back(project(a), project(b));
+        add_segment(a, b);
       }
       const int cuts = ref.cut_faces ? ref.cut_count : int(solid.faces.size());
       for (int k = 0; k < cuts; ++k) {
         const auto& face = solid.faces[std::size_t(ref.cut_faces ? ref.cut_faces[k] : k)];
         std::array<double, 3> h;
         for (int j = 0; j < 3; ++j)
-          h[std::size_t(j)] = f.normal.dot(solid.corners[std::size_t(face[std::size_t(j)])] - f.centre);
+          h[std::size_t(j)] =
+              f.normal.dot(solid.corners[std::size_t(face[std::size_t(j)])] - f.centre);
         for (const double level : levels) {
           Vec3 ends[2];
           int found_ends = 0;
@@ -409,7 +425,7 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
             const Vec3& b = solid.corners[std::size_t(face[std::size_t((j + 1) % 3)])];
             ends[found_ends++] = a + (b - a) * ((level - ha) / (hb - ha));
           }
-          if (found_ends == 2) outline.emplace_back(project(ends[0]), project(ends[1]));
+          if (found_ends == 2) add_segment(ends[0], ends[1]);
         }
       }
       if (outline.empty()) continue;
@@ -425,8 +441,12 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
       begin(lo_t, hi_t);
       for (const auto& [p, q] : outline) edge(p, q);
       const bool reaches = commit() || outline_in_light;
-      if (covers) out.umbra = ref.key;
-      found(reaches, gap, ref.key);
+      if (covers) {
+        out.umbra = ref.key;
+        found(reaches, gap, ref.key);
+      } else {
+        found(reaches, std::max(gap, std::isfinite(edge_distance) ? edge_distance : gap), ref.key);
+      }
       continue;
     }
     if (silhouette.empty() || t_hi < t_first || t_lo > t_last || s_hi < extent_lo ||
@@ -448,8 +468,8 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
         continue;
       const Vec3& a = solid.corners[std::size_t(ends[0])];
       const Vec3 ab = solid.corners[std::size_t(ends[1])] - a;
-      const double along = std::clamp((origin - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300),
-                                      0.0, 1.0);
+      const double along =
+          std::clamp((origin - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
       edge_distance = std::min(edge_distance, (a + along * ab - origin).norm());
     }
     const bool reaches = commit() || corner_in_light;

@@ -136,8 +136,12 @@ BlockerOutline prepare_outline(const ShaftCuller& culler, const Light& light,
     h_top = std::min(h_top, n.dot(c - light.centre()) * (1 - 1e-9));
   }
   const Vec3 centre = origins.centre(), half = 0.5 * (origins.hi - origins.lo);
-  // The triangles of the union and how each faces the tile (1, 0, -1 mixed), sorted by index.
-  std::vector<std::pair<std::uint32_t, std::int8_t>> set;
+  // The triangles of the union and how each faces the tile (1, 0, -1 mixed), marked in a memo
+  // by triangle index.
+  thread_local FacingMemo memo;
+  memo.begin(culler.triangle_count());
+  thread_local std::vector<std::uint32_t> set;
+  set.clear();
   for (std::uint32_t t : triangles) {
     const Vec3* c = culler.triangle_corners(t);
     bool within = true;
@@ -153,32 +157,33 @@ BlockerOutline prepare_outline(const ShaftCuller& culler, const Light& light,
     }
     const Vec3& normal = culler.triangle_normal(t);
     const double mid = normal.dot(centre - c[0]), spread = half.dot(normal.cwiseAbs());
-    set.push_back({t, std::int8_t(mid - spread > 0 ? 1 : mid + spread < 0 ? 0 : -1)});
+    memo.stamp[t] = memo.generation;
+    memo.facing[t] = std::int8_t(mid - spread > 0 ? 1 : mid + spread < 0 ? 0 : -1);
+    set.push_back(t);
   }
-  std::sort(set.begin(), set.end());
-  const auto find = [&](int t) -> const std::pair<std::uint32_t, std::int8_t>* {
-    if (t < 0) return nullptr;
-    const auto it = std::lower_bound(set.begin(), set.end(),
-                                     std::pair<std::uint32_t, std::int8_t>(std::uint32_t(t), -2));
-    return it != set.end() && it->first == std::uint32_t(t) ? &*it : nullptr;
-  };
-  for (const auto& [t, facing] : set)
+  std::sort(set.begin(), set.end());  // edges in a fixed order, whatever the candidates' order
+  for (const std::uint32_t t : set) {
+    const std::int8_t facing = memo.facing[t];
     for (int k = 0; k < 3; ++k) {
       OutlineEdge e;
       e.triangle = t;
-      e.edge = std::int8_t(k);
       e.facing = facing;
-      const auto* across = find(culler.neighbour(t, k));
-      if (across) {
-        if (facing >= 0 && across->second >= 0) {
-          if (facing == across->second) continue;  // cancelled for every texel of the tile
+      const int across = culler.neighbour(t, k);
+      if (across >= 0 && memo.stamp[std::size_t(across)] == memo.generation) {
+        const std::int8_t other = memo.facing[std::size_t(across)];
+        if (facing >= 0 && other >= 0) {
+          if (facing == other) continue;  // cancelled for every texel of the tile
         } else {
-          e.across = std::int32_t(across->first);
-          e.across_facing = across->second;
+          e.across = std::int32_t(across);
+          e.across_facing = other;
         }
       }
+      const Vec3* c = culler.triangle_corners(t);
+      e.a = c[k];
+      e.b = c[(k + 1) % 3];
       out.edges.push_back(e);
     }
+  }
   return out;
 }
 
@@ -255,8 +260,7 @@ void rasterise_outline(const RasterTarget& target, const BlockerOutline& outline
             e.across_facing >= 0 ? e.across_facing : facing_of(std::uint32_t(e.across));
         if (other == facing) continue;
       }
-      const Vec3* c = culler.triangle_corners(e.triangle);
-      crossings.add(rows, project(c[e.edge]), project(c[(e.edge + 1) % 3]), facing ? turn : -turn);
+      crossings.add(rows, project(e.a), project(e.b), facing ? turn : -turn);
     }
   }
   if (crossings.commit(rows, *target.blocked)) {

@@ -63,8 +63,8 @@ struct LightRows {
 
 // One edge of a dense mesh's triangle that may bound the union of a tile's triangles of it.
 struct OutlineEdge {
+  Vec3 a, b;  // its ends, copied: a tile's edges are read in order, not from all of the mesh
   std::uint32_t triangle = 0;
-  std::int8_t edge = 0;  // from corner `edge` to the next
   // Whether the triangle faces every ray origin of the tile (1) or none (0); -1: some, so
   // decided per texel.
   std::int8_t facing = -1;
