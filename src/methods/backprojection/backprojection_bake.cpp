@@ -242,6 +242,9 @@ TileBlockers tile_blockers(const ShaftCuller& culler, const Light& light,
 }
 
 // Stage 2's exact evaluations of one uniform light (texel_refinement.h's PairSource).
+// A light whose form factor at a texel is below this shows it a sliver at its horizon.
+constexpr double kSliver = 1e-8;
+
 class LightPairs final : public PairSource {
  public:
   LightPairs(const TexelSpace& space, const Light& light, const BackprojectionInputs& in,
@@ -268,6 +271,24 @@ class LightPairs final : public PairSource {
     out = PairSample();
     const double form_factor = light_.form_factor(p, n);
     if (!(form_factor > 0)) return;
+    // A sliver of light at the texel's horizon (F below 1e-8: a texel on an edge, or near a
+    // curved blocker's terminator): whether geometry within a hair of the ray origin hides it
+    // is the rays' call, so the texel takes the reference's own estimate, as a texel whose
+    // visible part is too thin for the estimator's rows does.
+    const auto sliver = [&] {
+      thread_local ShadowRays batch(in_.samples);
+      thread_local std::vector<Vec2> strata;
+      Vec3 v;
+      out = PairSample();
+      if (!estimate_visibility(tx, light_, *in_.rays, in_.samples, in_.seed, in_.stream,
+                               space_.width, batch, strata, &v))
+        return;
+      out.route = TexelRoute::traced;
+      out.visibility = float(v.x());
+      // Nothing listed, as nothing hides the sliver, or a blocker at an unknown distance.
+      out.nearest = v.x() == 1 ? std::numeric_limits<float>::infinity() : 0.0f;
+    };
+    if (form_factor < kSliver) return sliver();
     // The blockers: the tile's candidates as they are (the estimator cuts what lies beyond the
     // light or behind the origin, and ignores what projects outside the light), or, for a tile
     // without a list, the texel's own shaft's polygons from the whole hierarchy.
@@ -286,8 +307,9 @@ class LightPairs final : public PairSource {
           origin, p, n, light_, nullptr, std::size_t(in_.max_polygons), polygons);
       if (listed == ShaftCuller::Polygons::too_many) {
         sample = estimator_.visibility_traced(p, n, origin, *in_.rays, form_factor);
-        if (!sample.contributes) return;  // no part of the light above the horizon after all
+        if (!sample.contributes) return sliver();
         out.route = TexelRoute::traced;
+        out.listed = false;
         out.visibility = float(sample.visibility);
         out.nearest = float(sample.nearest_blocker);
         return;
@@ -299,10 +321,7 @@ class LightPairs final : public PairSource {
       sample = estimator_.visibility(p, n, origin, Blockers{&blockers, nullptr, nullptr},
                                      form_factor, &out.triangles);
     }
-    if (!sample.contributes) {  // no part of the light above the horizon after all: left out
-      out = PairSample();
-      return;
-    }
+    if (!sample.contributes) return sliver();  // no rows above the horizon: a sliver
     // Nothing hid any of the light: exactly 1, as a clear shaft.
     out.route = out.triangles.empty() ? TexelRoute::clear : TexelRoute::exact;
     out.visibility = float(sample.visibility);
@@ -357,7 +376,7 @@ class LightPairs final : public PairSource {
     for (std::uint32_t i : tiles_.candidates[tile]) {
       const std::uint32_t key = in_.culler->blocker_key(i);
       if (std::binary_search(listed.begin(), listed.end(), key)) continue;
-      if (key != i) {
+      if (key & ShaftCuller::kSolidKey) {
         const Bounds3 box = in_.culler->key_bounds(key);
         if (!outside(box, origins.lo) && !outside(box, origins.hi)) continue;
       }

@@ -289,8 +289,18 @@ const LightRows& PenumbraEstimator::rows_for(const LightFrame& f, const Vec3& po
       hi = chord_half(t, f.radius);
       lo = -hi;
     }
+    // Only the part above the horizon: the cells of a row then resolve what the texel sees of
+    // it, however small a sliver of the chord that is.
+    const double cut = beta * t + gamma;
+    if (alpha > 0) {
+      lo = std::max(lo, -cut / alpha);
+    } else if (alpha < 0) {
+      hi = std::min(hi, -cut / alpha);
+    } else if (cut < 0) {
+      hi = lo;
+    }
     scratch.enter[std::size_t(r)] = lo;
-    scratch.leave[std::size_t(r)] = hi;
+    scratch.leave[std::size_t(r)] = std::max(lo, hi);
   }
   return scratch;
 }

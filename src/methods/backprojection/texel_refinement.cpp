@@ -172,9 +172,10 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
     if (std::isfinite(distance) &&
         (distance - box.diagonal()) * width < settings.feature_cells * s * texel_extent)
       return false;
-    // A traced sample lists nothing: the distance bound above is all there is to go on.
+    // A sample traced past the estimator's budget lists nothing: the distance bound above is
+    // all there is to go on.
     for (int k = 0; k < 5; ++k)
-      if (field.route[std::size_t(at[std::size_t(k)])] == TexelRoute::traced) return true;
+      if (!sample_at(std::size_t(at[std::size_t(k)])).listed) return true;
     thread_local std::vector<std::size_t> inside;
     inside.clear();
     for (int y = c.y0; y < c.y0 + s; ++y)

@@ -57,6 +57,9 @@ struct PairSample {
   // The blockers (ShaftCuller::blocker_key: triangles, or convex solids) that reach the light
   // from the texel, sorted, when listed.
   std::vector<std::uint32_t> triangles;
+  // False where the blockers were not listed (a shaft traced past the estimator's budget):
+  // then the distance bound is all the refinement has to go on.
+  bool listed = true;
   // A convex solid that hides all of the light by itself, or PenumbraSample::kNoUmbra.
   std::uint32_t umbra = 0xffffffffu;
 };
