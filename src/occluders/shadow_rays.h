@@ -22,6 +22,7 @@ class ShadowRays {
         weights_(std::size_t(capacity)),
         hit_(std::size_t(capacity)) {}
 
+  int capacity() const { return int(origins_.size()); }
   void clear() {
     n_ = 0;
     weight_sum_ = Vec3::Zero();

@@ -25,13 +25,6 @@ namespace sb {
 
 namespace {
 
-// Whether p lies outside the box, by more than a hundredth of its size.
-bool outside(const Bounds3& box, const Vec3& p) {
-  const double margin = 0.01 * box.diagonal();
-  return ((box.lo.array() - margin) > p.array()).any() ||
-         ((box.hi.array() + margin) < p.array()).any();
-}
-
 Vec3 ray_origin(const Texel& t, double offset) {
   return t.shadow_origin.cast<double>() + offset * t.geometric_normal.cast<double>();
 }
@@ -244,6 +237,9 @@ TileBlockers tile_blockers(const ShaftCuller& culler, const Light& light,
 // Stage 2's exact evaluations of one uniform light (texel_refinement.h's PairSource).
 // A light whose form factor at a texel is below this shows it a sliver at its horizon.
 constexpr double kSliver = 1e-8;
+// A ray origin this far from its texel, relative to a sphere light's distance, sees the sphere's
+// near side shifted by a hundredth of its radius or more.
+constexpr double kParallax = 1e-2;
 
 class LightPairs final : public PairSource {
  public:
@@ -276,7 +272,9 @@ class LightPairs final : public PairSource {
     // is the rays' call, so the texel takes the reference's own estimate, as a texel whose
     // visible part is too thin for the estimator's rows does.
     const auto sliver = [&] {
-      thread_local ShadowRays batch(in_.samples);
+      // One batch per thread, grown to the bake's samples (an earlier bake may have had fewer).
+      thread_local ShadowRays batch(0);
+      if (batch.capacity() < in_.samples) batch = ShadowRays(in_.samples);
       thread_local std::vector<Vec2> strata;
       Vec3 v;
       out = PairSample();
@@ -289,6 +287,24 @@ class LightPairs final : public PairSource {
       out.nearest = v.x() == 1 ? std::numeric_limits<float>::infinity() : 0.0f;
     };
     if (form_factor < kSliver) return sliver();
+    // The rows' fixed points traced (PenumbraEstimator::visibility_traced).
+    const auto traced = [&] {
+      const PenumbraSample sample =
+          estimator_.visibility_traced(p, n, origin, *in_.rays, form_factor);
+      if (!sample.contributes) return sliver();
+      out.route = TexelRoute::traced;
+      out.listed = false;
+      out.visibility = float(sample.visibility);
+      out.nearest = float(sample.nearest_blocker);
+    };
+    // A sphere light seen from a ray origin lifted far from the texel (a coarse mesh's smooth
+    // surface): the reference aims its rays from the origin at the sphere's near side as the
+    // texel sees it, which the origin sees shifted by parallax, where the rows see the
+    // silhouette's disk. Where the shift is a noticeable part of the sphere's radius, the rows'
+    // fixed points are traced to where the reference aims.
+    if (light_.shape() == LightShape::sphere &&
+        (origin - p).norm() > kParallax * (light_.centre() - p).norm())
+      return traced();
     // The blockers: the tile's candidates as they are (the estimator cuts what lies beyond the
     // light or behind the origin, and ignores what projects outside the light), or, for a tile
     // without a list, the texel's own shaft's polygons from the whole hierarchy.
@@ -305,15 +321,7 @@ class LightPairs final : public PairSource {
     } else {
       const ShaftCuller::Polygons listed = in_.culler->shaft_polygons(
           origin, p, n, light_, nullptr, std::size_t(in_.max_polygons), polygons);
-      if (listed == ShaftCuller::Polygons::too_many) {
-        sample = estimator_.visibility_traced(p, n, origin, *in_.rays, form_factor);
-        if (!sample.contributes) return sliver();
-        out.route = TexelRoute::traced;
-        out.listed = false;
-        out.visibility = float(sample.visibility);
-        out.nearest = float(sample.nearest_blocker);
-        return;
-      }
+      if (listed == ShaftCuller::Polygons::too_many) return traced();
       for (const ShaftPolygon& poly : polygons)
         blockers.push_back({poly.v.data(), poly.count, poly.normal, poly.triangle});
       // The union of what samples see is kept by key (a solid's triangles as the solid).
@@ -366,19 +374,18 @@ class LightPairs final : public PairSource {
       }
       return false;
     }
-    // The tile's candidates no sample listed, but for those of a convex solid the texels lie on
-    // (their own surface: a ray that leaves it above the horizon does not come back to it, and
-    // where it grazes it the samples listed it).
-    Bounds3 origins;
-    for (std::size_t t : texels) origins.extend(ray_origin(space_.texels[t], offset_));
+    // The tile's candidates no sample listed, but for those of a convex solid every texel lies
+    // on (their own surface: a ray that leaves it above the horizon does not come back to it,
+    // and where it grazes it the samples listed it).
     thread_local std::vector<std::uint32_t> unlisted;
     unlisted.clear();
+    std::uint32_t on_key = 0, off_key = 0;  // the last solid found to hold the texels, or not
     for (std::uint32_t i : tiles_.candidates[tile]) {
       const std::uint32_t key = in_.culler->blocker_key(i);
       if (std::binary_search(listed.begin(), listed.end(), key)) continue;
       if (key & ShaftCuller::kSolidKey) {
-        const Bounds3 box = in_.culler->key_bounds(key);
-        if (!outside(box, origins.lo) && !outside(box, origins.hi)) continue;
+        if (key != on_key && key != off_key) (on_solid(key, texels) ? on_key : off_key) = key;
+        if (key == on_key) continue;
       }
       unlisted.push_back(i);
     }
@@ -393,6 +400,29 @@ class LightPairs final : public PairSource {
   }
 
  private:
+  // Whether every one of the texels' ray origins lies on the convex solid `key` (or in it): in
+  // front of none of its face planes by more than the rays' offset, four times over, or a
+  // five-hundredth of its size (a curved surface's shadow origins lie on the smooth surface,
+  // outside its flat faces by their sagitta).
+  bool on_solid(std::uint32_t key, const std::vector<std::size_t>& texels) const {
+    const BlockerSolid& solid = in_.culler->solid_of_key(key);
+    const double tolerance = std::max(4 * offset_, 2e-3 * solid.bounds.diagonal());
+    for (std::size_t t : texels) {  // first its box, cheaply
+      const Vec3 origin = ray_origin(space_.texels[t], offset_);
+      if (((solid.bounds.lo.array() - tolerance) > origin.array()).any() ||
+          ((solid.bounds.hi.array() + tolerance) < origin.array()).any())
+        return false;
+    }
+    for (std::size_t t : texels) {
+      const Vec3 origin = ray_origin(space_.texels[t], offset_);
+      for (std::size_t f = 0; f < solid.faces.size(); ++f)
+        if (solid.normals[f].dot(origin - solid.corners[std::size_t(solid.faces[f][0])]) >
+            tolerance)
+          return false;
+    }
+    return true;
+  }
+
   const TexelSpace& space_;
   const Light& light_;
   const BackprojectionInputs& in_;

@@ -39,9 +39,9 @@
 // and the light's weight is integrated over the same rows (V = 1 − hidden / total), so that a
 // sliver of light above a grazing horizon, thinner than a row, is still resolved.
 //
-// A sphere is seen from the texel as the disk of its silhouette, whose plane is the shaft's base
-// (shaft_culling.cpp); uniform in solid angle, its points weigh cosθ_y·dω = cosθ_y·(h/ℓ)·dA/ℓ², the
-// same form with h the plane's distance.
+// A sphere is seen from the texel as the disk of its silhouette (just beyond the shaft's base,
+// shaft_culling.cpp: the same disk seen from the ray origin); uniform in solid angle, its points
+// weigh cosθ_y·dω = cosθ_y·(h/ℓ)·dA/ℓ², the same form with h the plane's distance.
 #include "methods/backprojection/penumbra_estimator.h"
 
 #include "methods/backprojection/light_rows.h"
@@ -190,7 +190,7 @@ double PenumbraEstimator::chord_half(double t, double radius) const {
   return std::sqrt(std::max(0.0, radius * radius - t * t));
 }
 
-bool PenumbraEstimator::frame(const Vec3& origin, LightFrame& f) const {
+bool PenumbraEstimator::frame(const Vec3& position, LightFrame& f) const {
   const Light& light = *light_;
   if (light.shape() != LightShape::sphere) {
     f.centre = light.centre();
@@ -201,13 +201,15 @@ bool PenumbraEstimator::frame(const Vec3& origin, LightFrame& f) const {
     f.clip_height = light_offset_;
     return true;
   }
-  // The silhouette of the sphere seen from the ray origin: a disk of radius R·√(D² − R²)/D at
-  // (D² − R²)/D from it, the shaft's base.
-  const Vec3 to = light.centre() - origin;
+  // The silhouette of the sphere seen from the texel, as the reference samples it: a disk of
+  // radius R·√(D² − R²)/D at (D² − R²)/D from it. Blockers are projected onto it from the ray
+  // origin, whose shaft holds every ray from there to it outside the sphere (the origin's own
+  // silhouette disk, the shaft's base, lies beyond the sphere's near side).
+  const Vec3 to = light.centre() - position;
   const double dist = to.norm(), radius = light.desc().radius;
   if (!(dist > radius * (1 + 1e-9))) return false;
   const Vec3 axis = to / dist;
-  f.centre = origin + axis * ((dist * dist - radius * radius) / dist);
+  f.centre = position + axis * ((dist * dist - radius * radius) / dist);
   f.normal = -axis;
   const Vec3 a = any_orthogonal(axis), b = axis.cross(a);
   const double c = std::cos(kRowAngle), s = std::sin(kRowAngle);
@@ -402,7 +404,7 @@ PenumbraSample PenumbraEstimator::visibility(const Vec3& position, const Vec3& n
   PenumbraSample out;
   out.nearest_blocker = kInfinity;
   LightFrame f;
-  if (!frame(origin, f)) return out;
+  if (!frame(position, f)) return out;
   LightRows scratch;
   const LightRows& rows = rows_for(f, position, normal, scratch);
   BlockedRows blocked;
@@ -428,7 +430,7 @@ PenumbraSample PenumbraEstimator::visibility_traced(const Vec3& position, const 
                                                     double form_factor) const {
   PenumbraSample out;
   LightFrame f;
-  if (!frame(origin, f)) return out;
+  if (!frame(position, f)) return out;
   LightRows scratch;
   const LightRows& rows = rows_for(f, position, normal, scratch);
   // One ray per pair of cells, to the middle of the pair on the row's centre line, stopping the
@@ -446,18 +448,19 @@ PenumbraSample PenumbraEstimator::visibility_traced(const Vec3& position, const 
     const double cell = (rows.leave[std::size_t(r)] - enter) / kCells;
     for (int k = 0; k < kPairs; ++k) {
       const std::size_t i = std::size_t(r) * kPairs + std::size_t(k);
-      const Vec3 d = f.centre + (enter + (2 * k + 1) * cell) * f.s_axis + t * f.t_axis - origin;
-      double length = 1;
+      const Vec3 x = f.centre + (enter + (2 * k + 1) * cell) * f.s_axis + t * f.t_axis;
+      Vec3 d = x - origin;
       if (light_->shape() == LightShape::sphere) {
-        // Where the ray enters the sphere, before the silhouette's plane.
-        const Vec3 oc = origin - light_->centre();
-        const double a = d.squaredNorm(), b = oc.dot(d), c = oc.squaredNorm() - radius * radius;
+        // The point of the sphere the texel sees through x, on its near side (where the
+        // reference aims: Light::above_horizon's samples), before the silhouette's plane.
+        const Vec3 e = x - position, pc = position - light_->centre();
+        const double a = e.squaredNorm(), b = pc.dot(e), c = pc.squaredNorm() - radius * radius;
         const double disc = b * b - a * c;
-        if (disc > 0) length = std::clamp((-b - std::sqrt(disc)) / a, 0.0, 1.0);
+        if (disc > 0) d = position + std::clamp((-b - std::sqrt(disc)) / a, 0.0, 1.0) * e - origin;
       }
-      const double norm = d.norm() * length;
+      const double norm = d.norm();
       directions[i] = d;
-      lengths[i] = norm > 2 * offset ? length * (1 - offset / norm) : 0.0;
+      lengths[i] = norm > 2 * offset ? 1 - offset / norm : 0.0;
     }
   }
   scene.occluded(int(origins.size()), origins.data(), directions.data(), lengths.data(),

@@ -160,7 +160,7 @@ class PenumbraEstimator {
   double weight_bias = 1.0;
 
  private:
-  bool frame(const Vec3& origin, LightFrame& f) const;
+  bool frame(const Vec3& position, LightFrame& f) const;
   // The rows for a texel: the light's own where all of it is above the texel's horizon, else
   // rows spread over the part above (so a sliver of light near the horizon has all of them).
   const LightRows& rows_for(const LightFrame& f, const Vec3& position, const Vec3& normal,

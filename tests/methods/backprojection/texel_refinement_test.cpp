@@ -3,6 +3,7 @@
 // kink between samples, a thin shadow no sample falls on, a UV chart border).
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <functional>
 
@@ -67,7 +68,7 @@ class FieldSource final : public PairSource {
       if (unlisted_where(space_.texels[t].x, space_.texels[t].y)) return true;
     return false;
   }
-  mutable int evaluations = 0;
+  mutable std::atomic<int> evaluations{0};  // evaluated in parallel
   double nearest = 10.0;  // metres: far, for penumbrae far wider than any cell
   std::function<bool(int, int)> unlisted_where, umbra_where;
 

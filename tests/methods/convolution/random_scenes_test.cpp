@@ -17,6 +17,7 @@
 #include "pipeline/bake.h"
 #include "scene/scene.h"
 #include "support/image_errors.h"
+#include "support/method_bakes.h"
 #include "support/random_scenes.h"
 
 namespace sb {
@@ -27,18 +28,6 @@ namespace fs = std::filesystem;
 // Over the texels `a` covers, every channel.
 double rmse(const ReceiverBake& a, const ReceiverBake& truth) {
   return image_errors::errors(a, truth).rmse;
-}
-
-BakeResult bake_with(Scene scene, const std::string& method, int samples, bool trace,
-                     std::uint64_t seed = 0) {
-  scene.bake.method = method;
-  scene.bake.samples = samples;
-  scene.bake.trace = trace;
-  scene.bake.seed = seed;
-  scene.bake.margin = 0;
-  auto result = bake(scene);
-  EXPECT_TRUE(result) << result.error().message;
-  return result ? std::move(*result) : BakeResult{};
 }
 
 // `alone`: also require the convolution without rays to be within the reference at 16 samples.
