@@ -1,22 +1,28 @@
-// The corpus benchmark (issue "The convolution method on the scenes artists bring"): for every
-// scene of the corpus and every receiver, each variant's in-process bake time (median of
-// --repeat runs, side by side in one program), its RMSE against the reference at
-// --truth-samples (covered texels), the peak memory of a whole `shadowbake bake` process (its
-// VmHWM), and the equal-error speed ratio: the time each family (the reference at 16/64/256
-// samples; the convolution at its settings) needs to reach RMSE --target, interpolated on its
-// error curve (log RMSE against log time, between the two points around the target; beyond
-// them, from the last two, marked '~').
+// The corpus benchmark (issue "Exact penumbrae without noise"): for every scene of the corpus and
+// every receiver, the default `backprojection` bake against the reference at 16, 64, 256 and
+// 1024 samples, in one program, side by side: each variant's in-process time (median of
+// --repeat runs, interleaved; the reference at 1024 samples once), its RMSE against a truth (the
+// reference at --truth-samples, 4096 by default, with its own seed) over covered texels, the
+// default's route shares (method_stats), the peak memory of a whole `shadowbake bake` process
+// (its VmHWM) for the default and the reference at 64, and the equal-error speed ratios: the
+// time the reference needs to reach RMSE --target (0.005) and the default's own RMSE,
+// interpolated on its error curve (log RMSE against log time, between the two samples counts
+// around the target; never extrapolated: where the default is more accurate than the reference
+// at 1024 samples, the ratio is given as at least that reference's time over the default's).
 //
 // A receiver's time is its own texel space, method and dilation, plus a share of the scene's
-// load (meshes, rays, clusters) in proportion to its texels.
+// load (meshes, rays, shaft hierarchy) in proportion to its texels. A scene's time is its whole
+// bake (load and every receiver); its RMSE pools every receiver's covered texels.
 //
 // Run: build/shadowbake_corpus_bench [--scenes room/scene.toml,...] [--repeat 5]
-//      [--truth-samples 1024] [--resolution 512] [--json out/corpus.json]
-// The references at --truth-samples are cached under out/corpus-truth/ (keyed by the scene
-// file's bytes, resolution and samples), so later runs only bake the variants.
+//      [--truth-samples 4096] [--resolution 512] [--target 0.005] [--json out/corpus.json]
+//      [--truth-only 1]
+// The truths are cached under out/corpus-truth/ (keyed by the scene file's bytes, resolution,
+// samples and the reference's version), so later runs only bake the variants.
 #include <fmt/core.h>
 #include <sys/wait.h>
 #include <unistd.h>
+
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -41,49 +47,19 @@ namespace {
 namespace fs = std::filesystem;
 
 struct Variant {
-  std::string label, family;  // "reference", "convolution" (the curves), "alone", "shaft"
+  std::string label;
   std::string method;
-  std::vector<std::pair<std::string, std::string>> cli;  // overrides, as the CLI takes them
-  std::function<void(sb::BakeSettings&)> apply;
+  int samples = 0;      // the reference's; 0 for the default
+  bool repeat = true;   // timed --repeat times (else once)
+  bool memory = false;  // its peak memory measured
 };
 
 std::vector<Variant> variants() {
-  std::vector<Variant> v;
-  for (int n : {16, 64, 256}) {
-    v.push_back({"reference-" + std::to_string(n),
-                 "reference",
-                 "reference",
-                 {{"--samples", std::to_string(n)}},
-                 [n](sb::BakeSettings& b) { b.samples = n; }});
-  }
-  // The convolution alone (no rays: shaft test and convolution), then with rays at 16, 64 and
-  // 256 samples where it cannot vouch for its values: the family on the equal-error curve.
-  v.push_back(
-      {"convolution-alone", "alone", "convolution", {{"--no-trace", ""}}, [](sb::BakeSettings& b) {
-         b.trace = false;
-       }});
-  for (int n : {16, 64, 256}) {
-    v.push_back({"convolution-" + std::to_string(n),
-                 "convolution",
-                 "convolution",
-                 {{"--samples", std::to_string(n)}},
-                 [n](sb::BakeSettings& b) {
-                   b.samples = n;
-                   b.trace = true;
-                 }});
-  }
-  // What the convolution contributes to the whole method: the same method with the convolution
-  // skipped (the shaft test, then rays at every pair it keeps; the reference's values).
-  v.push_back({"shaft-rays-64",
-               "shaft",
-               "convolution",
-               {{"--samples", "64"}, {"--no-convolve", ""}},
-               [](sb::BakeSettings& b) {
-                 b.samples = 64;
-                 b.trace = true;
-                 b.convolve = false;
-               }});
-  return v;
+  return {{"backprojection", "backprojection", 0, true, true},
+          {"reference-16", "reference", 16, true, false},
+          {"reference-64", "reference", 64, true, true},
+          {"reference-256", "reference", 256, true, false},
+          {"reference-1024", "reference", 1024, false, false}};
 }
 
 const std::vector<std::string> kDefaultScenes = {
@@ -113,9 +89,9 @@ double process_peak_mib(const std::string& scene, const Variant& v, int resoluti
   std::vector<std::string> args = {
       SB_CLI, "bake",     scene,    "-o",           out.string(),
       "-q",   "--method", v.method, "--resolution", std::to_string(resolution)};
-  for (const auto& [k, value] : v.cli) {
-    args.push_back(k);
-    if (!value.empty()) args.push_back(value);
+  if (v.samples > 0) {
+    args.push_back("--samples");
+    args.push_back(std::to_string(v.samples));
   }
   const pid_t pid = ::fork();
   if (pid == 0) {
@@ -147,49 +123,59 @@ double process_peak_mib(const std::string& scene, const Variant& v, int resoluti
   return peak_kib / 1024.0;
 }
 
-// Time at RMSE `target` on a family's curve of (time, rmse) points; `extrapolated` when the
-// target lies outside them.
-std::optional<double> time_at(std::vector<std::pair<double, double>> curve, double target,
-                              bool* extrapolated) {
-  curve.erase(std::remove_if(curve.begin(), curve.end(),
-                             [](const auto& p) { return !(p.first > 0 && p.second > 0); }),
-              curve.end());
-  if (curve.empty()) return std::nullopt;
+// The reference's time at RMSE `target` on its curve of (time, rmse) points, interpolated in
+// log-log between the two points around it; nullopt where the target lies outside them (above
+// the fewest samples' error, or below the most's).
+std::optional<double> time_at(std::vector<std::pair<double, double>> curve, double target) {
   std::sort(curve.begin(), curve.end());
-  if (curve.size() == 1) {
-    *extrapolated = curve[0].second > target;
-    if (curve[0].second <= target) return curve[0].first;
-    return std::nullopt;
-  }
-  // First point at or below the target, and the one before it.
-  for (std::size_t i = 0; i < curve.size(); ++i) {
-    if (curve[i].second > target) continue;
-    if (i == 0) {
-      *extrapolated = false;
-      return curve[0].first;
-    }
+  for (std::size_t i = 1; i < curve.size(); ++i) {
     const auto& [t0, e0] = curve[i - 1];
     const auto& [t1, e1] = curve[i];
-    *extrapolated = false;
+    if (!(t0 > 0 && t1 > 0 && e0 > 0 && e1 > 0)) continue;
+    if (!(e0 >= target && target >= e1)) continue;
+    if (e0 == e1) return t0;
     const double s = (std::log(target) - std::log(e0)) / (std::log(e1) - std::log(e0));
     return std::exp(std::log(t0) + s * (std::log(t1) - std::log(t0)));
   }
-  // Beyond the last point: the last two points' slope, if the error falls with time.
-  const auto& [t0, e0] = curve[curve.size() - 2];
-  const auto& [t1, e1] = curve.back();
-  if (!(e1 < e0)) return std::nullopt;
-  *extrapolated = true;
-  const double s = (std::log(target) - std::log(e0)) / (std::log(e1) - std::log(e0));
-  return std::exp(std::log(t0) + s * (std::log(t1) - std::log(t0)));
+  return std::nullopt;
+}
+
+struct Measured {
+  std::map<std::string, std::vector<double>> seconds;
+  std::map<std::string, double> rmse;
+  std::map<std::string, std::int64_t> texels;
+  std::map<std::string, sb::MethodStats> stats;
+  std::vector<double> scene_runs;
+  double scene_rmse = 0;
+  double peak_mib = NAN;
+};
+
+// Where `target` lies below every point of the curve (more accurate than the reference at its
+// most samples): the time of that point, which the reference needs at least to reach it.
+std::optional<double> time_beyond(const std::vector<std::pair<double, double>>& curve,
+                                  double target) {
+  std::optional<double> best;
+  double best_error = INFINITY;
+  for (const auto& [t, e] : curve)
+    if (t > 0 && e > 0 && e < best_error) best_error = e, best = t;
+  if (best && target > 0 && target < best_error) return best;
+  return std::nullopt;
+}
+
+std::string ratio_text(const std::optional<double>& reference, double ours,
+                       const std::optional<double>& at_least = std::nullopt) {
+  if (reference) return fmt::format("{:.1f}", *reference / ours);
+  if (at_least) return fmt::format("> {:.1f}", *at_least / ours);
+  return "-";
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   std::vector<std::string> scenes = kDefaultScenes;
-  int repeat = 5, truth_samples = 1024, resolution = 512;
-  bool truth_only = false;
+  int repeat = 5, truth_samples = 4096, resolution = 512;
   double target = 0.005;
+  bool truth_only = false;
   std::string json_path;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i], value = argv[i + 1];
@@ -236,17 +222,16 @@ int main(int argc, char** argv) {
                                  std::to_string(truth_samples) + "/reference-2");
     const fs::path truth_dir = cache / fmt::format("{:016x}", key);
     std::map<std::string, sb::Image> truth;
-    std::map<std::string, std::vector<std::uint8_t>> covered;
     for (const auto& obj : scene.objects) {
       if (!obj.receiver) continue;
       if (auto img = sb::read_image(truth_dir / (obj.name + ".exr"))) truth[obj.name] = *img;
     }
-    sb::Scene truth_scene = scene;
-    truth_scene.bake.method = "reference";
-    truth_scene.bake.samples = truth_samples;
-    truth_scene.bake.seed = 12345;  // independent of the variants' seed
     if (truth.size() != std::size_t(std::count_if(scene.objects.begin(), scene.objects.end(),
                                                   [](const auto& o) { return o.receiver; }))) {
+      sb::Scene truth_scene = scene;
+      truth_scene.bake.method = "reference";
+      truth_scene.bake.samples = truth_samples;
+      truth_scene.bake.seed = 12345;  // independent of the variants' seed
       fmt::print(stderr, "{}: baking the reference at {} samples ...\n", name, truth_samples);
       auto result = sb::bake(truth_scene);
       if (!result) {
@@ -259,24 +244,17 @@ int main(int argc, char** argv) {
         (void)sb::write_image(truth_dir / (r.name + ".exr"), r.image, sb::PixelFormat::float32);
       }
     }
-
     if (truth_only) continue;
-    // Variants, interleaved repeat by repeat so that load on the machine hits all alike.
-    struct Measured {
-      std::map<std::string, std::vector<double>> seconds;
-      std::map<std::string, double> error;
-      double scene_seconds = 0;
-      std::vector<double> scene_runs;
-      double peak_mib = NAN;
-      int64_t rays = 0;
-    };
+
+    // The variants, interleaved repeat by repeat so that load on the machine hits all alike.
     std::vector<Measured> measured(vs.size());
     std::vector<std::string> receivers;
     for (int rep = 0; rep < repeat; ++rep) {
       for (std::size_t k = 0; k < vs.size(); ++k) {
+        if (rep > 0 && !vs[k].repeat) continue;
         sb::Scene s = scene;
         s.bake.method = vs[k].method;
-        vs[k].apply(s.bake);
+        if (vs[k].samples > 0) s.bake.samples = vs[k].samples;
         auto result = sb::bake(s);
         if (!result) {
           fmt::print(stderr, "{} {}: {}\n", name, vs[k].label, result.error().message);
@@ -285,71 +263,107 @@ int main(int argc, char** argv) {
         double total_texels = 0;
         for (const auto& r : result->receivers) total_texels += double(r.covered_texels);
         receivers.clear();
+        std::vector<image_errors::Errors> parts;
         for (const auto& r : result->receivers) {
           receivers.push_back(r.name);
           const double share = total_texels > 0 ? double(r.covered_texels) / total_texels : 0;
           measured[k].seconds[r.name].push_back(r.seconds + share * result->load_seconds);
           if (rep == 0) {
             // Covered texels of this bake (margin 0: every texel with a value is covered).
-            measured[k].error[r.name] =
-                image_errors::errors(r.image, truth[r.name], r.covered).rmse;
+            const image_errors::Errors e = image_errors::errors(r.image, truth[r.name], r.covered);
+            measured[k].rmse[r.name] = e.rmse;
+            measured[k].texels[r.name] = e.count;
+            measured[k].stats[r.name] = r.report.stats;
+            parts.push_back(e);
           }
         }
+        if (rep == 0) measured[k].scene_rmse = image_errors::pooled(parts).rmse;
         measured[k].scene_runs.push_back(result->load_seconds + result->bake_seconds);
-        measured[k].rays = result->shadow_rays;
       }
     }
-    for (std::size_t k = 0; k < vs.size(); ++k) {
-      measured[k].scene_seconds = median(measured[k].scene_runs);
-      measured[k].peak_mib = process_peak_mib(file.string(), vs[k], resolution);
-    }
+    for (std::size_t k = 0; k < vs.size(); ++k)
+      if (vs[k].memory) measured[k].peak_mib = process_peak_mib(file.string(), vs[k], resolution);
 
+    // Per receiver: the default's time, RMSE and routes; the references'; the ratios.
+    const Measured& ours = measured[0];
+    const auto seconds = [&](std::size_t k, const std::string& r) {
+      return median(measured[k].seconds.at(r));
+    };
+    const auto curve = [&](const std::function<double(std::size_t)>& time,
+                           const std::function<double(std::size_t)>& error) {
+      std::vector<std::pair<double, double>> points;
+      for (std::size_t k = 1; k < vs.size(); ++k) points.emplace_back(time(k), error(k));
+      return points;
+    };
     fmt::print("\n## {} ({}², truth: reference-{})\n\n", name, resolution, truth_samples);
-    fmt::print("| variant | scene s | peak MiB |");
-    for (const auto& r : receivers) fmt::print(" {} s | {} RMSE |", r, r);
-    fmt::print("\n|---|---|---|");
-    for (std::size_t i = 0; i < receivers.size(); ++i) fmt::print("---|---|");
-    fmt::print("\n");
+    fmt::print(
+        "| receiver | backprojection s | RMSE | clear / exact / interpolated / traced | "
+        "reference-16 s, RMSE | -64 | -256 | -1024 | ref-64 / ours | at RMSE {} | at our RMSE "
+        "|\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        target);
     nlohmann::ordered_json entry;
     entry["scene"] = name;
     entry["resolution"] = resolution;
     entry["truth_samples"] = truth_samples;
-    for (std::size_t k = 0; k < vs.size(); ++k) {
-      fmt::print("| {} | {:.3f} | {:.0f} |", vs[k].label, measured[k].scene_seconds,
-                 measured[k].peak_mib);
-      auto& j = entry["variants"][vs[k].label];
-      j["scene_seconds"] = measured[k].scene_seconds;
-      j["peak_mib"] = measured[k].peak_mib;
-      for (const auto& r : receivers) {
-        const double t = median(measured[k].seconds[r]);
-        fmt::print(" {:.3f} | {:.4f} |", t, measured[k].error[r]);
-        j["receivers"][r] = {{"seconds", t}, {"rmse", measured[k].error[r]}};
-      }
-      fmt::print("\n");
-    }
-    // Equal error, per receiver.
-    fmt::print("\nTime to RMSE {} (s) and the ratio reference / convolution:\n\n", target);
-    fmt::print("| receiver | reference | convolution | ratio |\n|---|---|---|---|\n");
-    for (const auto& r : receivers) {
-      std::map<std::string, std::vector<std::pair<double, double>>> curves;
-      for (std::size_t k = 0; k < vs.size(); ++k)
-        curves[vs[k].family].emplace_back(median(measured[k].seconds[r]), measured[k].error[r]);
-      bool ex_ref = false, ex_conv = false;
-      const auto t_ref = time_at(curves["reference"], target, &ex_ref);
-      const auto t_conv = time_at(curves["convolution"], target, &ex_conv);
-      const auto show = [](const std::optional<double>& t, bool ex) {
-        return t ? fmt::format("{}{:.3f}", ex ? "~" : "", *t) : std::string("-");
+    entry["target"] = target;
+    for (const std::string& r : receivers) {
+      const auto ref_curve = curve([&](std::size_t k) { return seconds(k, r); },
+                                   [&](std::size_t k) { return measured[k].rmse.at(r); });
+      const double t = seconds(0, r), e = ours.rmse.at(r);
+      const auto at_target = time_at(ref_curve, target);
+      const auto at_ours = time_at(ref_curve, e);
+      const auto beyond = time_beyond(ref_curve, e);
+      const auto route = [&](const char* key) {
+        for (const auto& [k, v] : ours.stats.at(r))
+          if (k == key) return v;
+        return 0.0;
       };
-      const std::string ratio =
-          t_ref && t_conv ? fmt::format("{}{:.2f}", ex_ref || ex_conv ? "~" : "", *t_ref / *t_conv)
-                          : std::string("-");
-      fmt::print("| {} | {} | {} | {} |\n", r, show(t_ref, ex_ref), show(t_conv, ex_conv), ratio);
-      entry["equal_error"][r] = {
-          {"reference_seconds", t_ref ? nlohmann::ordered_json(*t_ref) : nlohmann::ordered_json()},
-          {"convolution_seconds",
-           t_conv ? nlohmann::ordered_json(*t_conv) : nlohmann::ordered_json()},
-          {"extrapolated", ex_ref || ex_conv}};
+      fmt::print("| {} | {:.3f} | {:.4f} | {:.2f} / {:.2f} / {:.2f} / {:.2f} |", r, t, e,
+                 route("clear_fraction"), route("exact_fraction"), route("interpolated_fraction"),
+                 route("traced_fraction"));
+      for (std::size_t k = 1; k < vs.size(); ++k)
+        fmt::print(" {:.3f}, {:.4f} |", seconds(k, r), measured[k].rmse.at(r));
+      fmt::print(" {:.2f} | {} | {} |\n", seconds(2, r) / t, ratio_text(at_target, t),
+                 ratio_text(at_ours, t, beyond));
+      auto& j = entry["receivers"][r];
+      j["texels"] = ours.texels.at(r);
+      for (std::size_t k = 0; k < vs.size(); ++k)
+        j[vs[k].label] = {{"seconds", seconds(k, r)}, {"rmse", measured[k].rmse.at(r)}};
+      for (const auto& [k, v] : ours.stats.at(r)) j["routes"][k] = v;
+      j["reference_seconds_at_target"] =
+          at_target ? nlohmann::ordered_json(*at_target) : nlohmann::ordered_json();
+      j["reference_seconds_at_our_rmse"] =
+          at_ours ? nlohmann::ordered_json(*at_ours) : nlohmann::ordered_json();
+      j["reference_seconds_at_our_rmse_at_least"] =
+          beyond ? nlohmann::ordered_json(*beyond) : nlohmann::ordered_json();
     }
+    // The scene as a whole.
+    const auto scene_curve = curve([&](std::size_t k) { return median(measured[k].scene_runs); },
+                                   [&](std::size_t k) { return measured[k].scene_rmse; });
+    const double scene_t = median(ours.scene_runs);
+    const auto scene_at_target = time_at(scene_curve, target);
+    const auto scene_at_ours = time_at(scene_curve, ours.scene_rmse);
+    const auto scene_beyond = time_beyond(scene_curve, ours.scene_rmse);
+    fmt::print("| **scene** | {:.3f} | {:.4f} | peak {:.0f} MiB (reference-64: {:.0f}) |", scene_t,
+               ours.scene_rmse, ours.peak_mib, measured[2].peak_mib);
+    for (std::size_t k = 1; k < vs.size(); ++k)
+      fmt::print(" {:.3f}, {:.4f} |", median(measured[k].scene_runs), measured[k].scene_rmse);
+    fmt::print(" {:.2f} | {} | {} |\n", median(measured[2].scene_runs) / scene_t,
+               ratio_text(scene_at_target, scene_t),
+               ratio_text(scene_at_ours, scene_t, scene_beyond));
+    auto& j = entry["scene_totals"];
+    for (std::size_t k = 0; k < vs.size(); ++k)
+      j[vs[k].label] = {{"seconds", median(measured[k].scene_runs)},
+                        {"rmse", measured[k].scene_rmse},
+                        {"peak_mib", std::isnan(measured[k].peak_mib)
+                                         ? nlohmann::ordered_json()
+                                         : nlohmann::ordered_json(measured[k].peak_mib)}};
+    j["reference_seconds_at_target"] =
+        scene_at_target ? nlohmann::ordered_json(*scene_at_target) : nlohmann::ordered_json();
+    j["reference_seconds_at_our_rmse"] =
+        scene_at_ours ? nlohmann::ordered_json(*scene_at_ours) : nlohmann::ordered_json();
+    j["reference_seconds_at_our_rmse_at_least"] =
+        scene_beyond ? nlohmann::ordered_json(*scene_beyond) : nlohmann::ordered_json();
     report.push_back(entry);
     std::fflush(stdout);
   }

@@ -2,47 +2,67 @@
 """Summary of a corpus benchmark run (shadowbake_corpus_bench --json FILE), one row per scene,
 as docs/performance.md shows it. Usage: tests/tools/corpus_summary.py out/corpus.json
 
-Per scene: whole-scene in-process seconds of the reference at 64 samples, the convolution method
-at 64 (its rays where it cannot vouch for its values) and the same method with the convolution
-skipped (shaft test + rays, `--no-convolve`); peak memory of a whole convolution bake; and per
-receiver (those the lights reach through blockers, RMSE > 0 for the reference at 64): the time
-ratio reference-64 / convolution-64 (their RMSE are equal, the traced texels being the
-reference's), how many receivers the convolution is slower on, how many the convolution alone
-(no rays) is less accurate than the reference at 16 samples, and the equal-error ratio at RMSE
-0.005 where both curves reach it by interpolation."""
+Per scene: whole-scene in-process seconds of the default bake (backprojection) and of the
+reference at 64 samples, both medians of the run's repeats; the peak memory of a whole
+default bake; and per receiver that a light reaches through blockers (reference-64 RMSE > 0):
+the time ratio reference-64 / backprojection (min, median, max), how many receivers the default
+is slower than reference-64 on, how many it is less accurate than reference-256 on (RMSE against
+the truth), and the equal-error ratios (reference seconds at the error, interpolated on its
+16/64/256/1024 curve, over the default's seconds) at the run's target RMSE and at the default's
+own RMSE, where the curve reaches them (where the default is more accurate than the reference at
+1024 samples, the ratio at its own RMSE is a lower bound: that reference's time over the
+default's)."""
 import json
 import statistics
 import sys
 
 
+def spread(values):
+    if not values:
+        return "-"
+    return (f"{min(values):.1f}, {statistics.median(values):.1f}, {max(values):.1f} "
+            f"({len(values)})")
+
+
 def main(path):
     runs = json.load(open(path))
-    print("| scene | receivers | reference-64 s | convolution-64 s | shaft-rays-64 s | peak MiB "
-          "| ref-64 / conv-64 per receiver (min, median, max) | conv-64 slower | shaft-rays slower "
-          "| alone worse than ref-16 | equal-error ratio at 0.005 (interpolated) |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    target = runs[0]["target"] if runs else 0.005
+    print("| scene | shadowed receivers | backprojection s | reference-64 s | peak MiB "
+          "| ref-64 / ours per receiver (min, median, max) | slower than ref-64 "
+          "| less accurate than ref-256 "
+          f"| equal-error ratio at {target} (min, median, max (n)) "
+          "| equal-error ratio at own RMSE |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for run in runs:
-        v = run["variants"]
-        ref, conv = v["reference-64"]["receivers"], v["convolution-64"]["receivers"]
-        shaft = v.get("shaft-rays-64", {}).get("receivers", {})
-        alone, ref16 = v["convolution-alone"]["receivers"], v["reference-16"]["receivers"]
-        shadowed = [r for r in ref if ref[r]["rmse"] > 0]
-        ratios = [ref[r]["seconds"] / conv[r]["seconds"] for r in shadowed]
-        slower = sum(1 for r in shadowed if conv[r]["seconds"] > ref[r]["seconds"])
-        shaft_slower = sum(1 for r in shadowed if r in shaft and shaft[r]["seconds"] > ref[r]["seconds"])
+        recv = run["receivers"]
+        shadowed = [r for r in recv if recv[r]["reference-64"]["rmse"] > 0]
+        ours = {r: recv[r]["backprojection"] for r in shadowed}
+        ratios = [recv[r]["reference-64"]["seconds"] / ours[r]["seconds"] for r in shadowed]
+        slower = sum(1 for r in shadowed
+                     if ours[r]["seconds"] > recv[r]["reference-64"]["seconds"])
         worse = sum(1 for r in shadowed
-                    if alone[r]["rmse"] > 1.05 * ref16[r]["rmse"] + 5e-4)
-        equal = [e["reference_seconds"] / e["convolution_seconds"]
-                 for e in run.get("equal_error", {}).values()
-                 if e["reference_seconds"] and e["convolution_seconds"] and not e["extrapolated"]]
-        eq = (f"{min(equal):.2f}–{max(equal):.2f} ({len(equal)})" if equal else "-")
-        peak = max(v[k]["peak_mib"] for k in v if k.startswith("convolution"))
-        shaft_s = v["shaft-rays-64"]["scene_seconds"] if "shaft-rays-64" in v else float("nan")
-        print(f"| {run['scene']} | {len(shadowed)} of {len(ref)} | "
-              f"{v['reference-64']['scene_seconds']:.2f} | {v['convolution-64']['scene_seconds']:.2f} | "
-              f"{shaft_s:.2f} | {peak:.0f} | "
-              f"{min(ratios):.2f}, {statistics.median(ratios):.2f}, {max(ratios):.2f} | "
-              f"{slower} | {shaft_slower} | {worse} | {eq} |")
+                    if ours[r]["rmse"] > recv[r]["reference-256"]["rmse"])
+        at_target = [recv[r]["reference_seconds_at_target"] / ours[r]["seconds"]
+                     for r in shadowed if recv[r]["reference_seconds_at_target"] is not None]
+        # Where the default is more accurate than the reference at 1024 samples, a lower bound.
+        at_own, bounds = [], 0
+        for r in shadowed:
+            exact = recv[r]["reference_seconds_at_our_rmse"]
+            least = recv[r].get("reference_seconds_at_our_rmse_at_least")
+            if exact is not None:
+                at_own.append(exact / ours[r]["seconds"])
+            elif least is not None:
+                at_own.append(least / ours[r]["seconds"])
+                bounds += 1
+        totals = run["scene_totals"]
+        ratio_text = (f"{min(ratios):.1f}, {statistics.median(ratios):.1f}, {max(ratios):.1f}"
+                      if ratios else "-")
+        print(f"| {run['scene']} | {len(shadowed)} of {len(recv)} | "
+              f"{totals['backprojection']['seconds']:.2f} | "
+              f"{totals['reference-64']['seconds']:.2f} | "
+              f"{totals['backprojection']['peak_mib']:.0f} | {ratio_text} | {slower} | {worse} | "
+              f"{spread(at_target)} | {spread(at_own)}"
+              f"{f'; {bounds} of them lower bounds' if bounds else ''} |")
 
 
 if __name__ == "__main__":
