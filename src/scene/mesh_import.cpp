@@ -25,8 +25,11 @@
 //   winding disagrees with its vertex normals is reversed too: the normals say which side is out.
 // - OpenMesh refuses non-manifold faces; such a face is added on fresh copies of its vertices so
 //   no triangle, hence no blocker or receiver surface, is ever lost.
-// - Bad input (unreadable file, no triangles, non-finite positions, only degenerate triangles, a
-//   receiver without its UV channel) is an Error, never a crash or an exception.
+// - Bad input (unreadable file, no triangles, non-finite positions or ones beyond a thousand
+//   kilometres of the origin, only degenerate triangles, a receiver without its UV channel) is
+//   an Error, never a crash or an exception.
+#include <fmt/core.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -106,6 +109,10 @@ std::string assimp_message(const std::string& message) {
   const auto colon = message.find(": ");
   return one_line(colon != std::string::npos && colon < 16 ? message.substr(colon + 2) : message);
 }
+
+// The largest world coordinate accepted, metres: a thousand kilometres, where a float's step is
+// already 6 cm.
+constexpr double kMaxCoordinate = 1e6;
 
 std::string format_vec(const Vec3& v) {
   std::ostringstream out;
@@ -239,6 +246,16 @@ Expected<Mesh> build_mesh(const RawMeshFile& file, const ObjectDesc& obj, const 
                      format_vec(file_position) + "; fix the mesh file");
       }
       v.position = obj.transform * file_position;
+      // Finite but beyond any level (1e30 in a file, or a scale of 1e25): the ray tracer's
+      // float arithmetic overflows on such coordinates, and a float there is coarser than a
+      // texel anyway.
+      if (!(v.position.cwiseAbs().maxCoeff() <= kMaxCoordinate)) {
+        return error(fmt::format(
+            "'{}': vertex {} (as Assimp numbers them) at {} lies beyond {:g} m of the origin{}; "
+            "fix the mesh file or the object's transform",
+            path, vertices.size(), format_vec(v.position), kMaxCoordinate,
+            file_position.cwiseAbs().maxCoeff() <= kMaxCoordinate ? " after its transform" : ""));
+      }
       v.normal = Vec3::Zero();
       if (!part.normals.empty()) {
         const float* n = &part.normals[3 * i];

@@ -251,6 +251,12 @@ case("obj_nan_uv", {"scene.toml": scene([obj("floor", "nan.obj")]),
                     "nan.obj": QUAD_OBJ.replace("vt 1 1", "vt nan 1")}, 3, "'nan' where a finite number must be")
 case("obj_inf_vertex", {"scene.toml": scene([obj("floor", "inf.obj")]),
                         "inf.obj": QUAD_OBJ.replace("v 1 1 0", "v 1 inf 0")}, 3, "'inf' where a finite number must be")
+# Finite, but beyond any level: Embree's float arithmetic overflows on it (it aborted the process).
+case("obj_huge_vertex", {"scene.toml": scene([obj("floor", "huge.obj")]),
+                         "huge.obj": QUAD_OBJ.replace("v 1 1 0", "v 1 1e30 0")}, 3,
+     "lies beyond 1e+06 m of the origin")
+case("transform_huge_scale", {"scene.toml": scene([obj("floor", "quad.obj", scale="[1e25, 1e25, 1e25]")]),
+                              "quad.obj": QUAD_OBJ}, 3, "lies beyond 1e+06 m of the origin")
 case("obj_uv_index_out_of_range", {"scene.toml": scene([obj("floor", "uvindex.obj")]),
                                    "uvindex.obj": QUAD_OBJ.replace("3/3/1 4/4/1", "3/3/1 4/9/1")},
      3, "face references UV index 9, but the file has 4 'vt' line(s)")
