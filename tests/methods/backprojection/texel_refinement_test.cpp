@@ -69,7 +69,7 @@ class FieldSource final : public PairSource {
     return false;
   }
   mutable std::atomic<int> evaluations{0};  // evaluated in parallel
-  double nearest = 10.0;  // metres: far, for penumbrae far wider than any cell
+  double nearest = 10.0;                    // metres: far, for penumbrae far wider than any cell
   std::function<bool(int, int)> unlisted_where, umbra_where;
 
  private:
