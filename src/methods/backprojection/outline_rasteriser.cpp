@@ -60,10 +60,37 @@ struct FacingMemo {
 struct Crossings {
   std::array<std::array<std::int32_t, kCells + 1>, LightRows::kMaxRows> steps;
   std::uint64_t touched = 0;
+  // Per row, cells per unit of s (0 for a row of no width); and the rows' extent in s: an edge
+  // wholly past it crosses no row before a cell centre, one wholly before it crosses each row
+  // before the first.
+  std::array<double, LightRows::kMaxRows> cells_per_s{};
+  double s_lo = 0, s_hi = 0;
+
+  void begin(const LightRows& rows) {
+    touched = 0;
+    s_lo = kInfinity, s_hi = -kInfinity;
+    for (int r = 0; r < rows.count; ++r) {
+      const double enter = rows.enter[std::size_t(r)];
+      const double width = rows.leave[std::size_t(r)] - enter;
+      cells_per_s[std::size_t(r)] = width > 0 ? kCells / width : 0.0;
+      if (!(width > 0)) continue;
+      s_lo = std::min(s_lo, enter);
+      s_hi = std::max(s_hi, rows.leave[std::size_t(r)]);
+    }
+  }
+
+  void step(int r, int cell, int sign) {
+    if (!(touched >> r & 1)) {
+      steps[std::size_t(r)].fill(0);
+      touched |= std::uint64_t(1) << r;
+    }
+    steps[std::size_t(r)][std::size_t(cell)] += sign;
+  }
 
   // An edge p → q of a triangle turned `orient` (+1 counter-clockwise in (s, t)).
   void add(const LightRows& rows, Vec2 p, Vec2 q, int orient) {
     if (p.y() == q.y()) return;
+    if (p.x() >= s_hi && q.x() >= s_hi) return;  // past every centre of every row
     const bool up = q.y() > p.y();
     if (!up) std::swap(p, q);
     const int sign = up ? -orient : orient;
@@ -72,19 +99,19 @@ struct Crossings {
     const int a = int(std::clamp(std::ceil((p.y() - rows.first) / rows.pitch), 0.0, double(n)));
     const int b =
         int(std::clamp(std::ceil((q.y() - rows.first) / rows.pitch) - 1, -1.0, double(n - 1)));
+    if (p.x() <= s_lo && q.x() <= s_lo) {  // before every row: at its first cell
+      for (int r = a; r <= b; ++r)
+        if (cells_per_s[std::size_t(r)] > 0) step(r, 0, sign);
+      return;
+    }
     const double slope = (q.x() - p.x()) / (q.y() - p.y());
     for (int r = a; r <= b; ++r) {
+      const double per_s = cells_per_s[std::size_t(r)];
+      if (!(per_s > 0)) continue;
       const double s = p.x() + (rows.first + r * rows.pitch - p.y()) * slope;
-      const double enter = rows.enter[std::size_t(r)];
-      const double width = rows.leave[std::size_t(r)] - enter;
-      if (!(width > 0)) continue;
-      const double cell = std::ceil((s - enter) / width * kCells - 0.5);
+      const double cell = std::ceil((s - rows.enter[std::size_t(r)]) * per_s - 0.5);
       if (cell > kCells - 1) continue;  // past every centre of the row
-      if (!(touched >> r & 1)) {
-        steps[std::size_t(r)].fill(0);
-        touched |= std::uint64_t(1) << r;
-      }
-      steps[std::size_t(r)][std::size_t(std::max(0.0, cell))] += sign;
+      step(r, int(std::max(0.0, cell)), sign);
     }
   }
 
@@ -209,7 +236,7 @@ void rasterise_outline(const RasterTarget& target, const BlockerOutline& outline
   thread_local Crossings crossings;
   thread_local std::vector<BlockerPolygon> apart;
   memo.begin(culler.triangle_count());
-  crossings.touched = 0;
+  crossings.begin(rows);
   apart.assign(outline.apart.begin(), outline.apart.end());
   const auto facing_of = [&](std::uint32_t t) {
     if (memo.stamp[t] != memo.generation) {
