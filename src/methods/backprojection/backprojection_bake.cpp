@@ -377,6 +377,13 @@ class LightPairs final : public PairSource {
     // The tile's candidates no sample listed, but for those of a convex solid every texel lies
     // on (their own surface: a ray that leaves it above the horizon does not come back to it,
     // and where it grazes it the samples listed it).
+    thread_local std::vector<Vec3> origins;
+    origins.clear();
+    Bounds3 box;
+    for (std::size_t t : texels) {
+      origins.push_back(ray_origin(space_.texels[t], offset_));
+      box.extend(origins.back());
+    }
     thread_local std::vector<std::uint32_t> unlisted;
     unlisted.clear();
     std::uint32_t on_key = 0, off_key = 0;  // the last solid found to hold the texels, or not
@@ -384,15 +391,15 @@ class LightPairs final : public PairSource {
       const std::uint32_t key = in_.culler->blocker_key(i);
       if (std::binary_search(listed.begin(), listed.end(), key)) continue;
       if (key & ShaftCuller::kSolidKey) {
-        if (key != on_key && key != off_key) (on_solid(key, texels) ? on_key : off_key) = key;
+        if (key != on_key && key != off_key) (on_solid(key, origins, box) ? on_key : off_key) = key;
         if (key == on_key) continue;
       }
       unlisted.push_back(i);
     }
     if (unlisted.empty()) return false;
-    for (std::size_t t : texels) {
-      const Texel& tx = space_.texels[t];
-      if (in_.culler->maybe_blocked(ray_origin(tx, offset_), tx.position.cast<double>(),
+    for (std::size_t k = 0; k < texels.size(); ++k) {
+      const Texel& tx = space_.texels[texels[k]];
+      if (in_.culler->maybe_blocked(origins[k], tx.position.cast<double>(),
                                     tx.normal.cast<double>(), light_, &unlisted))
         return true;
     }
@@ -404,17 +411,15 @@ class LightPairs final : public PairSource {
   // front of none of its face planes by more than the rays' offset, four times over, or a
   // five-hundredth of its size (a curved surface's shadow origins lie on the smooth surface,
   // outside its flat faces by their sagitta).
-  bool on_solid(std::uint32_t key, const std::vector<std::size_t>& texels) const {
+  // `box` bounds the origins.
+  bool on_solid(std::uint32_t key, const std::vector<Vec3>& origins, const Bounds3& box) const {
     const BlockerSolid& solid = in_.culler->solid_of_key(key);
     const double tolerance = std::max(4 * offset_, 2e-3 * solid.bounds.diagonal());
-    for (std::size_t t : texels) {  // first its box, cheaply
-      const Vec3 origin = ray_origin(space_.texels[t], offset_);
-      if (((solid.bounds.lo.array() - tolerance) > origin.array()).any() ||
-          ((solid.bounds.hi.array() + tolerance) < origin.array()).any())
-        return false;
-    }
-    for (std::size_t t : texels) {
-      const Vec3 origin = ray_origin(space_.texels[t], offset_);
+    // First the boxes, cheaply.
+    if (((solid.bounds.lo.array() - tolerance) > box.lo.array()).any() ||
+        ((solid.bounds.hi.array() + tolerance) < box.hi.array()).any())
+      return false;
+    for (const Vec3& origin : origins) {
       for (std::size_t f = 0; f < solid.faces.size(); ++f)
         if (solid.normals[f].dot(origin - solid.corners[std::size_t(solid.faces[f][0])]) >
             tolerance)

@@ -368,6 +368,28 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
       corner(edge_faces[0]);
       corner(edge_faces[1]);
     }
+    // An outline edge a → b, projected p → q, that crosses the light's box: how near the origin
+    // it passes, into `distance` (its nearest, not the solid's: a ball's contact with the floor
+    // is not where V changes fastest here).
+    const auto near_edge = [&](const Vec2& p, const Vec2& q, const Vec3& a, const Vec3& b,
+                               double& distance) {
+      if (std::max(p.y(), q.y()) < t_first || std::min(p.y(), q.y()) > t_last ||
+          std::max(p.x(), q.x()) < extent_lo || std::min(p.x(), q.x()) > extent_hi)
+        return;
+      const Vec3 ab = b - a;
+      const double along =
+          std::clamp((origin - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
+      distance = std::min(distance, (a + along * ab - origin).norm());
+    };
+    // The solid rasterised: whether it reaches the light, and its umbra where it covers it.
+    const auto settle = [&](bool reaches, double edge_distance) {
+      if (covers) {
+        out.umbra = ref.key;
+        found(reaches, gap, ref.key);
+      } else {
+        found(reaches, std::max(gap, std::isfinite(edge_distance) ? edge_distance : gap), ref.key);
+      }
+    };
     if (!corners_within) {
       // A solid reaching past the slab (a crate on the floor a texel is on, a wall up to the
       // ceiling): its part within the slab is convex, outlined by its silhouette edges cut to
@@ -382,13 +404,7 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
       const auto add_segment = [&](const Vec3& a, const Vec3& b) {
         const Vec2 p = project(a), q = project(b);
         outline.emplace_back(p, q);
-        if (std::max(p.y(), q.y()) < t_first || std::min(p.y(), q.y()) > t_last ||
-            std::max(p.x(), q.x()) < extent_lo || std::min(p.x(), q.x()) > extent_hi)
-          return;
-        const Vec3 ab = b - a;
-        const double along =
-            std::clamp((origin - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
-        edge_distance = std::min(edge_distance, (a + along * ab - origin).norm());
+        near_edge(p, q, a, b, edge_distance);
       };
       const auto levels = {f.clip_height, h_top};
       for (const int e : silhouette) {
@@ -441,12 +457,7 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
       begin(lo_t, hi_t);
       for (const auto& [p, q] : outline) edge(p, q);
       const bool reaches = commit() || outline_in_light;
-      if (covers) {
-        out.umbra = ref.key;
-        found(reaches, gap, ref.key);
-      } else {
-        found(reaches, std::max(gap, std::isfinite(edge_distance) ? edge_distance : gap), ref.key);
-      }
+      settle(reaches, edge_distance);
       continue;
     }
     if (silhouette.empty() || t_hi < t_first || t_lo > t_last || s_hi < extent_lo ||
@@ -454,31 +465,17 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
       continue;
     begin(t_lo, t_hi);
     bool corner_in_light = false;
-    // How near the silhouette's edges that cross the light's box lie: they, not the solid's
-    // nearest point (a ball's contact with the floor), set how fast V changes here.
-    double edge_distance = kInfinity;
+    double edge_distance = kInfinity;  // of the silhouette's edges that cross the light's box
     for (const int e : silhouette) {
       const auto& ends = solid.edges[std::size_t(e)];
       const Vec2& p = at[std::size_t(ends[0])];
       const Vec2& q = at[std::size_t(ends[1])];
       edge(p, q);
       corner_in_light = corner_in_light || in_light(p);
-      if (std::max(p.y(), q.y()) < t_first || std::min(p.y(), q.y()) > t_last ||
-          std::max(p.x(), q.x()) < extent_lo || std::min(p.x(), q.x()) > extent_hi)
-        continue;
-      const Vec3& a = solid.corners[std::size_t(ends[0])];
-      const Vec3 ab = solid.corners[std::size_t(ends[1])] - a;
-      const double along =
-          std::clamp((origin - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
-      edge_distance = std::min(edge_distance, (a + along * ab - origin).norm());
+      near_edge(p, q, solid.corners[std::size_t(ends[0])], solid.corners[std::size_t(ends[1])],
+                edge_distance);
     }
-    const bool reaches = commit() || corner_in_light;
-    if (covers) {
-      out.umbra = ref.key;
-      found(reaches, gap, ref.key);
-    } else {
-      found(reaches, std::max(gap, std::isfinite(edge_distance) ? edge_distance : gap), ref.key);
-    }
+    settle(commit() || corner_in_light, edge_distance);
   }
 }
 
