@@ -14,6 +14,8 @@
 #include <assimp/Importer.hpp>
 #include <assimp/LogStream.hpp>
 
+#include <array>
+#include <cmath>
 #include <csignal>
 #include <cstdlib>
 #include <exception>
@@ -46,6 +48,10 @@ class Writer {
     put(std::uint64_t(s.size()));
     bytes.append(s);
   }
+  template <class T, std::size_t N>
+  void put_floats(const std::array<T, N>& v) {
+    for (const T& x : v) put(x);
+  }
   template <class T>
   void put_array(const std::vector<T>& v) {
     put(std::uint64_t(v.size()));
@@ -62,20 +68,60 @@ std::string one_line(std::string text) {
   return text;
 }
 
-// Read, copy out, pack: status 0 and the parts, or 1 and the error.
+std::array<float, 3> floats(const aiVector3D& v) { return {v.x, v.y, v.z}; }
+std::array<float, 3> floats(const aiColor3D& c) { return {c.r, c.g, c.b}; }
+
+// The nodes below `node`, depth first, each after its parent; a hierarchy deeper than any level
+// (or a cycle Assimp let through) is an error rather than a stack overflow.
+constexpr int kMaxNodeDepth = 256;
+bool collect_nodes(const aiNode* node, std::int32_t parent, int depth,
+                   std::vector<sb::RawNode>& nodes, unsigned mesh_count, std::string& error) {
+  if (depth > kMaxNodeDepth) {
+    error = fmt::format("node '{}' is nested more than {} levels deep", node->mName.C_Str(),
+                        kMaxNodeDepth);
+    return false;
+  }
+  sb::RawNode raw;
+  raw.name = node->mName.C_Str();
+  raw.parent = parent;
+  const aiMatrix4x4& m = node->mTransformation;
+  raw.transform = {m.a1, m.a2, m.a3, m.a4, m.b1, m.b2, m.b3, m.b4,
+                   m.c1, m.c2, m.c3, m.c4, m.d1, m.d2, m.d3, m.d4};
+  for (unsigned i = 0; i < node->mNumMeshes; ++i) {
+    if (node->mMeshes[i] >= mesh_count) {
+      error = fmt::format("node '{}' names mesh {} of {}", raw.name, node->mMeshes[i], mesh_count);
+      return false;
+    }
+    raw.parts.push_back(node->mMeshes[i]);
+  }
+  const auto index = std::int32_t(nodes.size());
+  nodes.push_back(std::move(raw));
+  for (unsigned c = 0; c < node->mNumChildren; ++c)
+    if (!collect_nodes(node->mChildren[c], index, depth + 1, nodes, mesh_count, error))
+      return false;
+  return true;
+}
+
+// Read, copy out, pack: status 0 and the file, or 1 and the error.
 std::string read_and_pack(const std::string& file, CapturedLog& log) {
   Writer out;
   out.put(sb::kMeshReaderMagic);
   std::string error;
   std::vector<sb::RawMeshPart> parts;
+  std::vector<sb::RawNode> nodes;
+  std::vector<sb::RawMaterial> materials;
+  std::vector<sb::RawLight> lights;
+  double unit_scale = 0;
   try {
     Assimp::Importer importer;
-    const unsigned flags = aiProcess_Triangulate | aiProcess_PreTransformVertices |
-                           aiProcess_GenSmoothNormals | aiProcess_ValidateDataStructure;
+    // No pre-transformation: the nodes and their transforms come back as they are, so that a
+    // level's objects stay apart and the transforms are applied in double precision.
+    const unsigned flags =
+        aiProcess_Triangulate | aiProcess_GenSmoothNormals | aiProcess_ValidateDataStructure;
     const aiScene* scene = importer.ReadFile(file, flags);
     if (!scene) {
       error = one_line(importer.GetErrorString());
-    } else if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) {
+    } else if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || !scene->mRootNode) {
       error = "the file holds no complete mesh";
     } else {
       for (unsigned m = 0; m < scene->mNumMeshes && error.empty(); ++m) {
@@ -107,8 +153,40 @@ std::string read_and_pack(const std::string& file, CapturedLog& log) {
             part.triangles.push_back(face.mIndices[k]);
           }
         }
+        part.material = am->mMaterialIndex;
         parts.push_back(std::move(part));
       }
+      if (error.empty()) collect_nodes(scene->mRootNode, -1, 0, nodes, scene->mNumMeshes, error);
+      for (unsigned i = 0; i < scene->mNumMaterials; ++i) {
+        const aiMaterial* am = scene->mMaterials[i];
+        sb::RawMaterial material;
+        material.name = am->GetName().C_Str();
+        aiColor3D emissive(0, 0, 0);
+        if (am->Get(AI_MATKEY_COLOR_EMISSIVE, emissive) == AI_SUCCESS)
+          material.emissive = floats(emissive);
+        materials.push_back(std::move(material));
+      }
+      for (unsigned i = 0; i < scene->mNumLights; ++i) {
+        const aiLight* al = scene->mLights[i];
+        sb::RawLight light;
+        light.name = al->mName.C_Str();
+        light.type = std::uint32_t(al->mType);
+        light.position = floats(al->mPosition);
+        light.direction = floats(al->mDirection);
+        light.up = floats(al->mUp);
+        light.color = floats(al->mColorDiffuse);
+        light.inner_cone = al->mAngleInnerCone;
+        light.outer_cone = al->mAngleOuterCone;
+        light.size = {al->mSize.x, al->mSize.y};
+        lights.push_back(std::move(light));
+      }
+      // FBX's centimetres per unit (Assimp keeps it as metadata, stored as a float or a double).
+      double factor = 0;
+      float factor_float = 0;
+      if (scene->mMetaData && !scene->mMetaData->Get("UnitScaleFactor", factor) &&
+          scene->mMetaData->Get("UnitScaleFactor", factor_float))
+        factor = factor_float;
+      if (std::isfinite(factor) && factor > 0) unit_scale = 0.01 * factor;
     }
   } catch (const std::exception& e) {
     error = one_line(e.what());
@@ -117,15 +195,40 @@ std::string read_and_pack(const std::string& file, CapturedLog& log) {
   out.put_string(error);
   out.put(std::uint64_t(log.messages.size()));
   for (const std::string& m : log.messages) out.put_string(one_line(m));
-  out.put(std::uint64_t(error.empty() ? parts.size() : 0));
-  if (error.empty()) {
-    for (const sb::RawMeshPart& p : parts) {
-      out.put_array(p.positions);
-      out.put_array(p.normals);
-      for (const auto& uv : p.uvs) out.put_array(uv);
-      out.put_array(p.triangles);
-    }
+  if (!error.empty()) return out.bytes;
+  out.put(std::uint64_t(parts.size()));
+  for (const sb::RawMeshPart& p : parts) {
+    out.put_array(p.positions);
+    out.put_array(p.normals);
+    for (const auto& uv : p.uvs) out.put_array(uv);
+    out.put_array(p.triangles);
+    out.put(p.material);
   }
+  out.put(std::uint64_t(nodes.size()));
+  for (const sb::RawNode& n : nodes) {
+    out.put_string(n.name);
+    out.put(n.parent);
+    out.put_floats(n.transform);
+    out.put_array(n.parts);
+  }
+  out.put(std::uint64_t(materials.size()));
+  for (const sb::RawMaterial& m : materials) {
+    out.put_string(m.name);
+    out.put_floats(m.emissive);
+  }
+  out.put(std::uint64_t(lights.size()));
+  for (const sb::RawLight& l : lights) {
+    out.put_string(l.name);
+    out.put(l.type);
+    out.put_floats(l.position);
+    out.put_floats(l.direction);
+    out.put_floats(l.up);
+    out.put_floats(l.color);
+    out.put(l.inner_cone);
+    out.put(l.outer_cone);
+    out.put_floats(l.size);
+  }
+  out.put(unit_scale);
   return out.bytes;
 }
 

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <map>
 #include <memory>
 #include <optional>
 #include <thread>
@@ -24,6 +25,7 @@
 #include "pipeline/memory_budget.h"
 #include "scene/lights.h"
 #include "scene/mesh.h"
+#include "scene/mesh_reader.h"
 #include "texels/lightmap_sizes.h"
 #include "texels/texel_space.h"
 
@@ -33,15 +35,26 @@ namespace {
 
 // Every object's mesh, in scene order; skipped degenerate triangles become warnings. A mesh file
 // may be a quarter of the memory budget, and its reader may use half of it: Assimp's scene and
-// the working mesh take several times the file's size.
+// the working mesh take several times the file's size. A file that several objects share (a
+// level's nodes) is read once and kept until its last object is built.
 Expected<std::vector<Mesh>> load_meshes(const Scene& scene, std::vector<std::string>* warnings) {
   std::vector<Mesh> meshes;
   meshes.reserve(scene.objects.size());
   ImportLimits limits;
   limits.max_file_bytes = memory_budget(scene.bake) / 4;
   limits.max_memory = memory_budget(scene.bake) / 2;
+  std::map<std::filesystem::path, std::size_t> users;
+  for (const auto& obj : scene.objects) ++users[obj.mesh];
+  std::map<std::filesystem::path, std::shared_ptr<const RawMeshFile>> read;
   for (const auto& obj : scene.objects) {
-    auto mesh = import_mesh(obj, scene.file, limits);
+    std::shared_ptr<const RawMeshFile>& file = read[obj.mesh];
+    if (!file) {
+      auto raw = read_object_file(obj, scene.file, limits);
+      if (!raw) return raw.error();
+      file = std::move(*raw);
+    }
+    auto mesh = build_object_mesh(obj, *file, scene.file);
+    if (--users[obj.mesh] == 0) read.erase(obj.mesh);
     if (!mesh) return mesh.error();
     if (mesh->skipped_degenerate > 0 && warnings) {
       warnings->push_back(scene.file.string() + ":" + std::to_string(obj.line) + ": object '" +

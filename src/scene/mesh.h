@@ -6,6 +6,7 @@
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,15 @@ struct ImportLimits {
 };
 Expected<Mesh> import_mesh(const ObjectDesc& obj, const std::filesystem::path& scene_file,
                            const ImportLimits& limits = {});
+
+// The two halves of import_mesh, for objects that share a file (a level's nodes): the file read
+// once (its checks, Assimp in the helper, dropped data refused), and an object's mesh built from
+// it. Errors name scene_file and the object as import_mesh's do.
+struct RawMeshFile;
+Expected<std::shared_ptr<const RawMeshFile>> read_object_file(
+    const ObjectDesc& obj, const std::filesystem::path& scene_file, const ImportLimits& limits);
+Expected<Mesh> build_object_mesh(const ObjectDesc& obj, const RawMeshFile& file,
+                                 const std::filesystem::path& scene_file);
 
 // World-space triangle of face f, as three points.
 struct Triangle {

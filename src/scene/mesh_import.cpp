@@ -2,11 +2,12 @@
 // FBX, ...) and builds the project's working mesh (mesh.h) in world space.
 //
 // Why each choice:
-// - Assimp post-processing triangulates, pre-transforms vertices (node transforms applied; all
-//   meshes of the file become one object) and generates smooth normals only where the file has
-//   none. It is not asked to remove degenerate triangles (we count them, so the user is told) nor
-//   to convert axes (world coordinates are the file's own; the scene's transform places the
-//   object).
+// - Assimp post-processing triangulates and generates smooth normals only where the file has
+//   none. It is not asked to pre-transform vertices: the node hierarchy comes back, and node
+//   transforms are applied here in double precision (file_nodes.h), every node's meshes making
+//   one object, or one node's making one object of a level (level_file.h). It is not asked to
+//   remove degenerate triangles (we count them, so the user is told) nor to convert axes (world
+//   coordinates are the file's own; the scene's transform places the object).
 // - Vertices are welded here, not by Assimp's JoinIdenticalVertices: in Assimp 5.2.5 that step
 //   compares only the first UV channel, so on a mesh whose lightmap UVs (channel 1) have seams
 //   where its texture UVs (channel 0) have none, vertices on either side of a lightmap seam are
@@ -17,12 +18,12 @@
 //   misread or exhaust memory on; Assimp then reads it in a helper process (mesh_reader.h), so a
 //   crash, a hang or a runaway allocation inside Assimp is an error too; Assimp's own warnings
 //   that it dropped faces are errors here.
-// - obj.transform is applied here, in double precision: points by the affine map, normals by the
-//   inverse transpose of its linear part. A mirroring transform (negative determinant) reverses
-//   every triangle's winding so that the winding-derived face normals keep agreeing with the
-//   transformed vertex normals (both stay on the file's outward side). Assimp's pre-transform
-//   does not do the same for a mirroring node transform inside the file, so any triangle whose
-//   winding disagrees with its vertex normals is reversed too: the normals say which side is out.
+// - obj.transform after the node's world transform is applied here, in double precision: points
+//   by the affine map, normals by the inverse transpose of its linear part. A mirroring transform
+//   (negative determinant) reverses every triangle's winding so that the winding-derived face
+//   normals keep agreeing with the transformed vertex normals (both stay on the file's outward
+//   side); any triangle whose winding still disagrees with its vertex normals is reversed too:
+//   the normals say which side is out.
 // - OpenMesh refuses non-manifold faces; such a face is added on fresh copies of its vertices so
 //   no triangle, hence no blocker or receiver surface, is ever lost.
 // - Bad input (unreadable file, no triangles, non-finite positions or ones beyond a thousand
@@ -43,6 +44,7 @@
 #include <utility>
 #include <vector>
 
+#include "scene/file_nodes.h"
 #include "scene/mesh.h"
 #include "scene/mesh_file_checks.h"
 #include "scene/mesh_reader.h"
@@ -152,44 +154,45 @@ void add_triangle(TriMesh& mesh, TriMesh::VertexHandle a, TriMesh::VertexHandle 
   mesh.add_face(copies[0], copies[1], copies[2]);
 }
 
-// For every vertex of the file (all meshes concatenated, in order), the index of the first vertex
-// that has the same position, normal and UVs in every channel, bit for bit: the welded vertex it
-// becomes. Bitwise, because "identical" is what a weld may merge without changing any attribute;
-// +0 and -0 stay apart, which only keeps a seam.
-std::vector<std::size_t> weld_vertices(const RawMeshFile& file) {
-  // Up to 3 + 3 + 3 * kMaxUvChannels floats, and which of them are present.
+// For every vertex (all instances concatenated, in order), the index of the first vertex that
+// has the same world position and normal and the same UVs in every channel, bit for bit: the
+// welded vertex it becomes. Bitwise, because "identical" is what a weld may merge without
+// changing any attribute; +0 and -0 stay apart, which only keeps a seam.
+std::vector<std::size_t> weld_vertices(const std::vector<ImportedVertex>& vertices,
+                                       const RawMeshFile& file,
+                                       const std::vector<PartInstance>& instances) {
+  // World position and normal (6 doubles), up to 3 * kMaxUvChannels floats, which are present.
   struct Key {
     std::uint32_t present = 0;
-    std::uint32_t bits[6 + 3 * kMaxUvChannels] = {};
+    std::uint64_t world[6] = {};
+    std::uint32_t bits[3 * kMaxUvChannels] = {};
     bool operator==(const Key& o) const {
-      return present == o.present && std::memcmp(bits, o.bits, sizeof bits) == 0;
+      return present == o.present && std::memcmp(world, o.world, sizeof world) == 0 &&
+             std::memcmp(bits, o.bits, sizeof bits) == 0;
     }
   };
   struct KeyHash {
     std::size_t operator()(const Key& k) const {
       std::uint64_t h = 1469598103934665603ull ^ k.present;  // FNV-1a over the words
+      for (std::uint64_t w : k.world) h = (h ^ w) * 1099511628211ull;
       for (std::uint32_t w : k.bits) h = (h ^ w) * 1099511628211ull;
       return std::size_t(h);
     }
   };
-  std::size_t total = 0;
-  for (const RawMeshPart& part : file.parts) total += part.vertex_count();
-  std::vector<std::size_t> representative(total);
+  std::vector<std::size_t> representative(vertices.size());
   std::unordered_map<Key, std::size_t, KeyHash> first;
-  first.reserve(total);
+  first.reserve(vertices.size());
   std::size_t index = 0;
-  for (const RawMeshPart& part : file.parts) {
+  for (const PartInstance& instance : instances) {
+    const RawMeshPart& part = file.parts[instance.part];
     for (std::size_t i = 0; i < part.vertex_count(); ++i, ++index) {
       Key key;
-      std::memcpy(key.bits, &part.positions[3 * i], 12);
-      if (!part.normals.empty()) {
-        key.present |= 1;
-        std::memcpy(key.bits + 3, &part.normals[3 * i], 12);
-      }
+      std::memcpy(key.world, vertices[index].position.data(), 24);
+      std::memcpy(key.world + 3, vertices[index].normal.data(), 24);
       for (int c = 0; c < kMaxUvChannels; ++c) {
         if (part.uvs[std::size_t(c)].empty()) continue;
-        key.present |= 2u << c;
-        std::memcpy(key.bits + 6 + 3 * c, &part.uvs[std::size_t(c)][3 * i], 12);
+        key.present |= 1u << c;
+        std::memcpy(key.bits + 3 * c, &part.uvs[std::size_t(c)][3 * i], 12);
       }
       representative[index] = first.try_emplace(key, index).first->second;
     }
@@ -197,13 +200,15 @@ std::vector<std::size_t> weld_vertices(const RawMeshFile& file) {
   return representative;
 }
 
-Expected<Mesh> build_mesh(const RawMeshFile& file, const ObjectDesc& obj, const std::string& path,
+Expected<Mesh> build_mesh(const RawMeshFile& file, const std::vector<PartInstance>& instances,
+                          const ObjectDesc& obj, const std::string& path,
                           const ErrorPrefix& error) {
   Mesh result;
   result.name = obj.name;
 
   std::size_t triangle_count = 0;
-  for (const RawMeshPart& part : file.parts) triangle_count += part.triangles.size() / 3;
+  for (const PartInstance& instance : instances)
+    triangle_count += file.parts[instance.part].triangles.size() / 3;
   if (triangle_count == 0) {
     return error("'" + path + "' has no triangles (an object needs a surface)");
   }
@@ -212,7 +217,8 @@ Expected<Mesh> build_mesh(const RawMeshFile& file, const ObjectDesc& obj, const 
   const bool channel_in_range = obj.uv_channel >= 0 && obj.uv_channel < kMaxUvChannels;
   result.has_uv = channel_in_range;
   const RawMeshPart* part_without_uv = nullptr;
-  for (const RawMeshPart& part : file.parts) {
+  for (const PartInstance& instance : instances) {
+    const RawMeshPart& part = file.parts[instance.part];
     if (!channel_in_range || part.uvs[std::size_t(obj.uv_channel)].empty()) {
       result.has_uv = false;
       if (!part_without_uv) part_without_uv = &part;
@@ -222,19 +228,18 @@ Expected<Mesh> build_mesh(const RawMeshFile& file, const ObjectDesc& obj, const 
   // A receiver's texture UVs (channel 0), when its lightmap UVs are another channel and every
   // part has them: a glTF of the bake carries them as TEXCOORD_0.
   bool keep_texture_uv = obj.receiver && obj.uv_channel != 0;
-  for (const RawMeshPart& part : file.parts)
-    keep_texture_uv = keep_texture_uv && !part.uvs[0].empty();
+  for (const PartInstance& instance : instances)
+    keep_texture_uv = keep_texture_uv && !file.parts[instance.part].uvs[0].empty();
 
-  // Vertices in world space, all parts concatenated. UVs are copied only when every part has
+  // Vertices in world space, all instances concatenated. UVs are copied only when every part has
   // the channel, so has_uv says what the texcoords hold.
-  const Mat3 linear = obj.transform.linear();
-  const Mat3 normal_matrix = linear.inverse().transpose();
-  const bool mirrors = linear.determinant() < 0;
   std::vector<ImportedVertex> vertices;
-  std::vector<std::size_t> first_vertex(file.parts.size());
+  std::vector<std::size_t> first_vertex(instances.size());
   bool uvs_finite = true;
-  for (std::size_t m = 0; m < file.parts.size(); ++m) {
-    const RawMeshPart& part = file.parts[m];
+  for (std::size_t m = 0; m < instances.size(); ++m) {
+    const RawMeshPart& part = file.parts[instances[m].part];
+    const Affine3& transform = instances[m].transform;
+    const Mat3 normal_matrix = transform.linear().inverse().transpose();
     first_vertex[m] = vertices.size();
     for (std::size_t i = 0; i < part.vertex_count(); ++i) {
       ImportedVertex v;
@@ -245,7 +250,7 @@ Expected<Mesh> build_mesh(const RawMeshFile& file, const ObjectDesc& obj, const 
                      " (as Assimp numbers them) has a non-finite position " +
                      format_vec(file_position) + "; fix the mesh file");
       }
-      v.position = obj.transform * file_position;
+      v.position = transform * file_position;
       // Finite but beyond any level (1e30 in a file, or a scale of 1e25): the ray tracer's
       // float arithmetic overflows on such coordinates, and a float there is coarser than a
       // texel anyway.
@@ -299,14 +304,14 @@ Expected<Mesh> build_mesh(const RawMeshFile& file, const ObjectDesc& obj, const 
 
   // Degenerate threshold relative to the object's size, from the vertices faces use.
   Bounds3 bounds;
-  for (std::size_t m = 0; m < file.parts.size(); ++m)
-    for (const std::uint32_t index : file.parts[m].triangles)
+  for (std::size_t m = 0; m < instances.size(); ++m)
+    for (const std::uint32_t index : file.parts[instances[m].part].triangles)
       bounds.extend(vertices[first_vertex[m] + index].position);
   const double diagonal = bounds.diagonal();
   const double min_area = kDegenerateAreaFraction * diagonal * diagonal;
 
   TriMesh& mesh = result.mesh;
-  const std::vector<std::size_t> welded = weld_vertices(file);
+  const std::vector<std::size_t> welded = weld_vertices(vertices, file, instances);
   std::vector<TriMesh::VertexHandle> handle(vertices.size());  // made on first use
   auto vertex = [&](std::size_t index) {
     if (!handle[index].is_valid()) {
@@ -319,8 +324,9 @@ Expected<Mesh> build_mesh(const RawMeshFile& file, const ObjectDesc& obj, const 
     }
     return handle[index];
   };
-  for (std::size_t m = 0; m < file.parts.size(); ++m) {
-    const std::vector<std::uint32_t>& triangles = file.parts[m].triangles;
+  for (std::size_t m = 0; m < instances.size(); ++m) {
+    const std::vector<std::uint32_t>& triangles = file.parts[instances[m].part].triangles;
+    const bool mirrors = instances[m].transform.linear().determinant() < 0;
     for (std::size_t f = 0; f + 2 < triangles.size(); f += 3) {
       std::size_t index[3];
       for (int k = 0; k < 3; ++k)
@@ -361,8 +367,9 @@ Expected<Mesh> build_mesh(const RawMeshFile& file, const ObjectDesc& obj, const 
 
 }  // namespace
 
-Expected<Mesh> import_mesh(const ObjectDesc& obj, const std::filesystem::path& scene_file,
-                           const ImportLimits& import_limits) {
+Expected<std::shared_ptr<const RawMeshFile>> read_object_file(
+    const ObjectDesc& obj, const std::filesystem::path& scene_file,
+    const ImportLimits& import_limits) {
   const ErrorPrefix error(obj, scene_file);
   const std::filesystem::path file = mesh_path(obj, scene_file);
   const std::string path = file.string();
@@ -382,10 +389,30 @@ Expected<Mesh> import_mesh(const ObjectDesc& obj, const std::filesystem::path& s
       return error("'" + path + "' is broken: Assimp says \"" + assimp_message(dropped) +
                    "\"; fix or re-export the mesh file");
     }
-    return build_mesh(*raw, obj, path, error);
+    return std::shared_ptr<const RawMeshFile>(std::make_shared<RawMeshFile>(std::move(*raw)));
   } catch (const std::exception& e) {
     return error("cannot import mesh '" + path + "': " + one_line(e.what()));
   }
+}
+
+Expected<Mesh> build_object_mesh(const ObjectDesc& obj, const RawMeshFile& file,
+                                 const std::filesystem::path& scene_file) {
+  const ErrorPrefix error(obj, scene_file);
+  const std::string path = mesh_path(obj, scene_file).string();
+  try {
+    const std::vector<PartInstance> instances =
+        part_instances(file, node_world_transforms(file), obj.node, obj.parts, obj.transform);
+    return build_mesh(file, instances, obj, path, error);
+  } catch (const std::exception& e) {
+    return error("cannot import mesh '" + path + "': " + one_line(e.what()));
+  }
+}
+
+Expected<Mesh> import_mesh(const ObjectDesc& obj, const std::filesystem::path& scene_file,
+                           const ImportLimits& import_limits) {
+  auto file = read_object_file(obj, scene_file, import_limits);
+  if (!file) return file.error();
+  return build_object_mesh(obj, **file, scene_file);
 }
 
 }  // namespace sb

@@ -96,7 +96,7 @@ Expected<RawMeshFile> unpack(std::string_view bytes) {
     if (!in.get_array(p.positions) || !in.get_array(p.normals)) return broken();
     for (auto& uv : p.uvs)
       if (!in.get_array(uv)) return broken();
-    if (!in.get_array(p.triangles)) return broken();
+    if (!in.get_array(p.triangles) || !in.get(p.material)) return broken();
     const std::size_t n = p.positions.size();
     bool sizes =
         n % 3 == 0 && (p.normals.empty() || p.normals.size() == n) && p.triangles.size() % 3 == 0;
@@ -105,6 +105,35 @@ Expected<RawMeshFile> unpack(std::string_view bytes) {
     if (!sizes) return broken();
     file.parts.push_back(std::move(p));
   }
+  std::uint64_t count = 0;
+  if (!in.get(count)) return broken();
+  for (std::uint64_t i = 0; i < count; ++i) {
+    RawNode n;
+    if (!in.get_string(n.name) || !in.get(n.parent) || !in.get(n.transform) ||
+        !in.get_array(n.parts))
+      return broken();
+    // Depth first: a parent comes before its children, and only the root has none.
+    if ((i == 0) != (n.parent < 0) || n.parent >= std::int32_t(i)) return broken();
+    for (std::uint32_t part : n.parts)
+      if (part >= file.parts.size()) return broken();
+    file.nodes.push_back(std::move(n));
+  }
+  if (file.nodes.empty() || !in.get(count)) return broken();
+  for (std::uint64_t i = 0; i < count; ++i) {
+    RawMaterial m;
+    if (!in.get_string(m.name) || !in.get(m.emissive)) return broken();
+    file.materials.push_back(std::move(m));
+  }
+  if (!in.get(count)) return broken();
+  for (std::uint64_t i = 0; i < count; ++i) {
+    RawLight l;
+    if (!in.get_string(l.name) || !in.get(l.type) || !in.get(l.position) || !in.get(l.direction) ||
+        !in.get(l.up) || !in.get(l.color) || !in.get(l.inner_cone) || !in.get(l.outer_cone) ||
+        !in.get(l.size))
+      return broken();
+    file.lights.push_back(std::move(l));
+  }
+  if (!in.get(file.unit_scale)) return broken();
   if (!in.done()) return broken();
   return file;
 }

@@ -95,6 +95,11 @@ struct ObjectDesc {
   // In Lightmap"); 1 otherwise.
   double lightmap_scale = 1.0;
   int line = 0;  // line of the [[object]] table in the scene file, for errors
+  // An object of a level file (level_file.h): the node of `mesh` it is, and the node's parts it
+  // takes (empty: all; a node's emissive parts are lights). -1: every node of the file is this
+  // one object. `transform` applies after the node's world transform.
+  int node = -1;
+  std::vector<std::uint32_t> parts;
 };
 
 enum class LightShape { rectangle, disk, sphere };
