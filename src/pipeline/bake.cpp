@@ -150,6 +150,7 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   const auto thread_limit = limit_threads(options);
 
   BakeResult result;
+  result.setup_warnings = scene.warnings;
   report_ignored_settings(scene, *entry, &result.setup_warnings);
   const auto load_start = std::chrono::steady_clock::now();
   auto loaded = load_meshes(scene, &result.setup_warnings);

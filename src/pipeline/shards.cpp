@@ -11,6 +11,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <set>
 #include <sstream>
 
 #include "pipeline/settings_json.h"
@@ -73,9 +74,11 @@ Expected<std::string> scene_content_hash(const Scene& scene) {
   XXH3_128bits_reset(state.get());
   hash_text(state.get(), std::string("shadowbake ") + SHADOWBAKE_VERSION);
   if (Status s = hash_file(state.get(), scene.file); !s) return s.error();
+  std::set<fs::path> hashed = {scene.file};  // a level's file once, not once per node
   for (const ObjectDesc& obj : scene.objects) {
     hash_text(state.get(), obj.name);
-    if (Status s = hash_file(state.get(), obj.mesh); !s) return s.error();
+    if (hashed.insert(obj.mesh).second)
+      if (Status s = hash_file(state.get(), obj.mesh); !s) return s.error();
   }
   for (const LightDesc& light : scene.lights) {
     hash_text(state.get(), light.name);

@@ -52,8 +52,11 @@ Expected<Mesh> import_mesh(const ObjectDesc& obj, const std::filesystem::path& s
 
 // The two halves of import_mesh, for objects that share a file (a level's nodes): the file read
 // once (its checks, Assimp in the helper, dropped data refused), and an object's mesh built from
-// it. Errors name scene_file and the object as import_mesh's do.
+// it. Errors name scene_file and the object as import_mesh's do; read_checked_mesh_file's name
+// only the mesh file.
 struct RawMeshFile;
+Expected<RawMeshFile> read_checked_mesh_file(const std::filesystem::path& file,
+                                             const ImportLimits& limits);
 Expected<std::shared_ptr<const RawMeshFile>> read_object_file(
     const ObjectDesc& obj, const std::filesystem::path& scene_file, const ImportLimits& limits);
 Expected<Mesh> build_object_mesh(const ObjectDesc& obj, const RawMeshFile& file,

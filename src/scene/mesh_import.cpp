@@ -367,15 +367,12 @@ Expected<Mesh> build_mesh(const RawMeshFile& file, const std::vector<PartInstanc
 
 }  // namespace
 
-Expected<std::shared_ptr<const RawMeshFile>> read_object_file(
-    const ObjectDesc& obj, const std::filesystem::path& scene_file,
-    const ImportLimits& import_limits) {
-  const ErrorPrefix error(obj, scene_file);
-  const std::filesystem::path file = mesh_path(obj, scene_file);
+Expected<RawMeshFile> read_checked_mesh_file(const std::filesystem::path& file,
+                                             const ImportLimits& import_limits) {
   const std::string path = file.string();
   try {
     if (Status checked = check_mesh_file(file, import_limits.max_file_bytes); !checked) {
-      return error("cannot read mesh '" + path + "': " + checked.error().message);
+      return scene_error("cannot read mesh '" + path + "': " + checked.error().message);
     }
     MeshReadLimits limits;
     limits.max_memory = import_limits.max_memory;
@@ -384,15 +381,23 @@ Expected<std::shared_ptr<const RawMeshFile>> read_object_file(
                              ? import_limits.max_seconds
                              : 60 + 10 * double(std::filesystem::file_size(file, ec)) / 1e6;
     auto raw = read_mesh_file(file, limits);
-    if (!raw) return error("cannot read mesh '" + path + "': " + raw.error().message);
+    if (!raw) return scene_error("cannot read mesh '" + path + "': " + raw.error().message);
     if (const std::string dropped = dropped_data_message(raw->warnings); !dropped.empty()) {
-      return error("'" + path + "' is broken: Assimp says \"" + assimp_message(dropped) +
-                   "\"; fix or re-export the mesh file");
+      return scene_error("'" + path + "' is broken: Assimp says \"" + assimp_message(dropped) +
+                         "\"; fix or re-export the mesh file");
     }
-    return std::shared_ptr<const RawMeshFile>(std::make_shared<RawMeshFile>(std::move(*raw)));
+    return raw;
   } catch (const std::exception& e) {
-    return error("cannot import mesh '" + path + "': " + one_line(e.what()));
+    return scene_error("cannot import mesh '" + path + "': " + one_line(e.what()));
   }
+}
+
+Expected<std::shared_ptr<const RawMeshFile>> read_object_file(
+    const ObjectDesc& obj, const std::filesystem::path& scene_file,
+    const ImportLimits& import_limits) {
+  auto raw = read_checked_mesh_file(mesh_path(obj, scene_file), import_limits);
+  if (!raw) return ErrorPrefix(obj, scene_file)(raw.error().message);
+  return std::shared_ptr<const RawMeshFile>(std::make_shared<RawMeshFile>(std::move(*raw)));
 }
 
 Expected<Mesh> build_object_mesh(const ObjectDesc& obj, const RawMeshFile& file,

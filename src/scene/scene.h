@@ -161,10 +161,12 @@ struct Scene {
   std::vector<SettingGiven> bake_keys;  // in file order
   std::vector<ObjectDesc> objects;
   std::vector<LightDesc> lights;
+  std::vector<std::string> warnings;  // what reading it noticed (a level's renamed nodes, ...)
 };
 
 // Reads and validates a scene file. Every problem is an Error naming the file, the line, the item
-// and what is wrong; unknown keys are errors, not ignored.
+// and what is wrong; unknown keys are errors, not ignored. A file that is not .toml is a level
+// (level_file.h), baked alone with the default settings.
 Expected<Scene> load_scene(const std::filesystem::path& file);
 
 // Builds an object's transform from the optional keys: scale, then rotation about X, then Y,

@@ -21,6 +21,7 @@
 #include <system_error>
 #include <vector>
 
+#include "scene/level_file.h"
 #include "scene/scene.h"
 #include "scene/scene_file_tables.h"
 #include "scene/toml_table_reader.h"
@@ -134,9 +135,29 @@ Expected<std::vector<Desc>> read_unique(const std::filesystem::path& file, const
   return out;
 }
 
+// Appends an import's objects or lights to the scene's, refusing a name the scene already has.
+template <class Desc>
+Status add_unique(const std::filesystem::path& file, const char* kind, std::vector<Desc>& added,
+                  std::vector<Desc>& into) {
+  for (Desc& desc : added) {
+    for (const Desc& other : into) {
+      if (other.name == desc.name) {
+        return located_error(
+            file, desc.line, item_name(kind, desc.name),
+            fmt::format("{} names must be unique: the import's {} is also defined at line {}; "
+                        "rename one (an imported name is its node's)",
+                        kind, single_quoted(desc.name), other.line));
+      }
+    }
+    into.push_back(std::move(desc));
+  }
+  return Ok{};
+}
+
 }  // namespace
 
 Expected<Scene> load_scene(const std::filesystem::path& file) {
+  if (is_level_file(file)) return load_level_scene(file);
   Expected<std::string> text = read_text(file);
   if (!text) return text.error();
 
@@ -151,7 +172,8 @@ Expected<Scene> load_scene(const std::filesystem::path& file) {
 
   Scene scene;
   scene.file = file;
-  const std::vector<std::string_view> top_level_keys = {"bake", "output", "object", "light"};
+  const std::vector<std::string_view> top_level_keys = {"bake", "output", "object", "light",
+                                                        "import"};
   if (const toml::key* key = first_unknown_key(root, top_level_keys)) {
     return located_error(file, key->source().begin.line, "top level",
                          fmt::format("unknown key {} (known: {})", single_quoted(key->str()),
@@ -159,6 +181,7 @@ Expected<Scene> load_scene(const std::filesystem::path& file) {
   }
   std::vector<const toml::table*> object_tables;
   std::vector<const toml::table*> light_tables;
+  std::vector<const toml::table*> import_tables;
   for (const auto& [key, node] : root) {
     if (key == "bake") {
       const toml::table* bake = node.as_table();
@@ -187,7 +210,7 @@ Expected<Scene> load_scene(const std::filesystem::path& file) {
     } else {
       auto tables = tables_of(file, key, node);
       if (!tables) return tables.error();
-      (key == "object" ? object_tables : light_tables) = *tables;
+      (key == "object" ? object_tables : key == "light" ? light_tables : import_tables) = *tables;
     }
   }
 
@@ -197,6 +220,13 @@ Expected<Scene> load_scene(const std::filesystem::path& file) {
   auto lights = read_unique<LightDesc>(file, light_tables, "light", read_light);
   if (!lights) return lights.error();
   scene.lights = std::move(*lights);
+  for (std::size_t i = 0; i < import_tables.size(); ++i) {
+    auto level = read_import(file, *import_tables[i], i);
+    if (!level) return level.error();
+    if (Status s = add_unique(file, "object", level->objects, scene.objects); !s) return s.error();
+    if (Status s = add_unique(file, "light", level->lights, scene.lights); !s) return s.error();
+    scene.warnings.insert(scene.warnings.end(), level->warnings.begin(), level->warnings.end());
+  }
 
   if (scene.objects.empty()) {
     return located_error(file, 0, "scene", "no [[object]] table; a scene needs at least one");

@@ -15,6 +15,16 @@ bool is_file_name_part(std::string_view name) {
   return true;
 }
 
+Affine3 read_placement(TableReader& r) {
+  const Vec3 translate = r.vec3("translate", "3 finite numbers", is_finite).value_or(Vec3::Zero());
+  const Vec3 rotate_deg =
+      r.vec3("rotate_deg", "3 finite numbers (degrees)", is_finite).value_or(Vec3::Zero());
+  const Vec3 scale = r.vec3("scale", "3 finite non-zero numbers", [](double x) {
+                        return std::isfinite(x) && x != 0;
+                      }).value_or(Vec3::Ones());
+  return object_transform(translate, rotate_deg, scale);
+}
+
 Expected<ObjectDesc> read_object(const std::filesystem::path& file, const toml::table& table,
                                  std::size_t index) {
   TableReader r(file, table, fmt::format("[[object]] #{}", index + 1));
@@ -41,13 +51,7 @@ Expected<ObjectDesc> read_object(const std::filesystem::path& file, const toml::
   if (auto v = r.integer("uv", 0, std::numeric_limits<int>::max())) {
     obj.uv_channel = static_cast<int>(*v);
   }
-  const Vec3 translate = r.vec3("translate", "3 finite numbers", is_finite).value_or(Vec3::Zero());
-  const Vec3 rotate_deg =
-      r.vec3("rotate_deg", "3 finite numbers (degrees)", is_finite).value_or(Vec3::Zero());
-  const Vec3 scale = r.vec3("scale", "3 finite non-zero numbers", [](double x) {
-                        return std::isfinite(x) && x != 0;
-                      }).value_or(Vec3::Ones());
-  obj.transform = object_transform(translate, rotate_deg, scale);
+  obj.transform = read_placement(r);
   if (auto v = r.number("lightmap_scale", "a number > 0", is_positive)) obj.lightmap_scale = *v;
   if (r.failed()) return r.error();
   return obj;

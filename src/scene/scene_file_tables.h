@@ -29,4 +29,10 @@ Expected<ObjectDesc> read_object(const std::filesystem::path& file, const toml::
 Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::table& table,
                                std::size_t index);
 
+// The [[import]] table at `index` (from 0): its level file's objects and lights, placed and
+// overridden as the table says.
+struct LevelContents;
+Expected<LevelContents> read_import(const std::filesystem::path& file, const toml::table& table,
+                                    std::size_t index);
+
 }  // namespace sb

@@ -176,6 +176,10 @@ class TableReader {
 inline bool is_finite(double x) { return std::isfinite(x); }
 inline bool is_positive(double x) { return std::isfinite(x) && x > 0; }
 
+// The optional translate, rotate_deg and scale keys of an [[object]] or [[import]] table, as
+// object_transform builds them (scene.h).
+Affine3 read_placement(TableReader& r);
+
 // A path key naming an existing regular file, resolved against the scene file's folder.
 std::optional<std::filesystem::path> existing_file(TableReader& r,
                                                    const std::filesystem::path& file,

@@ -1,0 +1,388 @@
+// Levels (level_file.h): a mesh file's nodes as objects, its emissive rectangles and discs and its
+// KHR_lights_punctual lights as lights.
+#include "scene/level_file.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "scene/file_nodes.h"
+#include "scene/mesh_reader.h"
+
+namespace sb {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Lumens per watt: KHR_lights_punctual's candela and lux to the watts and W/m² of the scene
+// format, as Blender's glTF exporter and importer convert (PBR_WATTS_TO_LUMENS).
+constexpr double kLumensPerWatt = 683;
+
+std::string lower_extension(const fs::path& file) {
+  std::string ext = file.extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+// The glTF document of a .gltf or .glb file (the JSON chunk of a binary one), or null when the
+// file is not glTF or cannot be parsed (Assimp has read it by then, so it is well formed).
+nlohmann::json gltf_document(const fs::path& file) {
+  const std::string ext = lower_extension(file);
+  if (ext != ".gltf" && ext != ".glb") return nullptr;
+  std::ifstream in(file, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (ext == ".glb") {
+    // Header (magic, version, length), then the first chunk (length, type "JSON", data).
+    std::uint32_t length = 0, type = 0;
+    if (bytes.size() < 20) return nullptr;
+    std::memcpy(&length, bytes.data() + 12, 4);
+    std::memcpy(&type, bytes.data() + 16, 4);
+    if (type != 0x4E4F534A || length > bytes.size() - 20) return nullptr;
+    bytes = bytes.substr(20, length);
+  }
+  return nlohmann::json::parse(bytes, nullptr, false);
+}
+
+// Per material of the file, KHR_materials_emissive_strength's factor (1 where absent). Assimp
+// 5.2 does not read that extension; it keeps glTF's materials in their order.
+std::vector<double> emissive_strengths(const nlohmann::json& gltf, std::size_t count) {
+  std::vector<double> strength(count, 1.0);
+  if (!gltf.is_object() || !gltf.contains("materials") || !gltf["materials"].is_array())
+    return strength;
+  const auto& materials = gltf["materials"];
+  for (std::size_t i = 0; i < std::min(count, materials.size()); ++i) {
+    const auto* value = &materials[i];
+    for (const char* key : {"extensions", "KHR_materials_emissive_strength", "emissiveStrength"}) {
+      if (!value->is_object() || !value->contains(key)) {
+        value = nullptr;
+        break;
+      }
+      value = &(*value)[key];
+    }
+    if (value && value->is_number()) strength[i] = value->get<double>();
+  }
+  return strength;
+}
+
+// A node's name as an object or light name: characters a file name cannot hold become '_'.
+std::string safe_name(const std::string& name) {
+  std::string out;
+  for (char c : name) {
+    const bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
+                    c == '_' || c == '.' || c == '-';
+    out += ok ? c : '_';
+  }
+  if (out.empty()) out = "node";
+  if (out.front() == '.') out.front() = '_';
+  return out;
+}
+
+// Unique names for the nodes in `wanted` (indices into file.nodes): the node's own name, the
+// path of its parents (below the root) in front where two share it, and "-2", "-3", ... where
+// that still repeats (a warning each).
+std::map<std::size_t, std::string> unique_names(const RawMeshFile& file,
+                                                const std::vector<std::size_t>& wanted,
+                                                const std::string& where,
+                                                std::vector<std::string>& warnings) {
+  std::map<std::string, int> uses;
+  for (std::size_t n : wanted) ++uses[safe_name(file.nodes[n].name)];
+  std::map<std::size_t, std::string> names;
+  std::set<std::string> taken;
+  for (std::size_t n : wanted) {
+    std::string name = safe_name(file.nodes[n].name);
+    if (uses[name] > 1) {
+      for (std::int32_t p = file.nodes[n].parent; p > 0; p = file.nodes[std::size_t(p)].parent)
+        name = safe_name(file.nodes[std::size_t(p)].name) + "-" + name;
+    }
+    if (!taken.insert(name).second) {
+      std::string numbered;
+      for (int k = 2; !taken.insert(numbered = fmt::format("{}-{}", name, k)).second; ++k) {
+      }
+      warnings.push_back(
+          fmt::format("{}: node '{}': another node has the same name and parents; "
+                      "named '{}'",
+                      where, file.nodes[n].name, numbered));
+      name = numbered;
+    }
+    names[n] = name;
+  }
+  return names;
+}
+
+// An emissive part's triangles in world space, front side first (glTF's counter-clockwise).
+std::vector<Vec3> world_triangles(const RawMeshPart& part, const Affine3& transform) {
+  std::vector<Vec3> corners;
+  const bool mirrors = transform.linear().determinant() < 0;
+  for (std::size_t f = 0; f + 2 < part.triangles.size(); f += 3) {
+    Vec3 p[3];
+    for (int k = 0; k < 3; ++k) {
+      const float* v = &part.positions[3 * part.triangles[f + std::size_t(k)]];
+      p[k] = transform * Vec3(v[0], v[1], v[2]);
+    }
+    if (mirrors) std::swap(p[1], p[2]);
+    corners.insert(corners.end(), {p[0], p[1], p[2]});
+  }
+  return corners;
+}
+
+// The light an emissive part's triangles make, if they are a planar rectangle or disc: shape,
+// centre, normal (the front side), up, size. nullopt for any other shape.
+std::optional<LightDesc> planar_light(const std::vector<Vec3>& corners) {
+  Vec3 normal_sum = Vec3::Zero(), centroid = Vec3::Zero();
+  double area = 0;
+  Bounds3 bounds;
+  for (std::size_t i = 0; i + 2 < corners.size(); i += 3) {
+    const Vec3 cross = (corners[i + 1] - corners[i]).cross(corners[i + 2] - corners[i]);
+    normal_sum += cross;
+    area += 0.5 * cross.norm();
+    centroid += 0.5 * cross.norm() * (corners[i] + corners[i + 1] + corners[i + 2]) / 3.0;
+    for (int k = 0; k < 3; ++k) bounds.extend(corners[i + std::size_t(k)]);
+  }
+  if (!(area > 0) || normal_sum.norm() < 0.999 * 2 * area) return std::nullopt;  // not one plane
+  const Vec3 n = normal_sum.normalized();
+  centroid /= area;
+  const double size = bounds.diagonal();
+  for (const Vec3& p : corners)
+    if (std::abs((p - centroid).dot(n)) > 1e-4 * size) return std::nullopt;
+
+  LightDesc light;
+  light.normal = n;
+  // A rectangle: some triangle edge is a side, and the box along it has the triangles' area.
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i + 1 < corners.size(); ++i) {
+    Vec3 u = corners[i + 1] - corners[i];
+    u -= u.dot(n) * n;
+    if (u.norm() < 1e-6 * size) continue;
+    u.normalize();
+    const Vec3 v = n.cross(u);
+    double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;
+    for (const Vec3& p : corners) {
+      u0 = std::min(u0, (p - centroid).dot(u));
+      u1 = std::max(u1, (p - centroid).dot(u));
+      v0 = std::min(v0, (p - centroid).dot(v));
+      v1 = std::max(v1, (p - centroid).dot(v));
+    }
+    const double box = (u1 - u0) * (v1 - v0);
+    if (box < best && std::abs(box - area) <= 1e-3 * area) {
+      best = box;
+      light.shape = LightShape::rectangle;
+      light.position = centroid + 0.5 * (u0 + u1) * u + 0.5 * (v0 + v1) * v;
+      light.up = v;  // right = up × normal = u
+      light.width = u1 - u0;
+      light.height = v1 - v0;
+    }
+  }
+  if (std::isfinite(best)) return light;
+  // A disc: a polygon of at least 16 sides about its centroid holds more than 97 % of the
+  // circle through its farthest corner; it becomes a disk of its own area.
+  double reach = 0;
+  for (const Vec3& p : corners) reach = std::max(reach, (p - centroid).norm());
+  if (area < 0.97 * std::numbers::pi * reach * reach) return std::nullopt;
+  light.shape = LightShape::disk;
+  light.position = centroid;
+  light.radius = std::sqrt(area / std::numbers::pi);
+  const Vec3 y = std::abs(n.y()) < 0.999 ? Vec3::UnitY() : Vec3::UnitZ();
+  light.up = (y - y.dot(n) * n).normalized();
+  return light;
+}
+
+double light_area(const LightDesc& light) {
+  switch (light.shape) {
+    case LightShape::rectangle:
+      return light.width * light.height;
+    case LightShape::disk:
+      return std::numbers::pi * light.radius * light.radius;
+    case LightShape::sphere:
+      return 4 * std::numbers::pi * light.radius * light.radius;
+  }
+  return 0;
+}
+
+// Bytes a level's meshes take once built, per triangle placed: OpenMesh's half-edges and
+// attributes, the ray tracer's copy and the shafts' bounds (measured on the corpus: ~350).
+constexpr double kBytesPerPlacedTriangle = 400;
+
+}  // namespace
+
+bool is_level_file(const fs::path& file) { return lower_extension(file) != ".toml"; }
+
+Expected<LevelContents> import_level(const fs::path& file, const Affine3& placement, int line,
+                                     const ImportLimits& limits) {
+  const std::string where = file.string();
+  auto raw = read_checked_mesh_file(file, limits);
+  if (!raw) return raw.error();
+  LevelContents level;
+  const std::vector<Affine3> world = node_world_transforms(*raw);
+  const nlohmann::json gltf = gltf_document(file);
+  const std::vector<double> strength = emissive_strengths(gltf, raw->materials.size());
+  const auto fail = [&](const std::string& node, const std::string& problem) {
+    return scene_error(fmt::format("{}: node '{}': {}", where, node, problem));
+  };
+
+  // Emission per material (radiance, W/(m²·sr), per channel); a negative or non-finite one is an
+  // error naming the first node that uses it.
+  std::vector<Vec3> emission(raw->materials.size(), Vec3::Zero());
+  for (std::size_t m = 0; m < raw->materials.size(); ++m) {
+    const auto& e = raw->materials[m].emissive;
+    emission[m] = Vec3(e[0], e[1], e[2]) * strength[m];
+  }
+
+  std::vector<std::size_t> object_nodes;
+  double placed_triangles = 0;
+  for (std::size_t n = 0; n < raw->nodes.size(); ++n) {
+    bool surface = false;
+    for (std::uint32_t p : raw->nodes[n].parts) {
+      const RawMeshPart& part = raw->parts[p];
+      const Vec3 e = part.material < emission.size() ? emission[part.material] : Vec3::Zero();
+      if (!e.allFinite() || (e.array() < 0).any()) {
+        return fail(raw->nodes[n].name,
+                    fmt::format("material '{}' has a negative or non-finite emission ({}, {}, {})",
+                                raw->materials[part.material].name, e.x(), e.y(), e.z()));
+      }
+      surface = surface || !(e.maxCoeff() > 0);
+      placed_triangles += double(part.triangles.size() / 3);
+    }
+    if (surface) object_nodes.push_back(n);
+  }
+  // 100,000 instances of a mesh are cheap in the file and not in the bake: refused here with
+  // their cost rather than part-way through building them.
+  const double bytes = placed_triangles * kBytesPerPlacedTriangle;
+  if (limits.max_memory > 0 && bytes > double(limits.max_memory)) {
+    return scene_error(fmt::format(
+        "{}: its {} nodes place {:.0f} triangles, about {:.1f} GiB once built, more than the "
+        "{:.1f} GiB the bake may use; bake fewer instances or raise max_memory (--max-memory)",
+        where, raw->nodes.size(), placed_triangles, bytes / double(1ull << 30),
+        double(limits.max_memory) / double(1ull << 30)));
+  }
+
+  // Objects: a node's non-emissive parts.
+  const auto names = unique_names(*raw, object_nodes, where, level.warnings);
+  for (std::size_t n : object_nodes) {
+    ObjectDesc obj;
+    obj.name = names.at(n);
+    obj.mesh = file;
+    obj.node = int(n);
+    obj.transform = placement;
+    obj.line = line;
+    int channels = kMaxUvChannels;
+    for (std::uint32_t p : raw->nodes[n].parts) {
+      const RawMeshPart& part = raw->parts[p];
+      if (part.material < emission.size() && emission[part.material].maxCoeff() > 0) continue;
+      obj.parts.push_back(p);
+      channels = std::min(channels, part.uv_channel_count());
+    }
+    if (obj.parts.size() == raw->nodes[n].parts.size()) obj.parts.clear();
+    // The second UV set is the lightmap's by every engine's convention; the first otherwise.
+    obj.uv_channel = channels >= 2 ? 1 : 0;
+    if (channels == 0) {
+      obj.receiver = false;
+      level.warnings.push_back(fmt::format(
+          "{}: node '{}': has no UV set, so it is a blocker only (generated lightmap UVs are "
+          "not built yet); give it a lightmap UV set to bake it",
+          where, raw->nodes[n].name));
+    }
+    level.objects.push_back(std::move(obj));
+  }
+
+  // Lights: emissive rectangles and discs, then the file's punctual lights.
+  std::set<std::string> light_names;
+  const auto light_name = [&](const std::string& node) {
+    std::string name = safe_name(node);
+    for (int k = 2; !light_names.insert(name).second; ++k)
+      name = fmt::format("{}-{}", safe_name(node), k);
+    return name;
+  };
+  for (std::size_t n = 0; n < raw->nodes.size(); ++n) {
+    for (std::uint32_t p : raw->nodes[n].parts) {
+      const RawMeshPart& part = raw->parts[p];
+      if (part.material >= emission.size() || !(emission[part.material].maxCoeff() > 0)) continue;
+      const std::string& node = raw->nodes[n].name;
+      const std::optional<LightDesc> shape =
+          planar_light(world_triangles(part, placement * world[n]));
+      if (!shape) {
+        level.warnings.push_back(fmt::format(
+            "{}: node '{}': its emissive material '{}' is on a mesh that is not a planar "
+            "rectangle or disc, which is not a light shape yet; it is left out",
+            where, node, raw->materials[part.material].name));
+        continue;
+      }
+      LightDesc light = *shape;
+      light.name = light_name(node);
+      light.line = line;
+      const Vec3& e = emission[part.material];
+      light.color = e / e.maxCoeff();
+      light.power = std::numbers::pi * e.maxCoeff() * light_area(light);
+      level.lights.push_back(std::move(light));
+    }
+  }
+  for (const RawLight& raw_light : raw->lights) {
+    const auto node = std::find_if(raw->nodes.begin(), raw->nodes.end(),
+                                   [&](const RawNode& n) { return n.name == raw_light.name; });
+    const Affine3 transform =
+        placement * (node == raw->nodes.end() ? Affine3::Identity()
+                                              : world[std::size_t(node - raw->nodes.begin())]);
+    const Vec3 color(raw_light.color[0], raw_light.color[1], raw_light.color[2]);
+    const Vec3 position =
+        transform * Vec3(raw_light.position[0], raw_light.position[1], raw_light.position[2]);
+    if (!color.allFinite() || (color.array() < 0).any() || !position.allFinite())
+      return fail(raw_light.name, "the light has a negative or non-finite intensity or position");
+    if (raw_light.type != RawLight::point && raw_light.type != RawLight::spot) {
+      level.warnings.push_back(fmt::format(
+          "{}: node '{}': {} lights are not read yet; it is left out", where, raw_light.name,
+          raw_light.type == RawLight::directional ? "directional (sun)" : "area and ambient"));
+      continue;
+    }
+    if (!(color.maxCoeff() > 0)) continue;  // a light switched off
+    if (raw_light.type == RawLight::spot) {
+      level.warnings.push_back(fmt::format(
+          "{}: node '{}': a spot light's cone is not applied yet; it is baked as a point light",
+          where, raw_light.name));
+    }
+    LightDesc light;
+    light.name = light_name(raw_light.name);
+    light.shape = LightShape::sphere;
+    light.position = position;
+    light.radius = kImportedPointLightRadius;
+    light.color = color / color.maxCoeff();
+    light.power = 4 * std::numbers::pi * color.maxCoeff() / kLumensPerWatt;
+    light.line = line;
+    level.lights.push_back(std::move(light));
+  }
+  return level;
+}
+
+Expected<Scene> load_level_scene(const fs::path& file) {
+  Scene scene;
+  scene.file = file;
+  auto level = import_level(file, Affine3::Identity(), 0);
+  if (!level) return level.error();
+  scene.objects = std::move(level->objects);
+  scene.lights = std::move(level->lights);
+  scene.warnings = std::move(level->warnings);
+  if (scene.objects.empty())
+    return scene_error(file.string() + ": no node places a mesh, so there is nothing to bake");
+  if (scene.lights.empty()) {
+    return scene_error(file.string() +
+                       ": holds no light shadowbake reads (KHR_lights_punctual point or spot "
+                       "lights, or emissive rectangles and discs); add one, or bake it from a "
+                       "scene file that imports it and adds [[light]] tables");
+  }
+  if (std::none_of(scene.objects.begin(), scene.objects.end(),
+                   [](const ObjectDesc& o) { return o.receiver; }))
+    return scene_error(file.string() + ": no node has lightmap UVs, so there is nothing to bake");
+  return scene;
+}
+
+}  // namespace sb

@@ -1,0 +1,57 @@
+// A level: one mesh file (glTF, FBX, OBJ, anything Assimp reads) holding a whole scene, its
+// objects as nodes and its lights. `shadowbake bake level.glb` bakes one alone
+// (load_level_scene); a scene file brings one in with [[import]] (scene_file_imports.cpp) and
+// overrides what it needs by name.
+//
+// What a file's contents become (docs/scene-format.md, "Levels"):
+// - every node that places a mesh is an object, named by its node (file-name-safe: other
+//   characters become '_'); where two such nodes share a name, the names of their parents are put
+//   in front ("Shelf-Book"), and a name still repeated gets "-2", "-3", ... with a warning;
+// - each object is a receiver and a blocker, with its world transform (the file's node
+//   hierarchy, FBX's unit scale, then the import's placement), lightmap UVs from the second UV
+//   set where every part of it has one, else the first;
+// - a mesh part whose material emits (glTF emissiveFactor × KHR_materials_emissive_strength) is
+//   a light, not a surface: a planar rectangle or a planar disc becomes a rectangle or disk light
+//   emitting from its front side, of radiant exitance π × the emission (the emission read as
+//   radiance, W/(m²·sr), as Blender's Emission shader and its glTF exporter take it);
+// - KHR_lights_punctual point and spot lights become sphere lights of radius 0.25 m (Blender's
+//   default light radius, which its glTF importer gives them too) of power 4π × intensity / 683
+//   (candela to watts, as Blender's exporter and importer convert); a spot's cone is not applied
+//   yet, nor are directional (sun) lights and emissive meshes of other shapes read yet: each is
+//   a warning naming it.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "core/geometry.h"
+#include "scene/mesh.h"
+#include "scene/scene.h"
+
+namespace sb {
+
+// The radius an imported point or spot light gets where the scene does not give one, metres.
+inline constexpr double kImportedPointLightRadius = 0.25;
+
+struct LevelContents {
+  std::vector<ObjectDesc> objects;
+  std::vector<LightDesc> lights;
+  std::vector<std::string> warnings;  // one line each, naming the file and the node
+};
+
+// Reads `file` and makes its objects and lights, each placed by `placement` after the file's
+// own transforms; `line` is given to each (the [[import]] table's line, 0 for a level baked
+// alone). Errors name the file, the node and the problem.
+Expected<LevelContents> import_level(const std::filesystem::path& file, const Affine3& placement,
+                                     int line, const ImportLimits& limits = {});
+
+// Whether `file` is baked as a level rather than read as a scene file: any extension but .toml.
+bool is_level_file(const std::filesystem::path& file);
+
+// A scene of one level file alone: the default [bake] and [output] settings, the file's objects
+// and lights. Errors as load_scene's.
+Expected<Scene> load_level_scene(const std::filesystem::path& file);
+
+}  // namespace sb

@@ -1,0 +1,137 @@
+// The [[import]] tables of a scene file (docs/scene-format.md, "Levels"): a level file's objects
+// and lights (level_file.h) brought into the scene, placed, and changed by name or glob in
+// [[import.object]] and [[import.light]] tables. A pattern that matches nothing is an error: a
+// typo must not silently leave an object as it was.
+#include <fnmatch.h>
+
+#include <string>
+#include <vector>
+
+#include "scene/level_file.h"
+#include "scene/mesh_reader.h"
+#include "scene/scene_file_tables.h"
+#include "scene/toml_table_reader.h"
+
+namespace sb {
+
+namespace {
+
+// The tables under `key` of an [[import]] table (its [[import.object]] or [[import.light]]).
+std::vector<const toml::table*> sub_tables(TableReader& r, std::string_view key) {
+  std::vector<const toml::table*> tables;
+  const toml::node* node = r.find(key);
+  if (!node) return tables;
+  const auto* array = node->as_array();
+  if (array) {
+    for (const toml::node& element : *array)
+      if (const auto* table = element.as_table()) tables.push_back(table);
+  }
+  if (!array || tables.size() != array->size())
+    r.fail(key, fmt::format("'{0}' must be an array of tables, written [[import.{0}]]", key));
+  return tables;
+}
+
+// Every element of `items` whose name matches the table's `name` (a glob: *, ?, [...]), or an
+// error naming the pattern when none does.
+template <class Item>
+std::vector<Item*> matching(TableReader& r, std::vector<Item>& items, const char* kind,
+                            const std::filesystem::path& level) {
+  std::vector<Item*> found;
+  if (!r.require("name")) return found;
+  const std::optional<std::string> pattern = r.string("name");
+  if (!pattern) return found;
+  for (Item& item : items)
+    if (::fnmatch(pattern->c_str(), item.name.c_str(), 0) == 0) found.push_back(&item);
+  if (found.empty()) {
+    std::string names;
+    for (const Item& item : items) names += (names.empty() ? "" : ", ") + item.name;
+    r.fail("name", fmt::format("'{}' matches no {} of '{}' (its {}s: {})", *pattern, kind,
+                               level.string(), kind, names.empty() ? "none" : names));
+  }
+  return found;
+}
+
+Status override_objects(const std::filesystem::path& file, const toml::table& table,
+                        const std::filesystem::path& level, std::vector<ObjectDesc>& objects) {
+  TableReader r(file, table, "[[import.object]]");
+  r.check_known_keys({"name", "receiver", "blocker", "uv", "lightmap_scale", "allow_uncovered"});
+  const std::vector<ObjectDesc*> targets = matching(r, objects, "object", level);
+  const auto receiver = r.boolean("receiver");
+  const auto blocker = r.boolean("blocker");
+  const auto allow_uncovered = r.boolean("allow_uncovered");
+  const auto uv = r.integer("uv", 0, kMaxUvChannels - 1);
+  const auto scale = r.number("lightmap_scale", "a number > 0", is_positive);
+  if (r.failed()) return r.error();
+  for (ObjectDesc* o : targets) {
+    if (receiver) o->receiver = *receiver;
+    if (blocker) o->blocker = *blocker;
+    if (allow_uncovered) o->allow_uncovered = *allow_uncovered;
+    if (uv) o->uv_channel = int(*uv);
+    if (scale) o->lightmap_scale = *scale;
+    o->line = int(r.line());
+  }
+  return Ok{};
+}
+
+Status override_lights(const std::filesystem::path& file, const toml::table& table,
+                       const std::filesystem::path& level, std::vector<LightDesc>& lights) {
+  TableReader r(file, table, "[[import.light]]");
+  r.check_known_keys({"name", "enabled", "radius", "power", "color", "shadowmask_range"});
+  const std::vector<LightDesc*> targets = matching(r, lights, "light", level);
+  const auto enabled = r.boolean("enabled");
+  const auto radius = r.number("radius", "a positive number (metres)", is_positive);
+  const auto power = r.number("power", "a finite number > 0 (watts)", is_positive);
+  const auto color = r.vec3("color", "3 finite numbers >= 0, not all zero",
+                            [](double x) { return std::isfinite(x) && x >= 0; });
+  if (color && color->isZero(0)) r.fail_got("color", "3 finite numbers >= 0, not all zero");
+  const auto range = r.number("shadowmask_range", "a number > 0 (metres)", is_positive);
+  for (const LightDesc* light : targets) {
+    if (radius && light->shape == LightShape::rectangle)
+      r.fail("radius", fmt::format("'radius' applies to sphere and disk lights, and '{}' is a "
+                                   "rectangle",
+                                   light->name));
+  }
+  if (r.failed()) return r.error();
+  for (LightDesc* light : targets) {
+    if (radius) {
+      // The same exitance-independent power: only the size changes.
+      light->radius = *radius;
+    }
+    if (power) light->power = *power;
+    if (color) light->color = *color;
+    if (range) light->shadowmask_range = *range;
+    light->line = int(r.line());
+    if (enabled && !*enabled) light->name.clear();  // removed below
+  }
+  std::erase_if(lights, [](const LightDesc& l) { return l.name.empty(); });
+  return Ok{};
+}
+
+}  // namespace
+
+Expected<LevelContents> read_import(const std::filesystem::path& file, const toml::table& table,
+                                    std::size_t index) {
+  TableReader r(file, table, fmt::format("[[import]] #{}", index + 1));
+  r.check_known_keys({"file", "translate", "rotate_deg", "scale", "lights", "object", "light"});
+  r.require("file");
+  const auto level_file = existing_file(r, file, "file", "level file");
+  const Affine3 placement = read_placement(r);
+  const bool with_lights = r.boolean("lights").value_or(true);
+  const auto object_tables = sub_tables(r, "object");
+  const auto light_tables = sub_tables(r, "light");
+  if (r.failed()) return r.error();
+
+  auto level = import_level(*level_file, placement, int(r.line()));
+  if (!level) {
+    return located_error(file, int(r.line()), fmt::format("[[import]] #{}", index + 1),
+                         level.error().message);
+  }
+  if (!with_lights) level->lights.clear();
+  for (const toml::table* t : object_tables)
+    if (Status s = override_objects(file, *t, *level_file, level->objects); !s) return s.error();
+  for (const toml::table* t : light_tables)
+    if (Status s = override_lights(file, *t, *level_file, level->lights); !s) return s.error();
+  return std::move(*level);
+}
+
+}  // namespace sb

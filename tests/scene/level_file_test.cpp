@@ -1,0 +1,428 @@
+// Levels (scene/level_file.h): a whole glTF baked with no scene file, its nodes as objects and its
+// lights as lights, checked on scenes/level (Blender's export) and on small hand-written files.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "pipeline/bake.h"
+#include "scene/level_file.h"
+#include "scene/mesh.h"
+#include "scene/scene.h"
+
+namespace sb {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kLevel = fs::path(SB_SOURCE_DIR) / "scenes" / "level" / "level.glb";
+
+const ObjectDesc* object_named(const Scene& scene, const std::string& name) {
+  for (const ObjectDesc& o : scene.objects)
+    if (o.name == name) return &o;
+  return nullptr;
+}
+
+const LightDesc* light_named(const Scene& scene, const std::string& name) {
+  for (const LightDesc& l : scene.lights)
+    if (l.name == name) return &l;
+  return nullptr;
+}
+
+bool any_warning_has(const std::vector<std::string>& warnings, const std::string& text) {
+  return std::any_of(warnings.begin(), warnings.end(),
+                     [&](const std::string& w) { return w.find(text) != std::string::npos; });
+}
+
+TEST(LevelFile, BlendersExportBecomesObjectsAndLights) {
+  auto scene = load_scene(kLevel);
+  ASSERT_TRUE(scene) << scene.error().message;
+  std::vector<std::string> names;
+  for (const ObjectDesc& o : scene->objects) names.push_back(o.name);
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"back_wall", "book_a", "book_b", "chair_a", "chair_b",
+                                             "floor", "shelf", "side_wall", "table"}));
+  for (const ObjectDesc& o : scene->objects) {
+    EXPECT_TRUE(o.receiver && o.blocker) << o.name;
+    EXPECT_EQ(o.uv_channel, 1) << o.name << ": the second UV set is the lightmap's";
+    EXPECT_GE(o.node, 0) << o.name;
+  }
+  // Blender's Z-up (x, y, z) is glTF's (x, z, -y). The ceiling panel: a 1 × 0.5 m quad at
+  // (0.4, 0.3, 2.4) facing down, emission (1, 0.95, 0.85) × 6, so 0.5 m² × π × 6 W.
+  const LightDesc* panel = light_named(*scene, "ceiling_panel");
+  ASSERT_NE(panel, nullptr);
+  EXPECT_EQ(panel->shape, LightShape::rectangle);
+  EXPECT_LT((panel->position - Vec3(0.4, 2.4, -0.3)).norm(), 1e-5);
+  EXPECT_LT((panel->normal - Vec3(0, -1, 0)).norm(), 1e-6);
+  EXPECT_NEAR(panel->width * panel->height, 0.5, 1e-5);
+  EXPECT_NEAR(std::max(panel->width, panel->height), 1.0, 1e-5);
+  EXPECT_NEAR(panel->power, std::numbers::pi * 6 * 0.5, 1e-3);
+  EXPECT_LT((panel->color - Vec3(1, 0.95, 0.85)).norm(), 1e-6);
+  // The disc: a 32-gon of radius 0.2 m at (-1.6, -1.2, 2.0), a disk of its own area.
+  const LightDesc* disc = light_named(*scene, "disc_lamp");
+  ASSERT_NE(disc, nullptr);
+  EXPECT_EQ(disc->shape, LightShape::disk);
+  EXPECT_LT((disc->position - Vec3(-1.6, 2.0, 1.2)).norm(), 1e-5);
+  const double polygon_area = 16 * 0.2 * 0.2 * std::sin(2 * std::numbers::pi / 32);
+  EXPECT_NEAR(disc->radius, std::sqrt(polygon_area / std::numbers::pi), 1e-5);
+  EXPECT_LT((disc->normal - Vec3(0, -1, 0)).norm(), 1e-6);
+  // The point light: 150 W at (1.6, -1.3, 1.8), written as 150 / 4π × 683 cd.
+  const LightDesc* bulb = light_named(*scene, "bulb");
+  ASSERT_NE(bulb, nullptr);
+  EXPECT_EQ(bulb->shape, LightShape::sphere);
+  EXPECT_LT((bulb->position - Vec3(1.6, 1.8, 1.3)).norm(), 1e-5);
+  EXPECT_NEAR(bulb->power, 150, 1e-3);
+  EXPECT_EQ(bulb->radius, kImportedPointLightRadius);
+  ASSERT_NE(light_named(*scene, "spot"), nullptr);
+  EXPECT_EQ(scene->lights.size(), 4u);
+  EXPECT_TRUE(any_warning_has(scene->warnings, "node 'sun': directional"));
+  EXPECT_TRUE(any_warning_has(scene->warnings, "node 'spot': a spot light's cone"));
+}
+
+// The level baked as one file equals the same objects baked one file per object
+// (scenes/level/objects, each exported alone by Blender with its world transform): bit for bit
+// where the node has no parent, and within float rounding of the composed transforms where it
+// has (the shelf under the wall, the books under the shelf).
+TEST(LevelFile, BakeEqualsOneFilePerObject) {
+  auto level = load_scene(kLevel);
+  ASSERT_TRUE(level) << level.error().message;
+  level->bake.resolution = 64;
+  level->bake.margin = 0;
+  Scene per_object = *level;
+  for (ObjectDesc& o : per_object.objects) {
+    o.mesh = kLevel.parent_path() / "objects" / (o.name + ".glb");
+    o.node = -1;
+    o.parts.clear();
+  }
+  auto a = bake(*level);
+  auto b = bake(per_object);
+  ASSERT_TRUE(a) << a.error().message;
+  ASSERT_TRUE(b) << b.error().message;
+  ASSERT_EQ(a->receivers.size(), b->receivers.size());
+  for (std::size_t r = 0; r < a->receivers.size(); ++r) {
+    const Image& x = a->receivers[r].image;
+    const Image& y = b->receivers[r].image;
+    ASSERT_EQ(x.pixels.size(), y.pixels.size());
+    float largest = 0;
+    for (std::size_t i = 0; i < x.pixels.size(); ++i)
+      largest = std::max(largest, std::abs(x.pixels[i] - y.pixels[i]));
+    const std::string& name = a->receivers[r].name;
+    const bool parented = name == "shelf" || name == "book_a" || name == "book_b";
+    if (parented) {
+      EXPECT_LT(largest, 1e-3) << name;
+    } else {
+      EXPECT_EQ(largest, 0) << name;
+    }
+  }
+}
+
+// The same room modelled in millimetres under a root scaled by 0.001, lit by its emissive panel
+// alone: the level's transforms make it the metre room.
+TEST(LevelFile, MillimetreLevelIsTheMetreLevel) {
+  auto mm = load_scene(kLevel.parent_path() / "level_mm.glb");
+  auto m = load_scene(kLevel);
+  ASSERT_TRUE(mm) << mm.error().message;
+  ASSERT_TRUE(m) << m.error().message;
+  ASSERT_EQ(mm->lights.size(), 1u);
+  const LightDesc& a = mm->lights[0];
+  const LightDesc& b = *light_named(*m, "ceiling_panel");
+  EXPECT_LT((a.position - b.position).norm(), 1e-6);
+  EXPECT_NEAR(a.width, b.width, 1e-6);
+  EXPECT_NEAR(a.power, b.power, 1e-4);
+  for (const char* name : {"floor", "chair_b", "book_a"}) {
+    const ObjectDesc* x = object_named(*mm, name);
+    const ObjectDesc* y = object_named(*m, name);
+    ASSERT_TRUE(x && y) << name;
+    auto mx = import_mesh(*x, mm->file);
+    auto my = import_mesh(*y, m->file);
+    ASSERT_TRUE(mx && my) << name;
+    ASSERT_EQ(mx->mesh.n_vertices(), my->mesh.n_vertices()) << name;
+    double largest = 0;
+    for (auto v : mx->mesh.vertices())
+      largest = std::max(largest, (mx->mesh.point(v) - my->mesh.point(v)).norm());
+    EXPECT_LT(largest, 1e-6) << name << ": metres";
+  }
+}
+
+// Small glTF files written here: one quad mesh (two triangles, normals +Z, one UV set) placed by
+// the nodes given.
+class HandWrittenLevel : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("sb_level_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  static std::string base64(const std::vector<std::uint8_t>& bytes) {
+    static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    for (std::size_t i = 0; i < bytes.size(); i += 3) {
+      const std::uint32_t n = (std::uint32_t(bytes[i]) << 16) |
+                              (i + 1 < bytes.size() ? std::uint32_t(bytes[i + 1]) << 8 : 0) |
+                              (i + 2 < bytes.size() ? bytes[i + 2] : 0);
+      out += table[(n >> 18) & 63];
+      out += table[(n >> 12) & 63];
+      out += i + 1 < bytes.size() ? table[(n >> 6) & 63] : '=';
+      out += i + 2 < bytes.size() ? table[n & 63] : '=';
+    }
+    return out;
+  }
+
+  // A glTF of `nodes`, the quad as mesh 0 with material 0 of the given emissive factor (and
+  // strength, when not 1), and the scene's root nodes.
+  fs::path write(const nlohmann::json& nodes, const std::vector<int>& roots,
+                 const std::vector<double>& emissive = {0, 0, 0}, double strength = 1,
+                 double quad_size = 1) {
+    const float h = float(quad_size / 2);
+    const float positions[] = {-h, -h, 0, h, -h, 0, h, h, 0, -h, h, 0};
+    const float normals[] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+    const float uvs[] = {0.1f, 0.1f, 0.9f, 0.1f, 0.9f, 0.9f, 0.1f, 0.9f};
+    const std::uint16_t indices[] = {0, 1, 2, 0, 2, 3};
+    std::vector<std::uint8_t> bytes(sizeof positions + sizeof normals + sizeof uvs +
+                                    sizeof indices);
+    std::uint8_t* at = bytes.data();
+    for (const auto& [data, size] :
+         {std::pair<const void*, std::size_t>{positions, sizeof positions},
+          {normals, sizeof normals},
+          {uvs, sizeof uvs},
+          {indices, sizeof indices}}) {
+      std::memcpy(at, data, size);
+      at += size;
+    }
+    nlohmann::json material = {{"name", "m"}, {"emissiveFactor", emissive}};
+    if (strength != 1)
+      material["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"] = strength;
+    nlohmann::json primitive;
+    primitive["attributes"] = {{"POSITION", 0}, {"NORMAL", 1}, {"TEXCOORD_0", 2}};
+    primitive["indices"] = 3;
+    primitive["material"] = 0;
+    nlohmann::json gltf;
+    gltf["asset"]["version"] = "2.0";
+    gltf["scene"] = 0;
+    gltf["scenes"] = nlohmann::json::array({{{"nodes", roots}}});
+    gltf["nodes"] = nodes;
+    gltf["materials"] = nlohmann::json::array({material});
+    gltf["meshes"] = nlohmann::json::array({{{"primitives", nlohmann::json::array({primitive})}}});
+    gltf["buffers"] =
+        nlohmann::json::array({{{"byteLength", bytes.size()},
+                                {"uri", "data:application/octet-stream;base64," + base64(bytes)}}});
+    const auto view = [](int offset, int length) {
+      return nlohmann::json{{"buffer", 0}, {"byteOffset", offset}, {"byteLength", length}};
+    };
+    gltf["bufferViews"] =
+        nlohmann::json::array({view(0, 48), view(48, 48), view(96, 32), view(128, 12)});
+    const auto accessor = [](int view, int type, int count, const char* shape) {
+      return nlohmann::json{
+          {"bufferView", view}, {"componentType", type}, {"count", count}, {"type", shape}};
+    };
+    nlohmann::json position = accessor(0, 5126, 4, "VEC3");
+    position["min"] = {-h, -h, 0};
+    position["max"] = {h, h, 0};
+    gltf["accessors"] =
+        nlohmann::json::array({position, accessor(1, 5126, 4, "VEC3"), accessor(2, 5126, 4, "VEC2"),
+                               accessor(3, 5123, 6, "SCALAR")});
+    if (strength != 1) gltf["extensionsUsed"] = {"KHR_materials_emissive_strength"};
+    const fs::path file = dir_ / "level.gltf";
+    std::ofstream(file) << gltf.dump(1);
+    return file;
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(HandWrittenLevel, RepeatedNamesTakeTheirParentsPath) {
+  const nlohmann::json nodes = {
+      {{"name", "shelf_a"}, {"children", {2}}, {"translation", {0, 0, 1}}},
+      {{"name", "shelf_b"}, {"children", {3}}, {"translation", {0, 0, 2}}},
+      {{"name", "book"}, {"mesh", 0}},
+      {{"name", "book"}, {"mesh", 0}, {"translation", {1, 0, 0}}},
+      {{"name", "book"}, {"mesh", 0}, {"translation", {3, 0, 0}}},
+      {{"name", "book"}, {"mesh", 0}, {"translation", {4, 0, 0}}}};
+  const fs::path file = write(nodes, {0, 1, 4, 5});
+  auto level = import_level(file, Affine3::Identity(), 0);
+  ASSERT_TRUE(level) << level.error().message;
+  std::vector<std::string> names;
+  for (const ObjectDesc& o : level->objects) names.push_back(o.name);
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"book", "book-2", "shelf_a-book", "shelf_b-book"}));
+  EXPECT_TRUE(any_warning_has(level->warnings, "node 'book': another node has the same name"));
+  // Each instance of the one mesh is its own object at its own place.
+  for (const ObjectDesc& o : level->objects) {
+    auto mesh = import_mesh(o, file);
+    ASSERT_TRUE(mesh) << mesh.error().message;
+    EXPECT_EQ(mesh->mesh.n_faces(), 2u);
+  }
+}
+
+TEST_F(HandWrittenLevel, EmissiveQuadIsARectangleLightWithItsStrength) {
+  const nlohmann::json nodes = {
+      {{"name", "panel"},
+       {"mesh", 0},
+       {"translation", {0, 3, 0}},
+       {"rotation", {0.7071067811865476, 0, 0, 0.7071067811865476}}},  // +Z turned to -Y
+      {{"name", "floor"},
+       {"mesh", 0},
+       {"rotation", {-0.7071067811865476, 0, 0, 0.7071067811865476}},
+       {"scale", {4, 4, 4}}}};
+  // The floor shares the emissive mesh: it is a light too, and the level has no object.
+  const fs::path file = write(nodes, {0, 1}, {1, 0.5, 0.25}, 8, 0.5);
+  auto level = import_level(file, Affine3::Identity(), 0);
+  ASSERT_TRUE(level) << level.error().message;
+  ASSERT_EQ(level->lights.size(), 2u);
+  const LightDesc& panel = level->lights[0];
+  EXPECT_EQ(panel.name, "panel");
+  EXPECT_EQ(panel.shape, LightShape::rectangle);
+  EXPECT_LT((panel.position - Vec3(0, 3, 0)).norm(), 1e-6);
+  EXPECT_LT((panel.normal - Vec3(0, -1, 0)).norm(), 1e-6);
+  EXPECT_NEAR(panel.width, 0.5, 1e-6);
+  EXPECT_NEAR(panel.height, 0.5, 1e-6);
+  EXPECT_NEAR(panel.power, std::numbers::pi * 8 * 0.25, 1e-5);  // π L A, L = 8 W/(m² sr)
+  EXPECT_LT((panel.color - Vec3(1, 0.5, 0.25)).norm(), 1e-6);
+  EXPECT_NEAR(level->lights[1].width, 2.0, 1e-6);
+  EXPECT_TRUE(level->objects.empty());
+  auto scene = load_level_scene(file);
+  ASSERT_FALSE(scene);
+  EXPECT_NE(scene.error().message.find("no node places a mesh"), std::string::npos)
+      << scene.error().message;
+}
+
+TEST_F(HandWrittenLevel, BadNodesAndEmissionAreOneLineErrors) {
+  {  // a node that is its own grandchild
+    const nlohmann::json nodes = {{{"name", "a"}, {"children", {1}}, {"mesh", 0}},
+                                  {{"name", "b"}, {"children", {0}}}};
+    auto level = import_level(write(nodes, {0}), Affine3::Identity(), 0);
+    ASSERT_FALSE(level);
+    EXPECT_EQ(level.error().message.find('\n'), std::string::npos);
+    EXPECT_NE(level.error().message.find("level.gltf"), std::string::npos) << level.error().message;
+  }
+  {  // 300 nodes each the child of the last
+    nlohmann::json nodes = nlohmann::json::array();
+    for (int i = 0; i < 300; ++i) {
+      nlohmann::json node = {{"name", fmt::format("n{}", i)}, {"mesh", 0}};
+      if (i + 1 < 300) node["children"] = {i + 1};
+      nodes.push_back(node);
+    }
+    auto level = import_level(write(nodes, {0}), Affine3::Identity(), 0);
+    ASSERT_FALSE(level);
+    EXPECT_NE(level.error().message.find("nested more than"), std::string::npos)
+        << level.error().message;
+  }
+  {  // negative emission
+    const nlohmann::json nodes = {{{"name", "lamp"}, {"mesh", 0}}};
+    auto level = import_level(write(nodes, {0}, {1, 1, 1}, -2), Affine3::Identity(), 0);
+    ASSERT_FALSE(level);
+    EXPECT_NE(level.error().message.find("node 'lamp': material 'm' has a negative"),
+              std::string::npos)
+        << level.error().message;
+  }
+  {  // an emissive quad of zero area: not a light, said so
+    const nlohmann::json nodes = {{{"name", "flat"}, {"mesh", 0}, {"scale", {1, 0, 1}}},
+                                  {{"name", "floor"}, {"mesh", 0}}};
+    auto level = import_level(write(nodes, {0, 1}, {1, 1, 1}), Affine3::Identity(), 0);
+    ASSERT_TRUE(level) << level.error().message;
+    EXPECT_TRUE(any_warning_has(level->warnings, "node 'flat': its emissive material"));
+  }
+}
+
+// 100,000 instances of one mesh: read, and refused by the bake's memory check with its estimate
+// (each is a receiver with a 512² lightmap), not built until memory runs out.
+TEST_F(HandWrittenLevel, HundredThousandInstancesAreRefusedWithTheirCost) {
+  nlohmann::json nodes = nlohmann::json::array();
+  std::vector<int> roots;
+  for (int i = 0; i < 100000; ++i) {
+    nodes.push_back({{"name", fmt::format("crate{}", i)},
+                     {"mesh", 0},
+                     {"translation", {double(i % 300), 0, double(i / 300)}}});
+    roots.push_back(i);
+  }
+  const fs::path file = write(nodes, roots);
+  auto scene = load_level_scene(file);
+  ASSERT_FALSE(scene);  // no light: the quad is not emissive
+  // With a light added by hand, the bake refuses before building the meshes.
+  auto level = import_level(file, Affine3::Identity(), 0);
+  ASSERT_TRUE(level) << level.error().message;
+  EXPECT_EQ(level->objects.size(), 100000u);
+  Scene crates;
+  crates.file = file;
+  crates.objects = level->objects;
+  LightDesc lamp;
+  lamp.name = "lamp";
+  lamp.shape = LightShape::sphere;
+  lamp.position = Vec3(0, 5, 0);
+  lamp.radius = 0.1;
+  lamp.power = 100;
+  crates.lights = {lamp};
+  auto baked = bake(crates);
+  ASSERT_FALSE(baked);
+  EXPECT_NE(baked.error().message.find("GiB"), std::string::npos) << baked.error().message;
+}
+
+}  // namespace
+}  // namespace sb
+
+namespace sb {
+namespace {
+
+// A scene file that imports the level and overrides by glob.
+TEST(LevelImport, SceneFileOverridesByNameAndGlob) {
+  auto scene = load_scene(fs::path(SB_SOURCE_DIR) / "scenes" / "level" / "scene.toml");
+  ASSERT_TRUE(scene) << scene.error().message;
+  EXPECT_EQ(scene->bake.resolution, 256);
+  EXPECT_EQ(scene->objects.size(), 9u);
+  for (const ObjectDesc& o : scene->objects)
+    EXPECT_EQ(o.receiver, o.name.rfind("book_", 0) != 0) << o.name;
+  EXPECT_EQ(light_named(*scene, "spot"), nullptr);
+  ASSERT_NE(light_named(*scene, "bulb"), nullptr);
+  EXPECT_EQ(light_named(*scene, "bulb")->radius, 0.1);
+  EXPECT_EQ(scene->lights.size(), 3u);
+}
+
+class LevelImportErrors : public ::testing::Test {
+ protected:
+  // The scene file `text` beside the level; load_scene's error message.
+  std::string error_of(const std::string& text) {
+    const fs::path file =
+        kLevel.parent_path() / ("import_test_" + std::to_string(::getpid()) + ".toml");
+    std::ofstream(file) << text;
+    auto scene = load_scene(file);
+    fs::remove(file);
+    return scene ? std::string() : scene.error().message;
+  }
+};
+
+TEST_F(LevelImportErrors, NamesThatMatchNothingOrClashAreErrors) {
+  const std::string head = "[[import]]\nfile = \"level.glb\"\n";
+  std::string e = error_of(head + "[[import.object]]\nname = \"chiar*\"\nreceiver = false\n");
+  EXPECT_NE(e.find(":4: [[import.object]]: 'chiar*' matches no object of"), std::string::npos) << e;
+  EXPECT_NE(e.find("chair_a"), std::string::npos) << e;
+  e = error_of(head + "[[import.light]]\nname = \"ceiling_panel\"\nradius = 0.2\n");
+  EXPECT_NE(e.find("'radius' applies to sphere and disk lights"), std::string::npos) << e;
+  e = error_of(head + "[[import.object]]\nname = \"floor\"\nuv = 9\n");
+  EXPECT_NE(e.find("'uv' must be an integer from 0 to 7"), std::string::npos) << e;
+  e = error_of(head +
+               "[[object]]\nname = \"floor\"\nmesh = \"objects/floor.glb\"\n\n[[light]]\nname = "
+               "\"sun\"\nshape = \"sphere\"\nposition = [0, 5, 0]\nradius = 0.1\npower = 10\n");
+  EXPECT_NE(e.find("object 'floor': object names must be unique"), std::string::npos) << e;
+  e = error_of("[[import]]\nfile = \"missing.glb\"\n");
+  EXPECT_NE(e.find(":2: [[import]] #1: level file 'missing.glb' not found"), std::string::npos)
+      << e;
+  e = error_of(head + "colour = 1\n");
+  EXPECT_NE(e.find("unknown key 'colour'"), std::string::npos) << e;
+}
+
+}  // namespace
+}  // namespace sb
