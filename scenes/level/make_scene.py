@@ -11,6 +11,8 @@ level.glb (Y up, metres, as Blender's glTF exporter writes it):
   down), an emissive disc of radius 0.2 m, a point light, a spot light and a sun
   (KHR_lights_punctual).
 
+level.fbx is level.glb exported as FBX with Blender's defaults (Y up, unit scale applied).
+
 level_mm.glb uses an engine's conventions instead: the same room modelled in millimetres under a
 root empty scaled by 0.001, and the emissive ceiling panel as its only light.
 
@@ -177,3 +179,11 @@ for obj in objects:
 
 build(unit=0.001, lights=False)
 export_level(os.path.join(here, "level_mm.glb"))
+
+# The metre level again, as FBX (Blender's defaults: Y up, -Z forward, unit scale applied), for
+# the FBX route through Assimp.
+build()
+bpy.ops.object.select_all(action="SELECT")
+bpy.ops.export_scene.fbx(filepath=os.path.join(here, "level.fbx"), use_selection=False,
+                         object_types={"MESH", "LIGHT", "EMPTY"}, use_mesh_modifiers=True,
+                         mesh_smooth_type="FACE", bake_anim=False)

@@ -356,7 +356,10 @@ Expected<LevelContents> import_level(const fs::path& file, const Affine3& placem
     light.position = position;
     light.radius = kImportedPointLightRadius;
     light.color = color / color.maxCoeff();
-    light.power = 4 * std::numbers::pi * color.maxCoeff() / kLumensPerWatt;
+    // glTF's intensity is candela; other formats' (FBX as Blender writes it) is the light's
+    // watts.
+    light.power = gltf.is_object() ? 4 * std::numbers::pi * color.maxCoeff() / kLumensPerWatt
+                                   : color.maxCoeff();
     light.line = line;
     level.lights.push_back(std::move(light));
   }

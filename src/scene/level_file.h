@@ -14,9 +14,11 @@
 //   a light, not a surface: a planar rectangle or a planar disc becomes a rectangle or disk light
 //   emitting from its front side, of radiant exitance π × the emission (the emission read as
 //   radiance, W/(m²·sr), as Blender's Emission shader and its glTF exporter take it);
-// - KHR_lights_punctual point and spot lights become sphere lights of radius 0.25 m (Blender's
-//   default light radius, which its glTF importer gives them too) of power 4π × intensity / 683
-//   (candela to watts, as Blender's exporter and importer convert); a spot's cone is not applied
+// - point and spot lights (glTF's KHR_lights_punctual, FBX's lights) become sphere lights of
+//   radius 0.25 m (Blender's default light radius, which its glTF importer gives them too) of
+//   power 4π × intensity / 683 for glTF (candela to watts, as Blender's exporter and importer
+//   convert) and the intensity as watts otherwise (as Blender's FBX exporter writes the light's
+//   power); a spot's cone is not applied
 //   yet, nor are directional (sun) lights and emissive meshes of other shapes read yet: each is
 //   a warning naming it.
 #pragma once

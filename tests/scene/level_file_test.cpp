@@ -154,6 +154,38 @@ TEST(LevelFile, MillimetreLevelIsTheMetreLevel) {
   }
 }
 
+// The level exported by Blender as FBX is the glTF level: the same objects, lights and powers
+// (FBX's light intensity is watts, glTF's candela), and a bake within float rounding of the
+// transforms.
+TEST(LevelFile, FbxExportIsTheGltfLevel) {
+  auto fbx = load_scene(kLevel.parent_path() / "level.fbx");
+  auto gltf = load_scene(kLevel);
+  ASSERT_TRUE(fbx) << fbx.error().message;
+  ASSERT_TRUE(gltf) << gltf.error().message;
+  ASSERT_EQ(fbx->lights.size(), gltf->lights.size());
+  for (const LightDesc& a : fbx->lights) {
+    const LightDesc* b = light_named(*gltf, a.name);
+    ASSERT_NE(b, nullptr) << a.name;
+    EXPECT_EQ(a.shape, b->shape) << a.name;
+    EXPECT_LT((a.position - b->position).norm(), 1e-5) << a.name;
+    EXPECT_NEAR(a.power, b->power, 1e-3 * b->power) << a.name;
+  }
+  ASSERT_EQ(fbx->objects.size(), gltf->objects.size());
+  fbx->bake.resolution = gltf->bake.resolution = 64;
+  auto x = bake(*fbx);
+  auto y = bake(*gltf);
+  ASSERT_TRUE(x && y);
+  for (const ReceiverBake& r : x->receivers) {
+    const auto other = std::find_if(y->receivers.begin(), y->receivers.end(),
+                                    [&](const ReceiverBake& o) { return o.name == r.name; });
+    ASSERT_NE(other, y->receivers.end()) << r.name;
+    float largest = 0;
+    for (std::size_t i = 0; i < r.image.pixels.size(); ++i)
+      largest = std::max(largest, std::abs(r.image.pixels[i] - other->image.pixels[i]));
+    EXPECT_LT(largest, 2e-3) << r.name;
+  }
+}
+
 // Small glTF files written here: one quad mesh (two triangles, normals +Z, one UV set) placed by
 // the nodes given.
 class HandWrittenLevel : public ::testing::Test {
