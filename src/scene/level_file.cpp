@@ -345,12 +345,20 @@ Expected<LevelContents> import_level(const fs::path& file, const Affine3& placem
       continue;
     }
     if (!(color.maxCoeff() > 0)) continue;  // a light switched off
-    if (raw_light.type == RawLight::spot) {
-      level.warnings.push_back(fmt::format(
-          "{}: node '{}': a spot light's cone is not applied yet; it is baked as a point light",
-          where, raw_light.name));
-    }
     LightDesc light;
+    if (raw_light.type == RawLight::spot) {
+      const Vec3 axis = transform.linear() * Vec3(raw_light.direction[0], raw_light.direction[1],
+                                                  raw_light.direction[2]);
+      // glTF's cone angles are half-angles; Assimp gives FBX's as the whole cone.
+      const double half = gltf.is_object() ? 1.0 : 0.5;
+      light.spot_inner = half * raw_light.inner_cone;
+      light.spot_outer = half * raw_light.outer_cone;
+      if (!axis.allFinite() || !(axis.norm() > 0) || !std::isfinite(light.spot_inner) ||
+          !(light.spot_outer > 0) || !(light.spot_outer < std::numbers::pi))
+        return fail(raw_light.name, "the spot light has a zero or non-finite direction or cone");
+      light.spot_axis = axis.normalized();
+      light.spot_inner = std::clamp(light.spot_inner, 0.0, light.spot_outer);
+    }
     light.name = light_name(raw_light.name);
     light.shape = LightShape::sphere;
     light.position = position;

@@ -18,9 +18,9 @@
 //   radius 0.25 m (Blender's default light radius, which its glTF importer gives them too) of
 //   power 4π × intensity / 683 for glTF (candela to watts, as Blender's exporter and importer
 //   convert) and the intensity as watts otherwise (as Blender's FBX exporter writes the light's
-//   power); a spot's cone is not applied
-//   yet, nor are directional (sun) lights and emissive meshes of other shapes read yet: each is
-//   a warning naming it.
+//   power); a spot keeps its cone (LightDesc::spot_axis), which scales its irradiance;
+// - directional (sun) lights and emissive meshes of other shapes are not read yet: each is a
+//   warning naming it.
 #pragma once
 
 #include <filesystem>

@@ -255,7 +255,20 @@ double Light::form_factor(const Vec3& y, const Vec3& n) const {
   return 0.0;
 }
 
+double Light::spot_factor(const Vec3& y) const {
+  if (!(desc_.spot_outer > 0)) return 1.0;
+  const Vec3 d = y - desc_.position;
+  const double length = d.norm();
+  if (!(length > 0)) return 0.0;
+  const double cos_outer = std::cos(desc_.spot_outer), cos_inner = std::cos(desc_.spot_inner);
+  const double t = std::clamp(
+      (desc_.spot_axis.dot(d) / length - cos_outer) / std::max(1e-3, cos_inner - cos_outer), 0.0,
+      1.0);
+  return t * t;
+}
+
 bool Light::reaches(const Vec3& y, const Vec3& n) const {
+  if (!(spot_factor(y) > 0)) return false;
   const Vec3 c = desc_.position - y;
   switch (desc_.shape) {
     case LightShape::rectangle: {
@@ -282,7 +295,7 @@ bool Light::reaches(const Vec3& y, const Vec3& n) const {
 }
 
 Vec3 Light::unoccluded_irradiance(const Vec3& y, const Vec3& n) const {
-  return exitance_ * form_factor(y, n);
+  return exitance_ * (form_factor(y, n) * spot_factor(y));
 }
 
 LightSample Light::sample(const Vec3& y, const Vec3& n, const Vec2& u) const {

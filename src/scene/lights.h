@@ -94,11 +94,17 @@ class Light {
   // 128-gon of equal area, clipped, otherwise (relative error < 1e-4, tested). A textured light
   // uses its mean exitance: exact for a uniform texture, the far-field value otherwise.
   Vec3 unoccluded_irradiance(const Vec3& y, const Vec3& n) const;
-  // Whether any of the light lies above the horizon of (y, n) and faces y, i.e. F > 0; much
-  // cheaper than F itself.
+  // Whether any of the light lies above the horizon of (y, n) and faces y, i.e. F > 0, and y is
+  // inside a spot's cone; much cheaper than F itself.
   bool reaches(const Vec3& y, const Vec3& n) const;
-  // The form factor F alone (dimensionless, H0 = E · F).
+  // The form factor F alone (dimensionless, H0 = E · F · spot_factor).
   double form_factor(const Vec3& y, const Vec3& n) const;
+  // A spot's cone at y (LightDesc::spot_axis): 1 inside the inner cone, 0 outside the outer one,
+  // and between them KHR_lights_punctual's falloff, the square of (cos θ − cos θ_outer) /
+  // (cos θ_inner − cos θ_outer), θ the angle between the axis and the direction from the centre
+  // to y. 1 everywhere for a light that is not a spot. It scales the light's irradiance, not
+  // its visibility: every method reads it through unoccluded_irradiance and reaches.
+  double spot_factor(const Vec3& y) const;
 
   // Maps a stratified point u ∈ [0,1)² to a light sample as seen from y with normal n.
   // Rectangle and disk: uniform in area, weight cosθ_light · cosθ_receiver / r².

@@ -120,6 +120,11 @@ struct LightDesc {
   // be given to another light (lightmaps/shadowmask.h). Infinite: wherever the light reaches.
   // The bake itself does not cut the light off.
   double shadowmask_range = std::numeric_limits<double>::infinity();
+  // A spot (a sphere light imported from a level's spot light): the unit axis it shines along and
+  // its cone's inner and outer half-angles, radians; spot_outer 0: no cone. Its unoccluded
+  // irradiance falls off between the two as glTF's KHR_lights_punctual says (Light::spot_factor).
+  Vec3 spot_axis = Vec3::Zero();
+  double spot_inner = 0, spot_outer = 0;
   int line = 0;
 };
 

@@ -83,10 +83,16 @@ TEST(LevelFile, BlendersExportBecomesObjectsAndLights) {
   EXPECT_LT((bulb->position - Vec3(1.6, 1.8, 1.3)).norm(), 1e-5);
   EXPECT_NEAR(bulb->power, 150, 1e-3);
   EXPECT_EQ(bulb->radius, kImportedPointLightRadius);
-  ASSERT_NE(light_named(*scene, "spot"), nullptr);
+  // The spot: 300 W at (-1.4, 1.2, 2.4) pointing down, a 70° cone blended over 15 % of it
+  // (Blender's spot_size and spot_blend, written as half-angles 35° and 29.75°).
+  const LightDesc* spot = light_named(*scene, "spot");
+  ASSERT_NE(spot, nullptr);
+  EXPECT_LT((spot->spot_axis - Vec3(0, -1, 0)).norm(), 1e-6);
+  EXPECT_NEAR(spot->spot_outer, 35 * std::numbers::pi / 180, 1e-6);
+  EXPECT_NEAR(spot->spot_inner, 0.5192354463883326, 1e-6);
+  EXPECT_NEAR(spot->power, 300, 1e-3);
   EXPECT_EQ(scene->lights.size(), 4u);
   EXPECT_TRUE(any_warning_has(scene->warnings, "node 'sun': directional"));
-  EXPECT_TRUE(any_warning_has(scene->warnings, "node 'spot': a spot light's cone"));
 }
 
 // The level baked as one file equals the same objects baked one file per object
@@ -169,6 +175,9 @@ TEST(LevelFile, FbxExportIsTheGltfLevel) {
     EXPECT_EQ(a.shape, b->shape) << a.name;
     EXPECT_LT((a.position - b->position).norm(), 1e-5) << a.name;
     EXPECT_NEAR(a.power, b->power, 1e-3 * b->power) << a.name;
+    EXPECT_LT((a.spot_axis - b->spot_axis).norm(), 1e-5) << a.name;
+    EXPECT_NEAR(a.spot_outer, b->spot_outer, 1e-6) << a.name;
+    EXPECT_NEAR(a.spot_inner, b->spot_inner, 1e-6) << a.name;
   }
   ASSERT_EQ(fbx->objects.size(), gltf->objects.size());
   fbx->bake.resolution = gltf->bake.resolution = 64;

@@ -3,6 +3,7 @@
 // sampling weights against the closed form.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -209,4 +210,35 @@ TEST(LightSampling, WeightsIntegrateToFormFactor) {
 }
 
 }  // namespace
+// A spot: a sphere light whose irradiance the cone scales by glTF's falloff, the square of
+// (cos θ − cos θ_outer) / (cos θ_inner − cos θ_outer), clamped; its visibility is not scaled.
+TEST(SpotLight, ConeScalesTheIrradianceAsKhrLightsPunctualSays) {
+  LightDesc spot;
+  spot.name = "spot";
+  spot.shape = LightShape::sphere;
+  spot.position = Vec3(0, 0, 3);
+  spot.radius = 0.05;
+  spot.power = 100;
+  spot.spot_axis = Vec3(0, 0, -1);
+  spot.spot_inner = 20 * std::numbers::pi / 180;
+  spot.spot_outer = 30 * std::numbers::pi / 180;
+  LightDesc bulb = spot;
+  bulb.spot_outer = 0;
+  const Light a(spot), b(bulb);
+  const Vec3 up(0, 0, 1);
+  for (double degrees : {0.0, 10.0, 19.9, 22.0, 25.0, 29.0, 31.0, 60.0}) {
+    const double theta = degrees * std::numbers::pi / 180;
+    const Vec3 y(3 * std::tan(theta), 0, 0);  // on the floor, θ off the axis
+    const double t = std::clamp((std::cos(theta) - std::cos(spot.spot_outer)) /
+                                    (std::cos(spot.spot_inner) - std::cos(spot.spot_outer)),
+                                0.0, 1.0);
+    EXPECT_NEAR(a.spot_factor(y), t * t, 1e-12) << degrees;
+    EXPECT_NEAR(a.unoccluded_irradiance(y, up).x(), t * t * b.unoccluded_irradiance(y, up).x(),
+                1e-12)
+        << degrees;
+    EXPECT_EQ(a.reaches(y, up), t > 0) << degrees;
+    EXPECT_EQ(a.form_factor(y, up), b.form_factor(y, up)) << degrees;
+  }
+}
+
 }  // namespace sb
