@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 #include "occluders/depth_clipping.h"
@@ -193,7 +194,11 @@ ReceiverPoint receiver_point(const ShadowMap& map, const Vec3& position, const V
   r.depth = f.depth(position);
   r.tangent = f.tangent(position);
   r.at = map.to_pixel(r.tangent);
-  r.bias = kBiasPixels * map.pixel * r.depth;
+  // Plus the stored depth's own rounding: a float holds depth to 6e-8 of it, which for a light
+  // far away (a sun, 10⁴ m off) is more than a pixel's footprint and would shadow every lit
+  // surface by itself.
+  r.bias = kBiasPixels * map.pixel * r.depth +
+           4 * double(std::numeric_limits<float>::epsilon()) * r.depth;
   // The ray through pixel (x, y) runs along D + t1·e1 + t2·e2 with t = (x + 0.5)·pixel − h; it
   // meets the plane n·(p − position) = 0 at depth n·(position − o) / n·(D + t1·e1 + t2·e2).
   const double ne1 = normal.dot(f.e1), ne2 = normal.dot(f.e2);

@@ -19,6 +19,7 @@
 
 #include "scene/file_nodes.h"
 #include "scene/mesh_reader.h"
+#include "scene/sun_light.h"
 
 namespace sb {
 
@@ -296,6 +297,19 @@ Expected<LevelContents> import_level(const fs::path& file, const Affine3& placem
     level.objects.push_back(std::move(obj));
   }
 
+  // The level's extent, for where a sun is put.
+  Bounds3 scene_bounds;
+  for (std::size_t n : object_nodes) {
+    const Affine3 node_transform = placement * world[n];
+    for (std::uint32_t p : raw->nodes[n].parts) {
+      const std::vector<float>& positions = raw->parts[p].positions;
+      for (std::size_t i = 0; i + 2 < positions.size(); i += 3)
+        scene_bounds.extend(node_transform *
+                            Vec3(positions[i], positions[i + 1], positions[i + 2]));
+    }
+  }
+  if (scene_bounds.empty()) scene_bounds.extend(Vec3::Zero());
+
   // Lights: emissive rectangles and discs, then the file's punctual lights.
   std::set<std::string> light_names;
   const auto light_name = [&](const std::string& node) {
@@ -338,13 +352,30 @@ Expected<LevelContents> import_level(const fs::path& file, const Affine3& placem
         transform * Vec3(raw_light.position[0], raw_light.position[1], raw_light.position[2]);
     if (!color.allFinite() || (color.array() < 0).any() || !position.allFinite())
       return fail(raw_light.name, "the light has a negative or non-finite intensity or position");
-    if (raw_light.type != RawLight::point && raw_light.type != RawLight::spot) {
-      level.warnings.push_back(fmt::format(
-          "{}: node '{}': {} lights are not read yet; it is left out", where, raw_light.name,
-          raw_light.type == RawLight::directional ? "directional (sun)" : "area and ambient"));
+    if (raw_light.type != RawLight::point && raw_light.type != RawLight::spot &&
+        raw_light.type != RawLight::directional) {
+      level.warnings.push_back(
+          fmt::format("{}: node '{}': area and ambient lights are not read yet; it is left out",
+                      where, raw_light.name));
       continue;
     }
     if (!(color.maxCoeff() > 0)) continue;  // a light switched off
+    if (raw_light.type == RawLight::directional) {
+      const Vec3 direction =
+          transform.linear() *
+          Vec3(raw_light.direction[0], raw_light.direction[1], raw_light.direction[2]);
+      if (!direction.allFinite() || !(direction.norm() > 0))
+        return fail(raw_light.name, "the sun has a zero or non-finite direction");
+      // glTF's sun is lux; FBX's (as Blender writes it) W/m².
+      const double irradiance =
+          gltf.is_object() ? color.maxCoeff() / kLumensPerWatt : color.maxCoeff();
+      LightDesc sun = sun_light(direction.normalized(), kSunAngleDeg, irradiance, scene_bounds);
+      sun.name = light_name(raw_light.name);
+      sun.color = color / color.maxCoeff();
+      sun.line = line;
+      level.lights.push_back(std::move(sun));
+      continue;
+    }
     LightDesc light;
     if (raw_light.type == RawLight::spot) {
       const Vec3 axis = transform.linear() * Vec3(raw_light.direction[0], raw_light.direction[1],

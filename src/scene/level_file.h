@@ -19,7 +19,9 @@
 //   power 4π × intensity / 683 for glTF (candela to watts, as Blender's exporter and importer
 //   convert) and the intensity as watts otherwise (as Blender's FBX exporter writes the light's
 //   power); a spot keeps its cone (LightDesc::spot_axis), which scales its irradiance;
-// - directional (sun) lights and emissive meshes of other shapes are not read yet: each is a
+// - directional lights become suns (sun_light.h) of Blender's 0.526° and the light's irradiance
+//   (lux / 683 for glTF, W/m² otherwise);
+// - emissive meshes of other shapes and area or ambient lights are not read yet: each is a
 //   warning naming it.
 #pragma once
 

@@ -125,6 +125,8 @@ struct LightDesc {
   // irradiance falls off between the two as glTF's KHR_lights_punctual says (Light::spot_factor).
   Vec3 spot_axis = Vec3::Zero();
   double spot_inner = 0, spot_outer = 0;
+  // A sun (a disk far away, sun_light.h): its angular diameter, degrees; 0 for other lights.
+  double sun_angle_deg = 0;
   int line = 0;
 };
 

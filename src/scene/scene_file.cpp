@@ -232,7 +232,9 @@ Expected<Scene> load_scene(const std::filesystem::path& file) {
     return located_error(file, 0, "scene", "no [[object]] table; a scene needs at least one");
   }
   if (scene.lights.empty()) {
-    return located_error(file, 0, "scene", "no [[light]] table; a scene needs at least one");
+    return located_error(
+        file, 0, "scene",
+        "no light: no [[light]] table, and no light imported; a scene needs at least one");
   }
   const bool any_receiver = std::any_of(scene.objects.begin(), scene.objects.end(),
                                         [](const ObjectDesc& o) { return o.receiver; });

@@ -10,6 +10,7 @@
 #include "scene/level_file.h"
 #include "scene/mesh_reader.h"
 #include "scene/scene_file_tables.h"
+#include "scene/sun_light.h"
 #include "scene/toml_table_reader.h"
 
 namespace sb {
@@ -76,7 +77,8 @@ Status override_objects(const std::filesystem::path& file, const toml::table& ta
 Status override_lights(const std::filesystem::path& file, const toml::table& table,
                        const std::filesystem::path& level, std::vector<LightDesc>& lights) {
   TableReader r(file, table, "[[import.light]]");
-  r.check_known_keys({"name", "enabled", "radius", "power", "color", "shadowmask_range"});
+  r.check_known_keys(
+      {"name", "enabled", "radius", "angle_deg", "power", "color", "shadowmask_range"});
   const std::vector<LightDesc*> targets = matching(r, lights, "light", level);
   const auto enabled = r.boolean("enabled");
   const auto radius = r.number("radius", "a positive number (metres)", is_positive);
@@ -85,7 +87,15 @@ Status override_lights(const std::filesystem::path& file, const toml::table& tab
                             [](double x) { return std::isfinite(x) && x >= 0; });
   if (color && color->isZero(0)) r.fail_got("color", "3 finite numbers >= 0, not all zero");
   const auto range = r.number("shadowmask_range", "a number > 0 (metres)", is_positive);
+  const auto angle = r.number("angle_deg", "a number of degrees in (0, 10]",
+                              [](double x) { return std::isfinite(x) && x > 0 && x <= 10; });
   for (const LightDesc* light : targets) {
+    const bool sun = light->sun_angle_deg > 0;
+    if (radius && sun)
+      r.fail("radius", fmt::format("'{}' is a sun: give its size as 'angle_deg'", light->name));
+    if (angle && !sun)
+      r.fail("angle_deg",
+             fmt::format("'angle_deg' applies to suns, and '{}' is not one", light->name));
     if (radius && light->shape == LightShape::rectangle)
       r.fail("radius", fmt::format("'radius' applies to sphere and disk lights, and '{}' is a "
                                    "rectangle",
@@ -97,6 +107,7 @@ Status override_lights(const std::filesystem::path& file, const toml::table& tab
       // The same exitance-independent power: only the size changes.
       light->radius = *radius;
     }
+    if (angle) set_sun_angle(*light, *angle);
     if (power) light->power = *power;
     if (color) light->color = *color;
     if (range) light->shadowmask_range = *range;

@@ -17,8 +17,10 @@
 
 #include "pipeline/bake.h"
 #include "scene/level_file.h"
+#include "scene/lights.h"
 #include "scene/mesh.h"
 #include "scene/scene.h"
+#include "scene/sun_light.h"
 
 namespace sb {
 namespace {
@@ -91,8 +93,29 @@ TEST(LevelFile, BlendersExportBecomesObjectsAndLights) {
   EXPECT_NEAR(spot->spot_outer, 35 * std::numbers::pi / 180, 1e-6);
   EXPECT_NEAR(spot->spot_inner, 0.5192354463883326, 1e-6);
   EXPECT_NEAR(spot->power, 300, 1e-3);
-  EXPECT_EQ(scene->lights.size(), 4u);
-  EXPECT_TRUE(any_warning_has(scene->warnings, "node 'sun': directional"));
+  // The sun: 3 W/m² (written as 3 × 683 lux), Blender's rotation (40°, 0, 30°) of -Z, as a disk
+  // of Blender's 0.526° seen from the room.
+  const LightDesc* sun = light_named(*scene, "sun");
+  ASSERT_NE(sun, nullptr);
+  const double rx = 40 * std::numbers::pi / 180, rz = 30 * std::numbers::pi / 180;
+  const Vec3 blender_direction(-std::sin(rz) * std::sin(rx), std::cos(rz) * std::sin(rx),
+                               -std::cos(rx));
+  const Vec3 direction(blender_direction.x(), blender_direction.z(), -blender_direction.y());
+  EXPECT_LT((sun->normal - direction).norm(), 1e-6);
+  const Vec3 floor_centre(0, 0, 0);
+  const Light sun_light(*sun);
+  EXPECT_NEAR(sun_light.unoccluded_irradiance(floor_centre, Vec3(0, 1, 0)).x(), 3 * -direction.y(),
+              3e-3);
+  EXPECT_EQ(scene->lights.size(), 5u);
+  EXPECT_EQ(sun->sun_angle_deg, kSunAngleDeg);
+  // Another angle keeps the sun's irradiance and widens its disk.
+  LightDesc wider = *sun;
+  set_sun_angle(wider, 2.0);
+  EXPECT_NEAR(
+      wider.radius / sun->radius,
+      std::tan(std::numbers::pi / 180) / std::tan(kSunAngleDeg / 2 * std::numbers::pi / 180), 1e-9);
+  EXPECT_NEAR(Light(wider).unoccluded_irradiance(floor_centre, Vec3(0, 1, 0)).x(),
+              sun_light.unoccluded_irradiance(floor_centre, Vec3(0, 1, 0)).x(), 1e-3);
 }
 
 // The level baked as one file equals the same objects baked one file per object
@@ -173,7 +196,9 @@ TEST(LevelFile, FbxExportIsTheGltfLevel) {
     const LightDesc* b = light_named(*gltf, a.name);
     ASSERT_NE(b, nullptr) << a.name;
     EXPECT_EQ(a.shape, b->shape) << a.name;
-    EXPECT_LT((a.position - b->position).norm(), 1e-5) << a.name;
+    // (A sun's disk lies 10⁴ m off: its place carries the float rounding of its direction.)
+    EXPECT_LT((a.position - b->position).norm(), 1e-5 + 1e-6 * b->position.norm()) << a.name;
+    EXPECT_LT((a.normal - b->normal).norm(), 1e-6) << a.name;
     EXPECT_NEAR(a.power, b->power, 1e-3 * b->power) << a.name;
     EXPECT_LT((a.spot_axis - b->spot_axis).norm(), 1e-5) << a.name;
     EXPECT_NEAR(a.spot_outer, b->spot_outer, 1e-6) << a.name;
@@ -429,7 +454,7 @@ TEST(LevelImport, SceneFileOverridesByNameAndGlob) {
   EXPECT_EQ(light_named(*scene, "spot"), nullptr);
   ASSERT_NE(light_named(*scene, "bulb"), nullptr);
   EXPECT_EQ(light_named(*scene, "bulb")->radius, 0.1);
-  EXPECT_EQ(scene->lights.size(), 3u);
+  EXPECT_EQ(scene->lights.size(), 4u);
 }
 
 class LevelImportErrors : public ::testing::Test {
@@ -452,6 +477,10 @@ TEST_F(LevelImportErrors, NamesThatMatchNothingOrClashAreErrors) {
   EXPECT_NE(e.find("chair_a"), std::string::npos) << e;
   e = error_of(head + "[[import.light]]\nname = \"ceiling_panel\"\nradius = 0.2\n");
   EXPECT_NE(e.find("'radius' applies to sphere and disk lights"), std::string::npos) << e;
+  e = error_of(head + "[[import.light]]\nname = \"sun\"\nradius = 0.2\n");
+  EXPECT_NE(e.find("'sun' is a sun: give its size as 'angle_deg'"), std::string::npos) << e;
+  e = error_of(head + "[[import.light]]\nname = \"bulb\"\nangle_deg = 1\n");
+  EXPECT_NE(e.find("'angle_deg' applies to suns"), std::string::npos) << e;
   e = error_of(head + "[[import.object]]\nname = \"floor\"\nuv = 9\n");
   EXPECT_NE(e.find("'uv' must be an integer from 0 to 7"), std::string::npos) << e;
   e = error_of(head +
@@ -463,6 +492,65 @@ TEST_F(LevelImportErrors, NamesThatMatchNothingOrClashAreErrors) {
       << e;
   e = error_of(head + "colour = 1\n");
   EXPECT_NE(e.find("unknown key 'colour'"), std::string::npos) << e;
+}
+
+}  // namespace
+}  // namespace sb
+
+namespace sb {
+namespace {
+
+// A sun is a disk far away: its H0 is E cos θ on any surface of the scene (within the 10⁻⁴ rad
+// its direction varies across the scene), 0 below the horizon.
+TEST(SunLight, IrradianceIsECosThetaAcrossTheScene) {
+  Bounds3 bounds;
+  bounds.extend(Vec3(-5, 0, -4));
+  bounds.extend(Vec3(5, 3, 4));
+  const Vec3 direction = Vec3(0.3, -1, 0.2).normalized();
+  const double irradiance = 800;
+  const Light sun(sun_light(direction, kSunAngleDeg, irradiance, bounds));
+  EXPECT_GE((sun.centre() - bounds.centre()).norm(), 1e4);
+  for (const Vec3& y : {Vec3(-5, 0, -4), Vec3(5, 3, 4), Vec3(0, 1, 0), Vec3(2, 0, -3)}) {
+    for (const Vec3& n : {Vec3(0, 1, 0), Vec3(1, 0, 0), Vec3(0, 0, -1), Vec3(-0.3, 1, -0.2)}) {
+      const Vec3 unit = n.normalized();
+      const double cosine = -direction.dot(unit);
+      const double expected = cosine > 0.01 ? irradiance * cosine : cosine < -0.01 ? 0 : -1;
+      if (expected < 0) continue;  // within the sun's radius of the horizon: clipped, not cos θ
+      EXPECT_NEAR(sun.unoccluded_irradiance(y, unit).x(), expected, 1e-3 * irradiance)
+          << y.transpose() << " n " << unit.transpose();
+    }
+  }
+}
+
+// The level under its sun alone: the noise-free estimator against the reference, the sun's
+// narrow penumbrae included.
+TEST(SunLight, LevelBakesAsTheReferenceDoes) {
+  auto scene = load_scene(kLevel);
+  ASSERT_TRUE(scene) << scene.error().message;
+  std::erase_if(scene->lights, [](const LightDesc& l) { return l.name != "sun"; });
+  ASSERT_EQ(scene->lights.size(), 1u);
+  scene->bake.resolution = 64;
+  scene->bake.margin = 0;
+  Scene reference = *scene;
+  reference.bake.method = "reference";
+  reference.bake.samples = 1024;
+  auto ours = bake(*scene);
+  auto truth = bake(reference);
+  ASSERT_TRUE(ours && truth);
+  for (std::size_t r = 0; r < ours->receivers.size(); ++r) {
+    const ReceiverBake& a = ours->receivers[r];
+    const ReceiverBake& b = truth->receivers[r];
+    double sum = 0;
+    std::int64_t count = 0;
+    for (std::size_t i = 0; i < a.covered.size(); ++i) {
+      if (!a.covered[i]) continue;
+      const double d = a.image.pixels[3 * i] - b.image.pixels[3 * i];
+      sum += d * d;
+      ++count;
+    }
+    ASSERT_GT(count, 0) << a.name;
+    EXPECT_LT(std::sqrt(sum / double(count)), 0.01) << a.name;
+  }
 }
 
 }  // namespace

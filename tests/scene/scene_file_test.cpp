@@ -476,7 +476,7 @@ TEST_F(SceneFile, RejectsBadTransformKeys) {
 
 TEST_F(SceneFile, RejectsSceneWithoutLightsObjectsOrReceivers) {
   const std::string file = (dir_ / "scene.toml").string();
-  EXPECT_EQ(error_of(object_floor).rfind(file + ": scene: no [[light]]", 0), 0u);
+  EXPECT_EQ(error_of(object_floor).rfind(file + ": scene: no light: no [[light]] table", 0), 0u);
   EXPECT_EQ(error_of(light_panel).rfind(file + ": scene: no [[object]]", 0), 0u);
   EXPECT_EQ(error_of(object_floor + "receiver = false\n" + light_panel)
                 .rfind(file + ": scene: no object has 'receiver' = true", 0),
