@@ -57,8 +57,8 @@ Expected<std::vector<Mesh>> load_meshes(const Scene& scene, std::vector<std::str
     if (--users[obj.mesh] == 0) read.erase(obj.mesh);
     if (!mesh) return mesh.error();
     if (mesh->skipped_degenerate > 0 && warnings) {
-      warnings->push_back(scene.file.string() + ":" + std::to_string(obj.line) + ": object '" +
-                          obj.name + "': skipped " + std::to_string(mesh->skipped_degenerate) +
+      warnings->push_back(object_location(scene.file, obj) + ": skipped " +
+                          std::to_string(mesh->skipped_degenerate) +
                           " degenerate (zero-area) triangles");
     }
     meshes.push_back(std::move(*mesh));
@@ -228,8 +228,7 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
       for (const Texel& t : spaces.back().texels)
         if ((reached[r][l] = lights[l].reaches(t.position.cast<double>(), t.normal.cast<double>())))
           break;
-    const std::string where =
-        scene.file.string() + ":" + std::to_string(obj.line) + ": object '" + obj.name + "': ";
+    const std::string where = object_location(scene.file, obj) + ": ";
     if (spaces.back().texels.empty()) {
       const UvLayoutReport& uv = layouts.back();
       const std::string problem = fmt::format(

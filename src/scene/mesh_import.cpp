@@ -67,8 +67,7 @@ struct ImportedVertex {
 class ErrorPrefix {
  public:
   ErrorPrefix(const ObjectDesc& obj, const std::filesystem::path& scene_file)
-      : prefix_(scene_file.string() + ":" + std::to_string(obj.line) + ": object '" + obj.name +
-                "': ") {}
+      : prefix_(object_location(scene_file, obj) + ": ") {}
   Error operator()(const std::string& problem) const { return scene_error(prefix_ + problem); }
 
  private:

@@ -176,6 +176,10 @@ struct Scene {
 // (level_file.h), baked alone with the default settings.
 Expected<Scene> load_scene(const std::filesystem::path& file);
 
+// "file:line: object 'name'", where messages about an object start; "file: object 'name'" for an
+// object of a level baked alone (line 0: no scene file line stands for it).
+std::string object_location(const std::filesystem::path& scene_file, const ObjectDesc& obj);
+
 // Builds an object's transform from the optional keys: scale, then rotation about X, then Y,
 // then Z (degrees; Blender's "XYZ Euler"), then translation.
 Affine3 object_transform(const Vec3& translate, const Vec3& rotate_deg, const Vec3& scale);

@@ -15,6 +15,11 @@ bool is_file_name_part(std::string_view name) {
   return true;
 }
 
+std::string object_location(const std::filesystem::path& scene_file, const ObjectDesc& obj) {
+  return obj.line > 0 ? fmt::format("{}:{}: object '{}'", scene_file.string(), obj.line, obj.name)
+                      : fmt::format("{}: object '{}'", scene_file.string(), obj.name);
+}
+
 Affine3 read_placement(TableReader& r) {
   const Vec3 translate = r.vec3("translate", "3 finite numbers", is_finite).value_or(Vec3::Zero());
   const Vec3 rotate_deg =
