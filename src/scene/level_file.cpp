@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -18,6 +17,7 @@
 #include <vector>
 
 #include "scene/file_nodes.h"
+#include "scene/lights.h"
 #include "scene/mesh_reader.h"
 #include "scene/sun_light.h"
 
@@ -43,17 +43,16 @@ nlohmann::json gltf_document(const fs::path& file) {
   const std::string ext = lower_extension(file);
   if (ext != ".gltf" && ext != ".glb") return nullptr;
   std::ifstream in(file, std::ios::binary);
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (ext == ".glb") {
-    // Header (magic, version, length), then the first chunk (length, type "JSON", data).
-    std::uint32_t length = 0, type = 0;
-    if (bytes.size() < 20) return nullptr;
-    std::memcpy(&length, bytes.data() + 12, 4);
-    std::memcpy(&type, bytes.data() + 16, 4);
-    if (type != 0x4E4F534A || length > bytes.size() - 20) return nullptr;
-    bytes = bytes.substr(20, length);
-  }
-  return nlohmann::json::parse(bytes, nullptr, false);
+  if (ext == ".gltf") return nlohmann::json::parse(in, nullptr, false);
+  // A binary glTF: its header (magic, version, length), then the first chunk's length and type
+  // ("JSON") and the JSON itself; the binary chunk after it is not read again.
+  std::uint32_t header[5] = {};
+  if (!in.read(reinterpret_cast<char*>(header), sizeof header) || header[4] != 0x4E4F534A ||
+      header[3] > header[2])
+    return nullptr;
+  std::string json(header[3], '\0');
+  if (!in.read(json.data(), std::streamsize(json.size()))) return nullptr;
+  return nlohmann::json::parse(json, nullptr, false);
 }
 
 // Per material of the file, KHR_materials_emissive_strength's factor (1 where absent). Assimp
@@ -80,11 +79,7 @@ std::vector<double> emissive_strengths(const nlohmann::json& gltf, std::size_t c
 // A node's name as an object or light name: characters a file name cannot hold become '_'.
 std::string safe_name(const std::string& name) {
   std::string out;
-  for (char c : name) {
-    const bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
-                    c == '_' || c == '.' || c == '-';
-    out += ok ? c : '_';
-  }
+  for (char c : name) out += is_file_name_char(c) ? c : '_';
   if (out.empty()) out = "node";
   if (out.front() == '.') out.front() = '_';
   return out;
@@ -199,20 +194,9 @@ std::optional<LightDesc> planar_light(const std::vector<Vec3>& corners) {
   return light;
 }
 
-double light_area(const LightDesc& light) {
-  switch (light.shape) {
-    case LightShape::rectangle:
-      return light.width * light.height;
-    case LightShape::disk:
-      return std::numbers::pi * light.radius * light.radius;
-    case LightShape::sphere:
-      return 4 * std::numbers::pi * light.radius * light.radius;
-  }
-  return 0;
-}
-
-// Bytes a level's meshes take once built, per triangle placed: OpenMesh's half-edges and
-// attributes, the ray tracer's copy and the shafts' bounds (measured on the corpus: ~350).
+// Bytes a level's meshes take once built, per triangle placed: an allowance for OpenMesh's
+// half-edges and attributes, the ray tracer's copy and the shafts' bounds (not measured; the
+// bake's own memory check, which counts its lightmaps, is what refuses real levels).
 constexpr double kBytesPerPlacedTriangle = 400;
 
 }  // namespace
@@ -337,7 +321,7 @@ Expected<LevelContents> import_level(const fs::path& file, const Affine3& placem
       light.line = line;
       const Vec3& e = emission[part.material];
       light.color = e / e.maxCoeff();
-      light.power = std::numbers::pi * e.maxCoeff() * light_area(light);
+      light.power = std::numbers::pi * e.maxCoeff() * Light(light).area();
       level.lights.push_back(std::move(light));
     }
   }

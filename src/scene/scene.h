@@ -34,6 +34,7 @@ enum class ErosionFactor { pcf, distance };
 // Whether `name` can stand in a file name on every platform outputs travel to: letters, digits,
 // '_', '.', '-', not starting with '.' (object names, and light names with per-light files).
 bool is_file_name_part(std::string_view name);
+bool is_file_name_char(char c);  // one character of such a name
 
 // Names of the methods this build knows, in the order docs/methods.md lists them.
 const std::vector<std::string>& known_methods();

@@ -5,13 +5,15 @@
 
 namespace sb {
 
+bool is_file_name_char(char c) {
+  return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' ||
+         c == '.' || c == '-';
+}
+
 bool is_file_name_part(std::string_view name) {
   if (name.empty() || name.front() == '.') return false;
-  for (char c : name) {
-    const bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
-                    c == '_' || c == '.' || c == '-';
-    if (!ok) return false;
-  }
+  for (char c : name)
+    if (!is_file_name_char(c)) return false;
   return true;
 }
 
