@@ -78,14 +78,16 @@ struct BakeArgs {
   bool explain = false;
   bool no_trace = false;
   bool no_convolve = false;
+  bool no_seams = false;
 };
 
 // --explain: per receiver its stage times, the method's figures and what the method says of its
 // choices (the convolution: its plan, directions, planes, error metric, images and stage times).
 void print_explanation(const sb::BakeResult& result) {
   for (const auto& r : result.receivers) {
-    fmt::print("{}: texel space {:.1f} ms, method {:.1f} ms, dilation {:.1f} ms\n", r.name,
-               1e3 * r.seconds_texels, 1e3 * r.seconds_method, 1e3 * r.seconds_dilate);
+    fmt::print("{}: texel space {:.1f} ms, method {:.1f} ms, dilation {:.1f} ms, seams {:.1f} ms\n",
+               r.name, 1e3 * r.seconds_texels, 1e3 * r.seconds_method, 1e3 * r.seconds_dilate,
+               1e3 * r.seconds_seams);
     for (const auto& [key, value] : r.report.stats) fmt::print("    {} = {:.4g}\n", key, value);
     fmt::print("{}", r.report.explain);
   }
@@ -130,6 +132,7 @@ int bake_scene(const BakeArgs& args, const std::string& scene_file, const std::s
   if (args.max_memory) settings.max_memory = *args.max_memory;
   if (args.no_trace) settings.trace = false;
   if (args.no_convolve) settings.convolve = false;
+  if (args.no_seams) settings.seams = false;
 
   // The output folder is locked and its names checked before the bake, so a bake that could not
   // publish its files fails in a second, not after its work.
@@ -332,6 +335,9 @@ Runner add_bake_command(CLI::App& app) {
   bake->add_flag("--no-convolve", o->args.no_convolve,
                  "convolution: skip the convolution, trace every pair the shaft test keeps "
                  "(overrides [bake] convolve)");
+  bake->add_flag("--no-seams", o->args.no_seams,
+                 "leave the texels along UV seams as baked; only measure the seams (overrides "
+                 "[bake] seams)");
   bake->add_flag("--explain", o->args.explain,
                  "print, per light and receiver, the convolution's direction, planes, error "
                  "metric, image sizes and stage times");

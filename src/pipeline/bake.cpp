@@ -1,5 +1,5 @@
 // The bake pipeline: scene → meshes → what the method needs (ray scene, clusters, shafts) and
-// lights → texel space per receiver → method → dilation. Methods come from the registry
+// lights → texel space per receiver → method → dilation → seams. Methods come from the registry
 // (methods/registry.cpp) and are called through their interface (methods/method.h).
 #include "pipeline/bake.h"
 
@@ -71,6 +71,47 @@ std::vector<const Mesh*> blocker_meshes(const Scene& scene, const std::vector<Me
   for (std::size_t i = 0; i < meshes.size(); ++i)
     if (scene.objects[i].blocker) blockers.push_back(&meshes[i]);
   return blockers;
+}
+
+// The covered texels whose value means nothing, for the seams' stitching (texels/seams.h): in a
+// visibility, those none of `lights` reaches (V = H / H0 with H0 = 0, written 0). None for an
+// irradiance, which is 0 there in truth.
+std::vector<std::uint8_t> arbitrary_texels(bool visibility, const TexelSpace& space,
+                                           const std::vector<const Light*>& lights) {
+  std::vector<std::uint8_t> arbitrary;
+  if (!visibility) return arbitrary;
+  arbitrary.assign(space.covered.size(), 0);
+  for (const Texel& t : space.texels) {
+    const Vec3 y = t.position.cast<double>(), n = t.normal.cast<double>();
+    const bool reached =
+        std::any_of(lights.begin(), lights.end(), [&](const Light* l) { return l->reaches(y, n); });
+    arbitrary[std::size_t(t.y) * std::size_t(space.width) + std::size_t(t.x)] = !reached;
+  }
+  return arbitrary;
+}
+
+// A receiver's images with their arbitrary texels, for stitch_seams: the value image (every
+// light), then each light's value and visibility images (that light alone), so that a light's
+// image is stitched as a bake of that light alone would stitch it.
+std::vector<SeamImage> seam_images(const Scene& scene, ReceiverBake& out, const TexelSpace& space,
+                                   const std::vector<Light>& lights) {
+  const bool visibility = scene.bake.quantity == Quantity::visibility;
+  std::vector<const Light*> all;
+  for (const Light& l : lights) all.push_back(&l);
+  std::vector<SeamImage> images = {{&out.image, arbitrary_texels(visibility, space, all)}};
+  for (std::size_t l = 0; l < out.per_light.size(); ++l)
+    images.push_back({&out.per_light[l], arbitrary_texels(visibility, space, {&lights[l]})});
+  for (std::size_t l = 0; l < out.per_light_visibility.size(); ++l)
+    images.push_back({&out.per_light_visibility[l], arbitrary_texels(true, space, {&lights[l]})});
+  return images;
+}
+
+// What a seam's lookup difference is measured against (SeamReport): 1 for a visibility, the
+// image's largest value for an irradiance (1 where it is black).
+double seam_scale(const Scene& scene, const Image& image) {
+  if (scene.bake.quantity == Quantity::visibility || image.pixels.empty()) return 1.0;
+  const float largest = *std::max_element(image.pixels.begin(), image.pixels.end());
+  return largest > 0 ? double(largest) : 1.0;
 }
 
 std::unique_ptr<tbb::global_control> limit_threads(const BakeOptions& options) {
@@ -205,7 +246,7 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   if (needs.shafts) shafts.emplace(blockers);
   result.load_seconds = seconds_since(load_start);
 
-  // The bake proper, timed from here: texel space, the method, dilation.
+  // The bake proper, timed from here: texel space, the method, dilation, seams.
   const auto bake_start = std::chrono::steady_clock::now();
   std::vector<TexelSpace> spaces;
   std::vector<double> raster_seconds;
@@ -304,6 +345,11 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     for (Image& image : out.per_light_visibility)
       dilate(image, spaces[r].covered, scene.bake.margin);
     out.seconds_dilate = seconds_since(dilate_start);
+    const auto seams_start = std::chrono::steady_clock::now();
+    out.seams = stitch_seams(find_seams(meshes[receivers[r]]), spaces[r].covered,
+                             seam_images(scene, out, spaces[r], lights),
+                             seam_scale(scene, out.image), scene.bake.seams);
+    out.seconds_seams = seconds_since(seams_start);
     out.covered_texels = std::int64_t(spaces[r].texels.size());
     out.uv = layouts[r];
     out.covered = spaces[r].covered;

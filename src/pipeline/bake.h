@@ -1,6 +1,6 @@
 // A whole bake: load the scene's meshes, size each receiver's lightmap (and pack them into
-// atlases), build texel space per receiver, run the chosen method, dilate into the margin. The
-// CLI writes the result with write_outputs (outputs.h).
+// atlases), build texel space per receiver, run the chosen method, dilate into the margin, stitch
+// UV seams. The CLI writes the result with write_outputs (outputs.h).
 #pragma once
 
 #include <cstdint>
@@ -17,6 +17,7 @@
 #include "methods/method.h"
 #include "scene/scene.h"
 #include "texels/atlas_packing.h"
+#include "texels/seams.h"
 #include "texels/uv_checks.h"
 
 namespace sb {
@@ -52,8 +53,11 @@ struct ReceiverBake {
   std::vector<std::uint8_t> covered;  // width × height: 1 where a triangle covers the texel
   std::int64_t covered_texels = 0;
   UvLayoutReport uv;   // the lightmap UV layout's checks
-  double seconds = 0;  // texel space + method + dilation, this receiver only
-  double seconds_texels = 0, seconds_method = 0, seconds_dilate = 0;  // its parts
+  double seconds = 0;  // texel space + method + dilation + seams, this receiver only
+  double seconds_texels = 0, seconds_method = 0, seconds_dilate = 0, seconds_seams = 0;
+  // Its UV seams: how many, the texels stitched, and the largest difference of the two sides'
+  // lookups before and after (texels/seams.h; after = before when [bake] seams is false).
+  SeamReport seams;
   // Per light, in scene order, when kept: its own V (or H0·V), dilated like the image; and what
   // its shadow mask needs (MixedImages::per_light_visibility, its influence cleared beyond its
   // shadowmask_range), dilated too.
@@ -84,7 +88,7 @@ struct BakeResult {
   // With [output] gltf, the objects that are blockers only, in scene order, as a glTF shows them.
   std::vector<std::pair<std::string, std::shared_ptr<const GltfMesh>>> gltf_blockers;
   double load_seconds = 0;       // mesh import and acceleration structures
-  double bake_seconds = 0;       // all receivers: texel space, method, dilation
+  double bake_seconds = 0;       // all receivers: texel space, method, dilation, seams
   std::int64_t shadow_rays = 0;  // rays traced, for sampling methods
 };
 

@@ -19,8 +19,9 @@ using json = nlohmann::ordered_json;
 // The receiver keys the schema names; any other key is one of the method's own entries.
 const std::set<std::string, std::less<>>& receiver_schema_keys() {
   static const std::set<std::string, std::less<>> keys = {
-      "name",     "files",   "atlas",          "uv_channel", "resolution", "method",
-      "quantity", "samples", "covered_texels", "uv_layout",  "seconds",    "method_stats"};
+      "name",   "files",    "atlas",       "uv_channel",     "resolution",
+      "method", "quantity", "samples",     "covered_texels", "uv_layout",
+      "seams",  "seconds",  "method_stats"};
   return keys;
 }
 
@@ -246,6 +247,14 @@ json receiver_to_json(const ManifestReceiver& r) {
         {"overlapping_texels", r.uv_layout.overlapping_texels},
         {"texels_near_other_charts", r.uv_layout.texels_near_other_charts},
         {"margin", r.uv_layout.margin}}},
+      {"seams",
+       {{"edges", r.seams.edges},
+        {"stitched", r.seams.stitched},
+        {"texels", r.seams.texels},
+        {"largest_difference_before", r.seams.largest_difference_before},
+        {"largest_difference_after", r.seams.largest_difference_after},
+        {"visible_before", r.seams.visible_before},
+        {"visible_after", r.seams.visible_after}}},
       {"seconds", r.seconds},
   });
   if (!r.method_stats.empty()) {
@@ -314,6 +323,17 @@ void read_receiver(const json& entry, const std::string& where, const std::strin
     layout_fields.read("overlapping_texels", r.uv_layout.overlapping_texels);
     layout_fields.read("texels_near_other_charts", r.uv_layout.texels_near_other_charts);
     layout_fields.read("margin", r.uv_layout.margin);
+  }
+  // Absent from manifests written before seams were measured.
+  if (const json* seams = entry.contains("seams") ? fields.object("seams") : nullptr) {
+    FieldReader seam_fields(*seams, where, fields.path_of("seams."), status);
+    seam_fields.read("edges", r.seams.edges);
+    seam_fields.read("stitched", r.seams.stitched);
+    seam_fields.read("texels", r.seams.texels);
+    seam_fields.read("largest_difference_before", r.seams.largest_difference_before);
+    seam_fields.read("largest_difference_after", r.seams.largest_difference_after);
+    seam_fields.read("visible_before", r.seams.visible_before);
+    seam_fields.read("visible_after", r.seams.visible_after);
   }
   fields.read("seconds", r.seconds);
   if (status && entry.contains("method_stats")) {

@@ -69,6 +69,17 @@ struct ManifestUvLayout {
   int margin = 0;  // texels
 };
 
+// The receiver's UV seams (SeamReport, texels/seams.h): the largest difference between the
+// bilinear lookups on a seam's two sides, in the lightmap's own units, and the share of seam
+// samples where it exceeds 1/255 (of 1 for visibility, of the largest value for irradiance),
+// before and after stitching.
+struct ManifestSeams {
+  std::int64_t edges = 0, texels = 0;
+  bool stitched = false;
+  double largest_difference_before = 0, largest_difference_after = 0;
+  double visible_before = 0, visible_after = 0;
+};
+
 struct ManifestReceiver {
   std::string name;
   std::optional<ManifestFiles> files;           // its own files (no atlas)
@@ -80,6 +91,7 @@ struct ManifestReceiver {
   int samples = 0;
   std::int64_t covered_texels = 0;
   ManifestUvLayout uv_layout;
+  ManifestSeams seams;
   double seconds = 0;
   MethodStats method_stats;  // written only when there are some
   // The method's own entries (MethodReport::manifest), written after method_stats in their

@@ -191,6 +191,13 @@ ManifestReceiver describe_receiver(const ReceiverBake& r, const BakeSettings& ef
                      .overlapping_texels = r.uv.overlapping_texels,
                      .texels_near_other_charts = r.uv.texels_near_other_charts,
                      .margin = r.uv.margin};
+  entry.seams = {.edges = r.seams.edges,
+                 .texels = r.seams.texels,
+                 .stitched = effective.seams,
+                 .largest_difference_before = r.seams.before.largest,
+                 .largest_difference_after = r.seams.after.largest,
+                 .visible_before = r.seams.before.visible,
+                 .visible_after = r.seams.after.visible};
   entry.seconds = r.seconds;
   entry.method_stats = r.report.stats;
   entry.method_entries = r.report.manifest;

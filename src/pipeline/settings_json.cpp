@@ -69,6 +69,7 @@ json settings_to_json(const BakeSettings& b, const OutputSettings& o) {
                {"quantity", to_string(b.quantity)},
                {"samples", b.samples},
                {"margin", b.margin},
+               {"seams", b.seams},
                {"seed", b.seed},
                {"error_texels", b.error_texels},
                {"max_image", b.max_image},
@@ -108,6 +109,7 @@ Status settings_from_json(const json& j, const std::string& where, BakeSettings&
   r.read_enum("quantity", b.quantity, {Quantity::visibility, Quantity::irradiance});
   r.read("samples", b.samples);
   r.read("margin", b.margin);
+  r.read("seams", b.seams);
   r.read("seed", b.seed);
   r.read("error_texels", b.error_texels);
   r.read("max_image", b.max_image);

@@ -18,7 +18,7 @@ using json = nlohmann::ordered_json;
 
 constexpr std::uint32_t kReceiverMagic = 0x52535342;  // "SBSR"
 constexpr std::uint32_t kMeshMagic = 0x4D535342;      // "SBSM"
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kVersion = 2;                 // 2: receivers' seams
 // A lightmap side no bake makes (resolution ≤ 16384), so that a damaged header cannot make the
 // reader allocate terabytes.
 constexpr std::uint64_t kMaxSide = 16384;
@@ -135,6 +135,11 @@ json receiver_metadata(const ReceiverBake& r) {
             {"charts", r.uv.charts},
             {"margin", r.uv.margin},
             {"texels_near_other_charts", r.uv.texels_near_other_charts}}},
+          {"seams",
+           {{"edges", r.seams.edges},
+            {"texels", r.seams.texels},
+            {"before", {r.seams.before.largest, r.seams.before.visible}},
+            {"after", {r.seams.after.largest, r.seams.after.visible}}}},
           {"rays", r.rays},
           {"uv_warnings", r.uv_warnings},
           {"lights_reached", r.lights_reached},
@@ -181,6 +186,12 @@ Expected<ReceiverBake> read_receiver(const json& meta, const std::filesystem::pa
     r.uv.charts = uv.at("charts").get<int>();
     r.uv.margin = uv.at("margin").get<int>();
     r.uv.texels_near_other_charts = uv.at("texels_near_other_charts").get<std::int64_t>();
+    const json& seams = meta.at("seams");
+    r.seams.edges = seams.at("edges").get<std::int64_t>();
+    r.seams.texels = seams.at("texels").get<std::int64_t>();
+    r.seams.before = {seams.at("before").at(0).get<double>(),
+                      seams.at("before").at(1).get<double>()};
+    r.seams.after = {seams.at("after").at(0).get<double>(), seams.at("after").at(1).get<double>()};
     r.rays = meta.at("rays").get<std::int64_t>();
     r.uv_warnings = meta.at("uv_warnings").get<std::vector<std::string>>();
     r.lights_reached = meta.at("lights_reached").get<std::vector<std::uint8_t>>();

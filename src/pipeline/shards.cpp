@@ -168,7 +168,8 @@ Status write_shard(OutputFolder& folder, const Scene& scene, const ShardSpec& sp
     timings["receivers"][r.name] = {{"seconds", r.seconds},
                                     {"texels", r.seconds_texels},
                                     {"method", r.seconds_method},
-                                    {"dilate", r.seconds_dilate}};
+                                    {"dilate", r.seconds_dilate},
+                                    {"seams", r.seconds_seams}};
     if (Status s = write_text_file(folder.staged(receiver_data_file(r.object)), data); !s) return s;
   }
   for (std::size_t b = 0; b < result.gltf_blockers.size(); ++b) {
@@ -293,6 +294,7 @@ Expected<MergedBake> merge_shards(const std::vector<fs::path>& folders,
         r->seconds_texels = t.value("texels", 0.0);
         r->seconds_method = t.value("method", 0.0);
         r->seconds_dilate = t.value("dilate", 0.0);
+        r->seconds_seams = t.value("seams", 0.0);
       }
       const std::size_t object = r->object;
       if (object >= merged.scene.objects.size() || !merged.scene.objects[object].receiver ||

@@ -46,8 +46,11 @@ struct BakeSettings {
   double texels_per_metre = 0;
   std::string method = "backprojection";
   Quantity quantity = Quantity::visibility;
-  int samples = 256;       // light samples per texel, for sampling methods
-  int margin = 4;          // texels of dilation around UV charts
+  int samples = 256;  // light samples per texel, for sampling methods
+  int margin = 4;     // texels of dilation around UV charts
+  // After dilation, adjust the texels along UV seams so that bilinear lookups on the two sides
+  // agree (texels/seams.h); false leaves them as baked, and only measures the seams.
+  bool seams = true;
   std::uint64_t seed = 0;  // sampling seed; same seed, same bytes
   // Bytes the bake may use (memory_budget.h); 0: the default, 3/4 of the physical memory.
   std::uint64_t max_memory = 0;

@@ -15,6 +15,7 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
                       "quantity",
                       "samples",
                       "margin",
+                      "seams",
                       "seed",
                       "max_memory",
                       "error_texels",
@@ -64,6 +65,7 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
   }
   if (auto v = r.integer("samples", 1, int_max)) bake.samples = static_cast<int>(*v);
   if (auto v = r.integer("margin", 0, int_max)) bake.margin = static_cast<int>(*v);
+  if (auto v = r.boolean("seams")) bake.seams = *v;
   if (auto v = r.integer("seed", 0, std::numeric_limits<std::int64_t>::max())) {
     bake.seed = static_cast<std::uint64_t>(*v);
   }

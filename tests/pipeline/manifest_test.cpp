@@ -51,6 +51,13 @@ Manifest full_manifest() {
                  .overlapping_texels = 7,
                  .texels_near_other_charts = 11,
                  .margin = 4};
+  r.seams = {.edges = 12,
+             .texels = 300,
+             .stitched = true,
+             .largest_difference_before = 0.5,
+             .largest_difference_after = 0.001,
+             .visible_before = 0.25,
+             .visible_after = 0.0};
   r.seconds = 0.25;
   r.method_stats = {{"clear_fraction", 0.5}, {"rays_per_texel", 3.0}};
   r.method_entries["penumbra_error"] = {{"metres", 0.01}, {"texels", 2.5}};
@@ -91,6 +98,12 @@ TEST(Manifest, RoundTripsEveryKey) {
   EXPECT_EQ(r.width, 64);
   EXPECT_EQ(r.height, 32);
   EXPECT_EQ(r.uv_layout.texels_near_other_charts, 11);
+  EXPECT_EQ(r.seams.edges, 12);
+  EXPECT_EQ(r.seams.texels, 300);
+  EXPECT_TRUE(r.seams.stitched);
+  EXPECT_EQ(r.seams.largest_difference_before, 0.5);
+  EXPECT_EQ(r.seams.largest_difference_after, 0.001);
+  EXPECT_EQ(r.seams.visible_before, 0.25);
   EXPECT_EQ(r.method_stats, written.receivers[0].method_stats);
   EXPECT_EQ(r.method_entries, written.receivers[0].method_entries);
   EXPECT_EQ(read->shadow_rays, 123456789012);
@@ -106,7 +119,7 @@ TEST(Manifest, KeepsTheFilesKeyOrder) {
   // The method's own entries follow method_stats.
   EXPECT_EQ(keys(j["receivers"][0]),
             (std::vector<std::string>{"name", "files", "uv_channel", "resolution", "method",
-                                      "quantity", "samples", "covered_texels", "uv_layout",
+                                      "quantity", "samples", "covered_texels", "uv_layout", "seams",
                                       "seconds", "method_stats", "penumbra_error", "lights"}));
   EXPECT_EQ(keys(j["receivers"][0]["uv_layout"]),
             (std::vector<std::string>{"charts", "uv_area", "uv_area_outside", "overlapping_texels",
