@@ -346,9 +346,11 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
       dilate(image, spaces[r].covered, scene.bake.margin);
     out.seconds_dilate = seconds_since(dilate_start);
     const auto seams_start = std::chrono::steady_clock::now();
-    out.seams = stitch_seams(find_seams(meshes[receivers[r]]), spaces[r].covered,
-                             seam_images(scene, out, spaces[r], lights),
-                             seam_scale(scene, out.image), scene.bake.seams);
+    // The arbitrary-texel masks cost a reach test per texel and light: only for a mesh with seams.
+    if (const std::vector<SeamEdge> seams = find_seams(meshes[receivers[r]]); !seams.empty()) {
+      out.seams = stitch_seams(seams, spaces[r].covered, seam_images(scene, out, spaces[r], lights),
+                               seam_scale(scene, out.image), scene.bake.seams);
+    }
     out.seconds_seams = seconds_since(seams_start);
     out.covered_texels = std::int64_t(spaces[r].texels.size());
     out.uv = layouts[r];

@@ -31,6 +31,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <numbers>
 #include <tuple>
 #include <unordered_map>
 #include <utility>
@@ -44,7 +45,7 @@ constexpr double kMarginPrior = 1e-6;
 constexpr double kHeldPrior = 1e3;  // an unknown held at a bound (SeamStitcher::stitch)
 constexpr int kMaxRounds = 8;
 // cos 0.5°: vertex normals on the two sides closer than this are one smooth surface.
-const double kSmoothCos = std::cos(0.5 * 3.14159265358979323846 / 180.0);
+const double kSmoothCos = std::cos(0.5 * std::numbers::pi / 180.0);
 
 using PositionBits = std::array<std::uint64_t, 3>;
 
@@ -84,17 +85,47 @@ void bilinear(const Vec2& p, int width, int height, int* texel, double* weight) 
   weight[3] = tx * ty;
 }
 
-// Where a straight path from p0 to p1 crosses a whole-number x or y, as parameters in (0, 1).
-void add_crossings(const Vec2& p0, const Vec2& p1, std::vector<double>& out) {
+// Where a straight path from p0 to p1 crosses a whole-number x or y inside the image (0 to
+// width − 1, 0 to height − 1), as parameters in (0, 1). Beyond the image the clamped lookup does
+// not change along that axis, so UVs far outside [0, 1] add no crossings.
+void add_crossings(const Vec2& p0, const Vec2& p1, int width, int height,
+                   std::vector<double>& out) {
   for (int axis = 0; axis < 2; ++axis) {
     const double a = p0[axis], b = p1[axis];
     if (a == b) continue;
-    const double lo = std::min(a, b), hi = std::max(a, b);
-    // A seam a few thousand texels long crosses as many lines; more cannot be in an image.
-    for (double line = std::ceil(lo); line < hi && out.size() < (1u << 20); line += 1.0)
-      if (line > lo) out.push_back((line - a) / (b - a));
+    const double last = double((axis == 0 ? width : height) - 1);
+    const double lo = std::max(std::min(a, b), -1.0), hi = std::min(std::max(a, b), last + 1);
+    for (double line = std::max(std::ceil(lo), 0.0); line < hi && line <= last; line += 1.0)
+      if (line > std::min(a, b)) out.push_back((line - a) / (b - a));
   }
 }
+
+// The least-squares system of a receiver's seams at one lightmap size, built once and solved for
+// each of its images (the value image, per-light images, shadow-mask visibility).
+class SeamStitcher {
+ public:
+  SeamStitcher(const std::vector<SeamEdge>& seams, int width, int height,
+               const std::vector<std::uint8_t>& covered);
+
+  std::int64_t texels() const { return std::int64_t(texel_.size()); }
+  // |lookup on side a − lookup on side b| over the measured samples and the channels: the
+  // largest, and the share of samples above scale / 255.
+  SeamDifference difference(const Image& image, const std::vector<std::uint8_t>& arbitrary,
+                            double scale) const;
+  // Solves for the image's seam texels, every channel, each kept within the values around it.
+  void stitch(Image& image, const std::vector<std::uint8_t>& arbitrary) const;
+
+ private:
+  struct Sample {
+    int texel[8];    // side a's four bilinear texels, then side b's (pixel indices)
+    int unknown[8];  // the same texels as indices into texel_
+    double weight[8];
+  };
+  bool measured(const Sample& s, const std::vector<std::uint8_t>& arbitrary) const;
+  std::vector<Sample> samples_;
+  std::vector<int> texel_;             // the solve's unknowns: pixel indices
+  std::vector<std::uint8_t> covered_;  // per unknown
+};
 
 }  // namespace
 
@@ -149,16 +180,15 @@ std::vector<SeamEdge> find_seams(const Mesh& mesh) {
 }
 
 SeamStitcher::SeamStitcher(const std::vector<SeamEdge>& seams, int width, int height,
-                           const std::vector<std::uint8_t>& covered)
-    : width_(width), height_(height), edges_(std::int64_t(seams.size())) {
+                           const std::vector<std::uint8_t>& covered) {
   if (seams.empty() || width <= 0 || height <= 0) return;
   std::vector<double> ts;
   for (const SeamEdge& seam : seams) {
     const Vec2 a0 = pixel_of(seam.a[0], width, height), a1 = pixel_of(seam.a[1], width, height);
     const Vec2 b0 = pixel_of(seam.b[0], width, height), b1 = pixel_of(seam.b[1], width, height);
     ts.assign({0.0, 1.0});
-    add_crossings(a0, a1, ts);
-    add_crossings(b0, b1, ts);
+    add_crossings(a0, a1, width, height, ts);
+    add_crossings(b0, b1, width, height, ts);
     std::sort(ts.begin(), ts.end());
     ts.erase(std::unique(ts.begin(), ts.end()), ts.end());
     const auto add_sample = [&](double t) {
@@ -184,8 +214,6 @@ SeamStitcher::SeamStitcher(const std::vector<SeamEdge>& seams, int width, int he
   covered_.resize(texel_.size());
   for (std::size_t u = 0; u < texel_.size(); ++u) covered_[u] = covered[std::size_t(texel_[u])];
 }
-
-SeamStitcher::~SeamStitcher() = default;
 
 bool SeamStitcher::measured(const Sample& s, const std::vector<std::uint8_t>& arbitrary) const {
   if (arbitrary.empty()) return true;
@@ -337,7 +365,7 @@ SeamReport stitch_seams(const std::vector<SeamEdge>& seams,
   if (images.empty() || seams.empty()) return report;
   const SeamImage& first = images.front();
   const SeamStitcher stitcher(seams, first.image->width, first.image->height, covered);
-  report.edges = stitcher.edges();
+  report.edges = std::int64_t(seams.size());
   report.before = stitcher.difference(*first.image, first.arbitrary, scale);
   if (!solve) {
     report.after = report.before;

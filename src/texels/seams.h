@@ -35,50 +35,14 @@ struct SeamDifference {
   double visible = 0;  // share of the measured samples, [0, 1]
 };
 struct SeamReport {
-  std::int64_t edges = 0, texels = 0;
+  std::int64_t edges = 0;
+  std::int64_t texels = 0;  // the texels the seams' lookups read: those the solve may change
   SeamDifference before, after;
 };
 
-// The least-squares system of a receiver's seams at one lightmap size, built once and solved for
-// each of its images (the value image, per-light images, shadow-mask visibility).
-class SeamStitcher {
- public:
-  // `covered`: the lightmap's coverage (TexelSpace::covered); uncovered texels (the dilated
-  // margin) are freer to move than covered ones, which hold baked values.
-  SeamStitcher(const std::vector<SeamEdge>& seams, int width, int height,
-               const std::vector<std::uint8_t>& covered);
-  ~SeamStitcher();
-  SeamStitcher(const SeamStitcher&) = delete;
-  SeamStitcher& operator=(const SeamStitcher&) = delete;
-
-  std::int64_t edges() const { return edges_; }
-  std::int64_t texels() const { return std::int64_t(texel_.size()); }
-  // `arbitrary` below: covered texels of the image whose value means nothing (a visibility where
-  // no light reaches, 0 or 1 by convention): they keep their values, and a sample that reads one
-  // is neither solved for nor measured; empty: none.
-  // |lookup on side a − lookup on side b| over the measured samples and the channels: the
-  // largest, and the share of samples above scale / 255.
-  SeamDifference difference(const Image& image, const std::vector<std::uint8_t>& arbitrary,
-                            double scale) const;
-  // Solves for the image's seam texels (width × height), every channel, each kept within the
-  // values around it (seams.cpp says how).
-  void stitch(Image& image, const std::vector<std::uint8_t>& arbitrary) const;
-
- private:
-  struct Sample {
-    int texel[8];    // side a's four bilinear texels, then side b's (pixel indices)
-    int unknown[8];  // the same texels as indices into texel_
-    double weight[8];
-  };
-  bool measured(const Sample& s, const std::vector<std::uint8_t>& arbitrary) const;
-  int width_ = 0, height_ = 0;
-  std::int64_t edges_ = 0;
-  std::vector<Sample> samples_;
-  std::vector<int> texel_;             // the solve's unknowns: pixel indices
-  std::vector<std::uint8_t> covered_;  // per unknown
-};
-
-// One image of a receiver to stitch, with its arbitrary texels (SeamStitcher).
+// One image of a receiver to stitch, with its arbitrary texels: covered texels whose value means
+// nothing (a visibility where no light reaches, 0 or 1 by convention). They keep their values,
+// and a seam sample that reads one is neither solved for nor measured; empty: none.
 struct SeamImage {
   Image* image = nullptr;
   std::vector<std::uint8_t> arbitrary;
@@ -87,6 +51,8 @@ struct SeamImage {
 // Stitches `images` (all width × height of one receiver) along `seams`, each on its own, and
 // reports on the first (its differences against `scale`: 1 for a visibility, the largest value
 // for an irradiance); with `solve` false, only measures them (after = before, texels 0).
+// `covered`: the lightmap's coverage (TexelSpace::covered); uncovered texels (the dilated
+// margin) are freer to move than covered ones, which hold baked values.
 SeamReport stitch_seams(const std::vector<SeamEdge>& seams,
                         const std::vector<std::uint8_t>& covered,
                         const std::vector<SeamImage>& images, double scale, bool solve = true);
