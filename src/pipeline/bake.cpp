@@ -26,6 +26,7 @@
 #include "scene/lights.h"
 #include "scene/mesh.h"
 #include "scene/mesh_reader.h"
+#include "texels/auto_uv.h"
 #include "texels/lightmap_sizes.h"
 #include "texels/texel_space.h"
 
@@ -36,7 +37,8 @@ namespace {
 // Every object's mesh, in scene order; skipped degenerate triangles become warnings. A mesh file
 // may be a quarter of the memory budget, and its reader may use half of it: Assimp's scene and
 // the working mesh take several times the file's size. A file that several objects share (a
-// level's nodes) is read once and kept until its last object is built.
+// level's nodes) is read once and kept until its last object is built. A receiver with
+// uv = "auto" gets its lightmap UVs here, packed for the side it will have.
 Expected<std::vector<Mesh>> load_meshes(const Scene& scene, std::vector<std::string>* warnings) {
   std::vector<Mesh> meshes;
   meshes.reserve(scene.objects.size());
@@ -60,6 +62,17 @@ Expected<std::vector<Mesh>> load_meshes(const Scene& scene, std::vector<std::str
       warnings->push_back(object_location(scene.file, obj) + ": skipped " +
                           std::to_string(mesh->skipped_degenerate) +
                           " degenerate (zero-area) triangles");
+    }
+    if (obj.auto_uv && obj.receiver) {
+      AutoUvTarget target;
+      target.margin = scene.bake.margin;
+      target.max_side = largest_lightmap_side(scene);
+      if (scene.bake.texels_per_metre > 0)
+        target.texels_per_metre = scene.bake.texels_per_metre * obj.lightmap_scale;
+      else
+        target.side = std::min(scene.bake.resolution, target.max_side);
+      if (auto made = generate_lightmap_uvs(*mesh, target); !made)
+        return scene_error(object_location(scene.file, obj) + ": " + made.error().message);
     }
     meshes.push_back(std::move(*mesh));
   }
@@ -318,7 +331,7 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     out.lights_reached = std::move(reached[r]);
     out.seconds_texels = raster_seconds[r];
     out.name = obj.name;
-    out.uv_channel = obj.uv_channel;
+    out.uv_channel = obj.auto_uv ? 1 : obj.uv_channel;  // generated: the glTF's TEXCOORD_1
     ReceiverInput input;
     input.space = &spaces[r];
     input.mesh = &meshes[receivers[r]];

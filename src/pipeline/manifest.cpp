@@ -246,7 +246,10 @@ json receiver_to_json(const ManifestReceiver& r) {
         {"uv_area_outside", r.uv_layout.uv_area_outside},
         {"overlapping_texels", r.uv_layout.overlapping_texels},
         {"texels_near_other_charts", r.uv_layout.texels_near_other_charts},
-        {"margin", r.uv_layout.margin}}},
+        {"margin", r.uv_layout.margin},
+        {"stretch", r.uv_layout.stretch},
+        {"density_spread", r.uv_layout.density_spread},
+        {"generated", r.uv_layout.generated}}},
       {"seams",
        {{"edges", r.seams.edges},
         {"stitched", r.seams.stitched},
@@ -323,6 +326,11 @@ void read_receiver(const json& entry, const std::string& where, const std::strin
     layout_fields.read("overlapping_texels", r.uv_layout.overlapping_texels);
     layout_fields.read("texels_near_other_charts", r.uv_layout.texels_near_other_charts);
     layout_fields.read("margin", r.uv_layout.margin);
+    // Absent from manifests written before the layout's quality was measured.
+    if (layout->contains("stretch")) layout_fields.read("stretch", r.uv_layout.stretch);
+    if (layout->contains("density_spread"))
+      layout_fields.read("density_spread", r.uv_layout.density_spread);
+    if (layout->contains("generated")) layout_fields.read("generated", r.uv_layout.generated);
   }
   // Absent from manifests written before seams were measured.
   if (const json* seams = entry.contains("seams") ? fields.object("seams") : nullptr) {

@@ -67,6 +67,9 @@ struct ManifestUvLayout {
   double uv_area = 0, uv_area_outside = 0;
   std::int64_t overlapping_texels = 0, texels_near_other_charts = 0;
   int margin = 0;  // texels
+  // Layout quality (UvLayoutReport); absent from manifests written before they were measured.
+  double stretch = 0, density_spread = 0;
+  bool generated = false;  // the bake made the UVs: they are the glTF output's TEXCOORD_1
 };
 
 // The receiver's UV seams (SeamReport, texels/seams.h): the largest difference between the

@@ -190,7 +190,10 @@ ManifestReceiver describe_receiver(const ReceiverBake& r, const BakeSettings& ef
                      .uv_area_outside = r.uv.uv_area_outside,
                      .overlapping_texels = r.uv.overlapping_texels,
                      .texels_near_other_charts = r.uv.texels_near_other_charts,
-                     .margin = r.uv.margin};
+                     .margin = r.uv.margin,
+                     .stretch = r.uv.stretch,
+                     .density_spread = r.uv.density_spread,
+                     .generated = r.uv.generated};
   entry.seams = {.edges = r.seams.edges,
                  .texels = r.seams.texels,
                  .stitched = effective.seams,

@@ -18,7 +18,7 @@ using json = nlohmann::ordered_json;
 
 constexpr std::uint32_t kReceiverMagic = 0x52535342;  // "SBSR"
 constexpr std::uint32_t kMeshMagic = 0x4D535342;      // "SBSM"
-constexpr std::uint32_t kVersion = 2;                 // 2: receivers' seams
+constexpr std::uint32_t kVersion = 3;  // 2: receivers' seams; 3: UV stretch, density spread
 // A lightmap side no bake makes (resolution ≤ 16384), so that a damaged header cannot make the
 // reader allocate terabytes.
 constexpr std::uint64_t kMaxSide = 16384;
@@ -134,7 +134,10 @@ json receiver_metadata(const ReceiverBake& r) {
             {"overlapping_texels", r.uv.overlapping_texels},
             {"charts", r.uv.charts},
             {"margin", r.uv.margin},
-            {"texels_near_other_charts", r.uv.texels_near_other_charts}}},
+            {"texels_near_other_charts", r.uv.texels_near_other_charts},
+            {"stretch", r.uv.stretch},
+            {"density_spread", r.uv.density_spread},
+            {"generated", r.uv.generated}}},
           {"seams",
            {{"edges", r.seams.edges},
             {"texels", r.seams.texels},
@@ -186,6 +189,9 @@ Expected<ReceiverBake> read_receiver(const json& meta, const std::filesystem::pa
     r.uv.charts = uv.at("charts").get<int>();
     r.uv.margin = uv.at("margin").get<int>();
     r.uv.texels_near_other_charts = uv.at("texels_near_other_charts").get<std::int64_t>();
+    r.uv.stretch = uv.at("stretch").get<double>();
+    r.uv.density_spread = uv.at("density_spread").get<double>();
+    r.uv.generated = uv.at("generated").get<bool>();
     const json& seams = meta.at("seams");
     r.seams.edges = seams.at("edges").get<std::int64_t>();
     r.seams.texels = seams.at("texels").get<std::int64_t>();

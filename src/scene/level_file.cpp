@@ -269,15 +269,10 @@ Expected<LevelContents> import_level(const fs::path& file, const Affine3& placem
       channels = std::min(channels, part.uv_channel_count());
     }
     if (obj.parts.size() == raw->nodes[n].parts.size()) obj.parts.clear();
-    // The second UV set is the lightmap's by every engine's convention; the first otherwise.
-    obj.uv_channel = channels >= 2 ? 1 : 0;
-    if (channels == 0) {
-      obj.receiver = false;
-      level.warnings.push_back(fmt::format(
-          "{}: node '{}': has no UV set, so it is a blocker only (generated lightmap UVs are "
-          "not built yet); give it a lightmap UV set to bake it",
-          where, raw->nodes[n].name));
-    }
+    // The second UV set is the lightmap's by every engine's convention; without one, the bake
+    // makes lightmap UVs (channel 0, if any, stays the texture UVs a glTF of the bake carries).
+    obj.auto_uv = channels < 2;
+    obj.uv_channel = obj.auto_uv ? 0 : 1;
     level.objects.push_back(std::move(obj));
   }
 

@@ -34,6 +34,7 @@ struct Mesh {
   // UVs, which a glTF of the bake carries beside the lightmap UVs); empty otherwise.
   std::vector<Vec2> texture_uv;
   int skipped_degenerate = 0;  // zero-area triangles dropped on import
+  bool uv_generated = false;   // the lightmap UVs were made by the bake (texels/auto_uv.h)
 };
 
 // Loads every mesh of every node of obj.mesh (one object = the whole file), applies node
@@ -61,6 +62,12 @@ Expected<std::shared_ptr<const RawMeshFile>> read_object_file(
     const ObjectDesc& obj, const std::filesystem::path& scene_file, const ImportLimits& limits);
 Expected<Mesh> build_object_mesh(const ObjectDesc& obj, const RawMeshFile& file,
                                  const std::filesystem::path& scene_file);
+
+// Adds triangle (a, b, c) to mesh; a face OpenMesh refuses (it would make a vertex or an edge
+// non-manifold) is added on three fresh copies of its vertices, and of their texture UVs when
+// `texture_uv` holds them (mesh_import.cpp).
+void add_triangle(TriMesh& mesh, TriMesh::VertexHandle a, TriMesh::VertexHandle b,
+                  TriMesh::VertexHandle c, std::vector<Vec2>& texture_uv);
 
 // World-space triangle of face f, as three points.
 struct Triangle {

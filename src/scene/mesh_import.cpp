@@ -121,10 +121,10 @@ std::string format_vec(const Vec3& v) {
   return out.str();
 }
 
-// Adds triangle (a, b, c) to mesh. OpenMesh's add_face refuses a face that would make a vertex or
-// an edge non-manifold (and prints why); the checks below are its own, done first to keep it
-// quiet. A refused face is added on three fresh copies of its vertices (and of their texture UVs,
-// when `texture_uv` holds them).
+}  // namespace
+
+// OpenMesh's add_face refuses a face that would make a vertex or an edge non-manifold (and prints
+// why); the checks below are its own, done first to keep it quiet.
 void add_triangle(TriMesh& mesh, TriMesh::VertexHandle a, TriMesh::VertexHandle b,
                   TriMesh::VertexHandle c, std::vector<Vec2>& texture_uv) {
   const TriMesh::VertexHandle corners[3] = {a, b, c};
@@ -152,6 +152,8 @@ void add_triangle(TriMesh& mesh, TriMesh::VertexHandle a, TriMesh::VertexHandle 
   }
   mesh.add_face(copies[0], copies[1], copies[2]);
 }
+
+namespace {
 
 // For every vertex (all instances concatenated, in order), the index of the first vertex that
 // has the same world position and normal and the same UVs in every channel, bit for bit: the
@@ -212,8 +214,10 @@ Expected<Mesh> build_mesh(const RawMeshFile& file, const std::vector<PartInstanc
     return error("'" + path + "' has no triangles (an object needs a surface)");
   }
 
-  // UV channel: every part must carry it for the object to have lightmap UVs.
-  const bool channel_in_range = obj.uv_channel >= 0 && obj.uv_channel < kMaxUvChannels;
+  // UV channel: every part must carry it for the object to have lightmap UVs. Generated ones
+  // (uv = "auto") are made after import (texels/auto_uv.h): none are read.
+  const bool channel_in_range =
+      !obj.auto_uv && obj.uv_channel >= 0 && obj.uv_channel < kMaxUvChannels;
   result.has_uv = channel_in_range;
   const RawMeshPart* part_without_uv = nullptr;
   for (const PartInstance& instance : instances) {
@@ -226,7 +230,7 @@ Expected<Mesh> build_mesh(const RawMeshFile& file, const std::vector<PartInstanc
 
   // A receiver's texture UVs (channel 0), when its lightmap UVs are another channel and every
   // part has them: a glTF of the bake carries them as TEXCOORD_0.
-  bool keep_texture_uv = obj.receiver && obj.uv_channel != 0;
+  bool keep_texture_uv = obj.receiver && (obj.auto_uv || obj.uv_channel != 0);
   for (const PartInstance& instance : instances)
     keep_texture_uv = keep_texture_uv && !file.parts[instance.part].uvs[0].empty();
 
@@ -291,7 +295,7 @@ Expected<Mesh> build_mesh(const RawMeshFile& file, const std::vector<PartInstanc
     result.has_uv = false;
     for (ImportedVertex& v : vertices) v.uv = Vec2::Zero();
   }
-  if (obj.receiver && !result.has_uv) {
+  if (obj.receiver && !result.has_uv && !obj.auto_uv) {
     const int channels = part_without_uv ? part_without_uv->uv_channel_count() : 0;
     const std::string channel = std::to_string(obj.uv_channel);
     return error("a receiver needs lightmap UVs in channel " + channel + " (uv = " + channel +

@@ -91,6 +91,9 @@ struct ObjectDesc {
   bool receiver = true;
   bool blocker = true;
   int uv_channel = 0;
+  // uv = "auto": the bake makes the lightmap UVs (texels/auto_uv.h); uv_channel (0) then names
+  // only the texture UVs that a glTF of the bake carries.
+  bool auto_uv = false;
   // A receiver whose lightmap UVs cover no texel is an error unless this is set (its lightmap is
   // then written black, with a warning).
   bool allow_uncovered = false;

@@ -60,14 +60,17 @@ Status override_objects(const std::filesystem::path& file, const toml::table& ta
   const auto receiver = r.boolean("receiver");
   const auto blocker = r.boolean("blocker");
   const auto allow_uncovered = r.boolean("allow_uncovered");
-  const auto uv = r.integer("uv", 0, kMaxUvChannels - 1);
+  const auto uv = r.uv_set("uv", kMaxUvChannels - 1);
   const auto scale = r.number("lightmap_scale", "a number > 0", is_positive);
   if (r.failed()) return r.error();
   for (ObjectDesc* o : targets) {
     if (receiver) o->receiver = *receiver;
     if (blocker) o->blocker = *blocker;
     if (allow_uncovered) o->allow_uncovered = *allow_uncovered;
-    if (uv) o->uv_channel = int(*uv);
+    if (uv) {
+      o->auto_uv = *uv == TableReader::kAutoUvSet;
+      o->uv_channel = o->auto_uv ? 0 : *uv;
+    }
     if (scale) o->lightmap_scale = *scale;
     o->line = int(r.line());
   }

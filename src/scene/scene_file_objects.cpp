@@ -1,5 +1,6 @@
 // The [[object]] tables of a scene file (docs/scene-format.md): name, mesh file, roles, UV
 // channel and object transform.
+#include "scene/mesh_reader.h"
 #include "scene/scene_file_tables.h"
 #include "scene/toml_table_reader.h"
 
@@ -55,8 +56,9 @@ Expected<ObjectDesc> read_object(const std::filesystem::path& file, const toml::
   if (auto v = r.boolean("receiver")) obj.receiver = *v;
   if (auto v = r.boolean("blocker")) obj.blocker = *v;
   if (auto v = r.boolean("allow_uncovered")) obj.allow_uncovered = *v;
-  if (auto v = r.integer("uv", 0, std::numeric_limits<int>::max())) {
-    obj.uv_channel = static_cast<int>(*v);
+  if (auto v = r.uv_set("uv", kMaxUvChannels - 1)) {
+    obj.auto_uv = *v == TableReader::kAutoUvSet;
+    obj.uv_channel = obj.auto_uv ? 0 : *v;
   }
   obj.transform = read_placement(r);
   if (auto v = r.number("lightmap_scale", "a number > 0", is_positive)) obj.lightmap_scale = *v;

@@ -38,33 +38,41 @@ void stable_sort_rects(void* base, std::size_t count, std::size_t size,
 
 namespace sb {
 
-namespace {
+bool RectanglePacking::all_packed() const {
+  return std::all_of(packed.begin(), packed.end(), [](bool b) { return b; });
+}
 
-// Packs the padded squares of `items` (indices into sides) into one size² atlas; returns the
-// positions of those that fit (x, y of the padded square) and which did.
-struct PackResult {
-  std::vector<int> x, y;
-  std::vector<bool> packed;
-};
-
-PackResult pack_one(const std::vector<int>& sides, const std::vector<std::size_t>& items, int size,
-                    int padding) {
-  std::vector<stbrp_rect> rects(items.size());
-  for (std::size_t i = 0; i < items.size(); ++i) {
+RectanglePacking pack_rectangles(const std::vector<std::array<int, 2>>& sizes, int width,
+                                 int height) {
+  std::vector<stbrp_rect> rects(sizes.size());
+  for (std::size_t i = 0; i < sizes.size(); ++i) {
     rects[i].id = int(i);
-    rects[i].w = rects[i].h = sides[items[i]] + 2 * padding;
+    rects[i].w = sizes[i][0];
+    rects[i].h = sizes[i][1];
   }
-  std::vector<stbrp_node> nodes(std::size_t(std::max(size, 1)));
+  std::vector<stbrp_node> nodes(std::size_t(std::max(width, 1)));
   stbrp_context context;
-  stbrp_init_target(&context, size, size, nodes.data(), int(nodes.size()));
+  stbrp_init_target(&context, width, height, nodes.data(), int(nodes.size()));
   stbrp_pack_rects(&context, rects.data(), int(rects.size()));
-  PackResult out;
+  // stb_rect_pack returns the rectangles in the order given (it sorts back by id).
+  RectanglePacking out;
   for (const stbrp_rect& r : rects) {
     out.x.push_back(r.x);
     out.y.push_back(r.y);
     out.packed.push_back(r.was_packed != 0);
   }
   return out;
+}
+
+namespace {
+
+// Packs the padded squares of `items` (indices into sides) into one size² atlas.
+RectanglePacking pack_one(const std::vector<int>& sides, const std::vector<std::size_t>& items,
+                          int size, int padding) {
+  std::vector<std::array<int, 2>> sizes;
+  for (const std::size_t item : items)
+    sizes.push_back({sides[item] + 2 * padding, sides[item] + 2 * padding});
+  return pack_rectangles(sizes, size, size);
 }
 
 }  // namespace
@@ -77,7 +85,7 @@ AtlasLayout pack_atlases(const std::vector<int>& sides, const AtlasSettings& set
   for (std::size_t i = 0; i < sides.size(); ++i) remaining[i] = i;
   while (!remaining.empty()) {
     const int atlas = int(layout.sizes.size());
-    PackResult result = pack_one(sides, remaining, settings.size, settings.padding);
+    RectanglePacking result = pack_one(sides, remaining, settings.size, settings.padding);
     std::vector<std::size_t> placed, left;
     for (std::size_t i = 0; i < remaining.size(); ++i)
       (result.packed[i] ? placed : left).push_back(remaining[i]);
@@ -89,8 +97,8 @@ AtlasLayout pack_atlases(const std::vector<int>& sides, const AtlasSettings& set
       // The last atlas (it holds every receiver left, in the same order): halve it while they
       // still fit.
       for (int smaller = size / 2; smaller >= 1; smaller /= 2) {
-        const PackResult again = pack_one(sides, placed, smaller, settings.padding);
-        if (!std::all_of(again.packed.begin(), again.packed.end(), [](bool b) { return b; })) break;
+        const RectanglePacking again = pack_one(sides, placed, smaller, settings.padding);
+        if (!again.all_packed()) break;
         size = smaller;
         result = again;
       }

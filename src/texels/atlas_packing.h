@@ -23,6 +23,17 @@ struct AtlasLayout {
   std::vector<AtlasPlacement> placements;  // per receiver, in the order given
 };
 
+// Rectangles of `sizes` (width, height) packed into one width × height area by stb_rect_pack's
+// skyline bottom-left (libstb-dev), tallest first, ties in the given order: the same sizes give the
+// same layout. Per rectangle, its lowest corner (x, y) and whether it fit.
+struct RectanglePacking {
+  std::vector<int> x, y;
+  std::vector<bool> packed;
+  bool all_packed() const;
+};
+RectanglePacking pack_rectangles(const std::vector<std::array<int, 2>>& sizes, int width,
+                                 int height);
+
 // Packs squares of `sides` (each at most settings.size − 2·padding) into as few atlases of
 // settings.size² as the packer manages, the last shrunk to the smallest power-of-two fraction of
 // settings.size that still holds its receivers. Skyline bottom-left (stb_rect_pack, libstb-dev),

@@ -14,6 +14,10 @@
 
 namespace sb {
 
+// Two vertex normals closer than this angle (degrees) are one smooth surface across an edge; wider
+// apart, the edge is hard (a crease the normals split).
+inline constexpr double kSmoothEdgeDegrees = 0.5;
+
 // One mesh edge seen from its two triangles: the UVs of its two ends on side a and on side b
 // (a[k] and b[k] are the same surface point).
 struct SeamEdge {

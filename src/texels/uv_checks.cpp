@@ -85,12 +85,62 @@ void sliding_min_max(std::vector<int>& lo, std::vector<int>& hi, int width, int 
 
 }  // namespace
 
+UvQuality uv_quality(const Mesh& mesh) {
+  UvQuality q;
+  if (!mesh.has_uv) return q;
+  // Per triangle: surface area, UV area, and Sander et al.'s (2001) L2 stretch² of the map from
+  // UV to surface, (|∂p/∂s|² + |∂p/∂t|²) / 2.
+  struct Sample {
+    double surface, uv, stretch2;
+  };
+  std::vector<Sample> samples;
+  double surface = 0, uv = 0;
+  for (const auto f : mesh.mesh.faces()) {
+    const Triangle t = triangle(mesh.mesh, f);
+    const double a = 0.5 * ((t.uv[1] - t.uv[0]).x() * (t.uv[2] - t.uv[0]).y() -
+                            (t.uv[1] - t.uv[0]).y() * (t.uv[2] - t.uv[0]).x());
+    const double area = 0.5 * (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]).norm();
+    if (!(std::abs(a) > 0) || !(area > 0)) continue;
+    const Vec3 ds = (t.p[0] * (t.uv[1].y() - t.uv[2].y()) + t.p[1] * (t.uv[2].y() - t.uv[0].y()) +
+                     t.p[2] * (t.uv[0].y() - t.uv[1].y())) /
+                    (2 * a);
+    const Vec3 dt = (t.p[0] * (t.uv[2].x() - t.uv[1].x()) + t.p[1] * (t.uv[0].x() - t.uv[2].x()) +
+                     t.p[2] * (t.uv[1].x() - t.uv[0].x())) /
+                    (2 * a);
+    samples.push_back({area, std::abs(a), 0.5 * (ds.squaredNorm() + dt.squaredNorm())});
+    surface += area;
+    uv += std::abs(a);
+  }
+  if (samples.empty()) return q;
+  // Stretch: √(Σ A·L2² / Σ A), times √(UV area / surface area) so that a uniform scale is 1.
+  double sum = 0;
+  for (const Sample& s : samples) sum += s.surface * s.stretch2;
+  q.stretch = std::sqrt(sum / surface) * std::sqrt(uv / surface);
+  // Density: texels per metre ∝ √(UV area / surface area), percentiles by surface area.
+  std::sort(samples.begin(), samples.end(),
+            [](const Sample& a, const Sample& b) { return a.uv * b.surface < b.uv * a.surface; });
+  auto density_at = [&](double fraction) {
+    double below = 0;
+    for (const Sample& s : samples) {
+      below += s.surface;
+      if (below >= fraction * surface) return std::sqrt(s.uv / s.surface);
+    }
+    return std::sqrt(samples.back().uv / samples.back().surface);
+  };
+  q.density_spread = density_at(0.95) / density_at(0.05);
+  return q;
+}
+
 UvLayoutReport check_uv_layout(const Mesh& mesh, const TexelSpace& space, int margin) {
   UvLayoutReport report;
   report.covered_texels = std::int64_t(space.texels.size());
   report.overlapping_texels = space.overlapping_texels;
   report.margin = margin;
+  report.generated = mesh.uv_generated;
   if (!mesh.has_uv) return report;
+  const UvQuality quality = uv_quality(mesh);
+  report.stretch = quality.stretch;
+  report.density_spread = quality.density_spread;
   const TriMesh& m = mesh.mesh;
   const int faces = int(m.n_faces());
 

@@ -22,7 +22,21 @@ struct UvLayoutReport {
   int margin = 0;  // texels, [bake] margin
   // Covered texels with a texel of another chart within `margin` texels (either axis).
   std::int64_t texels_near_other_charts = 0;
+  // How evenly the layout spends its texels on the surface (uv_quality): Sander et al.'s L2
+  // stretch with the layout's overall scale taken out (1: every triangle keeps its shape and its
+  // share of area; higher is worse), and the spread of texel density, the 95th over the 5th
+  // percentile of texels per metre by surface area (1: even).
+  double stretch = 0;
+  double density_spread = 0;
+  bool generated = false;  // the bake made these UVs (texels/auto_uv.h)
 };
+
+// The two quality figures of a UV layout (UvLayoutReport::stretch, density_spread), over the
+// triangles with UV area; {0, 0} for a mesh without UVs.
+struct UvQuality {
+  double stretch = 0, density_spread = 0;
+};
+UvQuality uv_quality(const Mesh& mesh);
 
 UvLayoutReport check_uv_layout(const Mesh& mesh, const TexelSpace& space, int margin);
 

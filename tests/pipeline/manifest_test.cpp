@@ -123,7 +123,8 @@ TEST(Manifest, KeepsTheFilesKeyOrder) {
                                       "seconds", "method_stats", "penumbra_error", "lights"}));
   EXPECT_EQ(keys(j["receivers"][0]["uv_layout"]),
             (std::vector<std::string>{"charts", "uv_area", "uv_area_outside", "overlapping_texels",
-                                      "texels_near_other_charts", "margin"}));
+                                      "texels_near_other_charts", "margin", "stretch",
+                                      "density_spread", "generated"}));
 }
 
 TEST(Manifest, LeavesOutWhatDoesNotApply) {

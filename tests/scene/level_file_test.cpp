@@ -57,6 +57,7 @@ TEST(LevelFile, BlendersExportBecomesObjectsAndLights) {
   for (const ObjectDesc& o : scene->objects) {
     EXPECT_TRUE(o.receiver && o.blocker) << o.name;
     EXPECT_EQ(o.uv_channel, 1) << o.name << ": the second UV set is the lightmap's";
+    EXPECT_FALSE(o.auto_uv) << o.name;
     EXPECT_GE(o.node, 0) << o.name;
   }
   // Blender's Z-up (x, y, z) is glTF's (x, z, -y). The ceiling panel: a 1 × 0.5 m quad at
@@ -326,8 +327,11 @@ TEST_F(HandWrittenLevel, RepeatedNamesTakeTheirParentsPath) {
   std::sort(names.begin(), names.end());
   EXPECT_EQ(names, (std::vector<std::string>{"book", "book-2", "shelf_a-book", "shelf_b-book"}));
   EXPECT_TRUE(any_warning_has(level->warnings, "node 'book': another node has the same name"));
-  // Each instance of the one mesh is its own object at its own place.
+  // Each instance of the one mesh is its own object at its own place. With no second UV set,
+  // the bake makes their lightmap UVs; channel 0 stays their texture UVs.
   for (const ObjectDesc& o : level->objects) {
+    EXPECT_TRUE(o.auto_uv) << o.name;
+    EXPECT_EQ(o.uv_channel, 0) << o.name;
     auto mesh = import_mesh(o, file);
     ASSERT_TRUE(mesh) << mesh.error().message;
     EXPECT_EQ(mesh->mesh.n_faces(), 2u);
@@ -482,7 +486,7 @@ TEST_F(LevelImportErrors, NamesThatMatchNothingOrClashAreErrors) {
   e = error_of(head + "[[import.light]]\nname = \"bulb\"\nangle_deg = 1\n");
   EXPECT_NE(e.find("'angle_deg' applies to suns"), std::string::npos) << e;
   e = error_of(head + "[[import.object]]\nname = \"floor\"\nuv = 9\n");
-  EXPECT_NE(e.find("'uv' must be an integer from 0 to 7"), std::string::npos) << e;
+  EXPECT_NE(e.find("'uv' must be a UV channel from 0 to 7 or \"auto\""), std::string::npos) << e;
   e = error_of(head +
                "[[object]]\nname = \"floor\"\nmesh = \"objects/floor.glb\"\n\n[[light]]\nname = "
                "\"sun\"\nshape = \"sphere\"\nposition = [0, 5, 0]\nradius = 0.1\npower = 10\n");

@@ -192,6 +192,21 @@ TEST_F(SceneFile, AppliesDefaults) {
   EXPECT_EQ(scene.lights[0].color, Vec3(1, 1, 1));
 }
 
+TEST_F(SceneFile, UvAutoAsksForGeneratedLightmapUvs) {
+  const Scene scene =
+      load_ok("[[object]]\nname = \"floor\"\nmesh = \"m.obj\"\nuv = \"auto\"\n" + light_panel);
+  EXPECT_TRUE(scene.objects[0].auto_uv);
+  EXPECT_EQ(scene.objects[0].uv_channel, 0);
+  EXPECT_FALSE(load_ok(object_floor + light_panel).objects[0].auto_uv);
+  const std::string e =
+      error_of("[[object]]\nname = \"floor\"\nmesh = \"m.obj\"\nuv = \"smart\"\n" + light_panel);
+  EXPECT_NE(
+      e.find("scene.toml:4: object 'floor': 'uv' must be a UV channel from 0 to 7 or \"auto\", "
+             "got \"smart\""),
+      std::string::npos)
+      << e;
+}
+
 TEST_F(SceneFile, ResolvesMeshAgainstSceneFolder) {
   const std::filesystem::path file =
       write("[[object]]\nname = \"floor\"\nmesh = \"../m.obj\"\n" + light_panel, "sub/scene.toml");
