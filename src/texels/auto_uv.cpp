@@ -45,6 +45,9 @@ constexpr double kFlatDegrees = 0.5;
 // across it would vary more than √2 along a side.
 constexpr double kMaxAreaSpread = 2.0;
 
+// Two border edges closer in space than this fraction of their length are a crack's two lips.
+constexpr double kCrackFraction = 1e-3;
+
 using PositionBits = std::array<std::uint64_t, 3>;
 PositionBits bits_of(const Vec3& p) {
   return {std::bit_cast<std::uint64_t>(p.x()), std::bit_cast<std::uint64_t>(p.y()),
@@ -183,9 +186,26 @@ bool segments_meet(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
          (o4 == 0 && on(c, d, b));
 }
 
-// Whether a flattened chart folds over itself: its border edges (by local vertex) crossing one
-// another, found by a sweep over their u extents.
-bool border_crosses(const std::vector<Vec2>& uv, const std::vector<std::array<int, 2>>& border) {
+// The distance between segments ab and cd in space.
+double segment_distance(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const Vec3 u = b - a, v = d - c, w = a - c;
+  const double uu = u.dot(u), uv = u.dot(v), vv = v.dot(v), uw = u.dot(w), vw = v.dot(w);
+  const double det = uu * vv - uv * uv;
+  double s = det > 1e-300 ? std::clamp((uv * vw - vv * uw) / det, 0.0, 1.0) : 0.0;
+  double t = vv > 0 ? std::clamp((uv * s + vw) / vv, 0.0, 1.0) : 0.0;
+  s = uu > 0 ? std::clamp((uv * t - uw) / uu, 0.0, 1.0) : 0.0;
+  return (w + s * u - t * v).norm();
+}
+
+// Whether a flattened chart folds over itself: two of its border edges (by local vertex) crossing
+// in UV, found by a sweep over their u extents. Edges that also touch in space are the two lips
+// of a crack (T-junctions, unwelded panels: common in assets made by others) laid side by side,
+// not a fold. Where they fold, the midpoints in space of the first two edges found crossing.
+struct Fold {
+  Vec3 a, b;
+};
+std::optional<Fold> border_crosses(const std::vector<Vec2>& uv, const std::vector<Vec3>& positions,
+                                   const std::vector<std::array<int, 2>>& border) {
   std::vector<std::size_t> order(border.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   auto lo = [&](std::size_t e) {
@@ -204,18 +224,25 @@ bool border_crosses(const std::vector<Vec2>& uv, const std::vector<std::array<in
     for (const std::size_t a : active) {
       const auto& [a0, a1] = border[a];
       if (a0 == e0 || a0 == e1 || a1 == e0 || a1 == e1) continue;  // neighbours share an end
-      if (segments_meet(uv[std::size_t(e0)], uv[std::size_t(e1)], uv[std::size_t(a0)],
-                        uv[std::size_t(a1)]))
-        return true;
+      if (!segments_meet(uv[std::size_t(e0)], uv[std::size_t(e1)], uv[std::size_t(a0)],
+                         uv[std::size_t(a1)]))
+        continue;
+      const Vec3 &p0 = positions[std::size_t(e0)], &p1 = positions[std::size_t(e1)];
+      const Vec3 &q0 = positions[std::size_t(a0)], &q1 = positions[std::size_t(a1)];
+      const double length = std::max((p1 - p0).norm(), (q1 - q0).norm());
+      if (segment_distance(p0, p1, q0, q1) > kCrackFraction * length)
+        return Fold{(p0 + p1) / 2, (q0 + q1) / 2};
     }
     active.push_back(e);
   }
-  return false;
+  return std::nullopt;
 }
 
 // The chart flattened, scaled so its UV area equals its surface area; nothing when it cannot be
-// (not a disc, folded, or its triangles' areas spread beyond kMaxAreaSpread).
-std::optional<ChartUvs> flatten(const Surface& s, const std::vector<int>& chart, bool* conformal) {
+// (not a disc, folded, or its triangles' areas spread beyond kMaxAreaSpread); `fold` then says
+// where it folded, if that was why.
+std::optional<ChartUvs> flatten(const Surface& s, const std::vector<int>& chart, bool* conformal,
+                                std::optional<Fold>* fold) {
   // Local vertices: one per position (texture-UV seams inside a chart are one vertex here).
   std::map<PositionBits, int> index;
   std::vector<Vec3> positions;
@@ -281,7 +308,7 @@ std::optional<ChartUvs> flatten(const Surface& s, const std::vector<int>& chart,
   std::vector<std::array<int, 2>> border;
   for (const auto& [edge, count] : uses)
     if (count == 1) border.push_back(edge);
-  if (border_crosses(uv, border)) return std::nullopt;
+  if ((*fold = border_crosses(uv, positions, border))) return std::nullopt;
   return out;
 }
 
@@ -341,10 +368,13 @@ void fit_rectangle(Chart& chart) {
   chart.size = hi - lo;
 }
 
-// The pieces of `chart` on the two sides of the plane through its centroid across its longest
-// axis, each split into its connected parts: halves of an annulus are discs, halves of a cap that
-// spreads too much spread less.
-std::vector<std::vector<int>> bisect(const Surface& s, const std::vector<int>& chart) {
+// The pieces of `chart` on the two sides of a plane, each split into its connected parts: the plane
+// halfway between the two lips of a fold, across the line joining them (a pinch in the surface,
+// such as a tufted cushion's, unfolds only once cut between its lips), or else the plane through
+// the chart's centroid across its longest axis (halves of an annulus are discs, halves of a cap
+// that spreads too much spread less).
+std::vector<std::vector<int>> bisect(const Surface& s, const std::vector<int>& chart,
+                                     const std::optional<Fold>& fold) {
   std::vector<Vec3> centre;
   Vec3 mean = Vec3::Zero();
   double area = 0;
@@ -360,8 +390,12 @@ std::vector<std::vector<int>> bisect(const Surface& s, const std::vector<int>& c
     covariance +=
         s.faces[std::size_t(chart[i])].area * (centre[i] - mean) * (centre[i] - mean).transpose();
   const Eigen::SelfAdjointEigenSolver<Mat3> solver(covariance);
-  const Vec3 axis = solver.eigenvectors().col(2);  // the largest eigenvalue's
-  std::vector<char> side(s.faces.size(), -1);      // −1: not in the chart
+  Vec3 axis = solver.eigenvectors().col(2);  // the largest eigenvalue's
+  if (fold && (fold->b - fold->a).norm() > 0) {
+    axis = (fold->b - fold->a).normalized();
+    mean = (fold->a + fold->b) / 2;
+  }
+  std::vector<char> side(s.faces.size(), -1);  // −1: not in the chart
   std::size_t below = 0;
   for (std::size_t i = 0; i < chart.size(); ++i) {
     side[std::size_t(chart[i])] = (centre[i] - mean).dot(axis) < 0;
@@ -390,12 +424,14 @@ std::vector<std::vector<int>> bisect(const Surface& s, const std::vector<int>& c
 void place_chart(const Surface& s, std::vector<int> faces, std::vector<Chart>& out) {
   Chart chart;
   chart.faces = std::move(faces);
-  if (auto uv = flatten(s, chart.faces, &chart.conformal)) {
+  std::optional<Fold> fold;
+  if (auto uv = flatten(s, chart.faces, &chart.conformal, &fold)) {
     chart.uv = std::move(*uv);
     out.push_back(std::move(chart));
     return;
   }
-  for (std::vector<int>& piece : bisect(s, chart.faces)) place_chart(s, std::move(piece), out);
+  for (std::vector<int>& piece : bisect(s, chart.faces, fold))
+    place_chart(s, std::move(piece), out);
 }
 
 // The texel rectangle a chart takes at `scale` texels per metre: the texels it touches when

@@ -131,6 +131,36 @@ TEST(AutoUv, ADensityGivesTheSideTheBakeSizesTheLightmapBy) {
   EXPECT_LT(clamped->texels_per_metre, 110);
 }
 
+// A flat sheet of 2 × 3 unit quads whose two columns are not welded along x = 1 from y = 0 to 2
+// (the right column's vertices there lie 1 nm off the plane, as an unwelded panel's do): a crack
+// whose two lips fall on one another in UV. One chart: the lips touch in space, so the chart does
+// not fold.
+TEST(AutoUv, ACrackIsNotAFold) {
+  Mesh m;
+  m.name = "sheet";
+  auto vertex = [&](double x, double y, double z) {
+    const auto h = m.mesh.add_vertex(TriMesh::Point(x, y, z));
+    m.mesh.set_normal(h, TriMesh::Normal(0, 0, 1));
+    return h;
+  };
+  std::vector<Vec2> unused;
+  auto quad = [&](TriMesh::VertexHandle a, TriMesh::VertexHandle b, TriMesh::VertexHandle c,
+                  TriMesh::VertexHandle d) {
+    add_triangle(m.mesh, a, b, c, unused);
+    add_triangle(m.mesh, a, c, d, unused);
+  };
+  for (int row = 0; row < 3; ++row) {
+    const double z = row < 2 ? 1e-9 : 0.0;  // the right column's lip, below y = 2
+    const double y0 = row, y1 = row + 1;
+    quad(vertex(0, y0, 0), vertex(1, y0, 0), vertex(1, y1, 0), vertex(0, y1, 0));
+    quad(vertex(1, y0, z), vertex(2, y0, 0), vertex(2, y1, 0), vertex(1, y1, row < 1 ? z : 0.0));
+  }
+  m.mesh.update_face_normals();
+  auto made = generate_lightmap_uvs(m, side_target(64));
+  ASSERT_TRUE(made) << made.error().message;
+  EXPECT_EQ(made->charts, 1);
+}
+
 TEST(AutoUv, ChartsThatCannotFitTheSideAreAnError) {
   Mesh mesh = corpus_mesh("shelf/books.glb");  // 522 charts
   auto made = generate_lightmap_uvs(mesh, side_target(32));
