@@ -372,7 +372,7 @@ Expected<LevelContents> import_level(const fs::path& file, const Affine3& placem
     light.name = light_name(raw_light.name);
     light.shape = LightShape::sphere;
     light.position = position;
-    light.radius = kImportedPointLightRadius;
+    light.radius = kPointLightRadius;  // a point, as glTF's are
     light.color = color / color.maxCoeff();
     // glTF's intensity is candela; other formats' (FBX as Blender writes it) is the light's
     // watts.

@@ -36,9 +36,6 @@
 
 namespace sb {
 
-// The radius an imported point or spot light gets where the scene does not give one, metres.
-inline constexpr double kImportedPointLightRadius = 0.25;
-
 struct LevelContents {
   std::vector<ObjectDesc> objects;
   std::vector<LightDesc> lights;

@@ -111,6 +111,13 @@ struct ObjectDesc {
 
 enum class LightShape { rectangle, disk, sphere };
 
+// A point light (a sphere light of radius 0 in a scene file, a level's point and spot lights) is
+// baked as a sphere of this radius, for every method: its penumbra, 10⁻⁵ m times a blocker's
+// distance to the receiver over its distance to the light, is far below any texel, and its
+// unoccluded irradiance is the point's, Φ cos θ / (4π d²), exactly wherever the sphere lies wholly
+// above a texel's horizon (a sphere's closed form does not depend on its radius there).
+inline constexpr double kPointLightRadius = 1e-5;
+
 struct LightDesc {
   std::string name;
   LightShape shape = LightShape::rectangle;
@@ -119,7 +126,7 @@ struct LightDesc {
   Vec3 up = Vec3(0, 1, 0);        // unit, made orthogonal to normal by the reader; height axis
   double width = 0;               // rectangle only, across up; metres
   double height = 0;              // rectangle only; metres
-  double radius = 0;              // disk and sphere; metres
+  double radius = 0;              // disk and sphere; metres (kPointLightRadius for a point)
   Vec3 color = Vec3(1, 1, 1);     // per-channel scale of the emitted power
   double power = 0;               // watts (for colour (1,1,1) and a white texture)
   std::filesystem::path texture;  // optional emission image over a rectangle or disk; resolved

@@ -84,7 +84,8 @@ Status override_lights(const std::filesystem::path& file, const toml::table& tab
       {"name", "enabled", "radius", "angle_deg", "power", "color", "shadowmask_range"});
   const std::vector<LightDesc*> targets = matching(r, lights, "light", level);
   const auto enabled = r.boolean("enabled");
-  const auto radius = r.number("radius", "a positive number (metres)", is_positive);
+  const auto radius = r.number("radius", "a number >= 0 (metres; 0: a point light, for spheres)",
+                               [](double x) { return std::isfinite(x) && x >= 0; });
   const auto power = r.number("power", "a finite number > 0 (watts)", is_positive);
   const auto color = r.vec3("color", "3 finite numbers >= 0, not all zero",
                             [](double x) { return std::isfinite(x) && x >= 0; });
@@ -99,6 +100,8 @@ Status override_lights(const std::filesystem::path& file, const toml::table& tab
     if (angle && !sun)
       r.fail("angle_deg",
              fmt::format("'angle_deg' applies to suns, and '{}' is not one", light->name));
+    if (radius && *radius == 0 && light->shape == LightShape::disk)
+      r.fail("radius", fmt::format("'{}' is a disk: its radius must be > 0", light->name));
     if (radius && light->shape == LightShape::rectangle)
       r.fail("radius", fmt::format("'radius' applies to sphere and disk lights, and '{}' is a "
                                    "rectangle",
@@ -108,7 +111,8 @@ Status override_lights(const std::filesystem::path& file, const toml::table& tab
   for (LightDesc* light : targets) {
     if (radius) {
       // The same exitance-independent power: only the size changes.
-      light->radius = *radius;
+      light->radius =
+          light->shape == LightShape::sphere ? std::max(*radius, kPointLightRadius) : *radius;
     }
     if (angle) set_sun_angle(*light, *angle);
     if (power) light->power = *power;

@@ -103,13 +103,19 @@ Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::ta
   if (is_rectangle) {
     r.forbid("radius", "applies only to disk and sphere lights, not rectangle");
   } else if (r.require("radius")) {
-    // Both `radius = 0.1` and `radius = [0.1]` are accepted.
-    const std::string_view requirement = "a positive number or [r] (metres)";
+    // Both `radius = 0.1` and `radius = [0.1]` are accepted; a sphere's may be 0, a point light.
+    const std::string_view requirement = is_sphere
+                                             ? "a number >= 0 or [r] (metres; 0: a point light)"
+                                             : "a positive number or [r] (metres)";
+    const auto valid = [&](double x) {
+      return is_sphere ? std::isfinite(x) && x >= 0 : is_positive(x);
+    };
     if (r.find("radius")->is_array()) {
-      if (auto v = r.numbers("radius", 1, requirement, is_positive)) light.radius = (*v)[0];
-    } else if (auto v = r.number("radius", requirement, is_positive)) {
+      if (auto v = r.numbers("radius", 1, requirement, valid)) light.radius = (*v)[0];
+    } else if (auto v = r.number("radius", requirement, valid)) {
       light.radius = *v;
     }
+    if (is_sphere && light.radius < kPointLightRadius) light.radius = kPointLightRadius;
   }
 
   const std::string_view color_requirement = "3 finite numbers >= 0, not all zero";

@@ -85,7 +85,7 @@ TEST(LevelFile, BlendersExportBecomesObjectsAndLights) {
   EXPECT_EQ(bulb->shape, LightShape::sphere);
   EXPECT_LT((bulb->position - Vec3(1.6, 1.8, 1.3)).norm(), 1e-5);
   EXPECT_NEAR(bulb->power, 150, 1e-3);
-  EXPECT_EQ(bulb->radius, kImportedPointLightRadius);
+  EXPECT_EQ(bulb->radius, kPointLightRadius);  // a point, as glTF's are
   // The spot: 300 W at (-1.4, 1.2, 2.4) pointing down, a 70° cone blended over 15 % of it
   // (Blender's spot_size and spot_blend, written as half-angles 35° and 29.75°).
   const LightDesc* spot = light_named(*scene, "spot");

@@ -438,9 +438,25 @@ TEST_F(SceneFile, RejectsBadRadius) {
   std::string two = light_bulb;
   two.replace(two.find("0.1"), 3, "[0.1, 0.2]");
   expect_error(object_floor + two, "radius", "light 'bulb'", "'radius'");
-  std::string zero = light_bulb;
-  zero.replace(zero.find("0.1"), 3, "[0]");
-  expect_error(object_floor + zero, "radius", "light 'bulb'", "'radius'");
+  const std::string negative =
+      "[[light]]\nname = \"bulb\"\nshape = \"sphere\"\nposition = [0, 0, 1]\nradius = [-0.1]\n"
+      "power = 10\n";
+  expect_error(object_floor + negative, "radius", "light 'bulb'", "'radius'");
+}
+
+// A sphere of radius 0 is a point light, baked as a sphere of kPointLightRadius; a disk's radius
+// must be positive.
+TEST_F(SceneFile, SphereOfRadiusZeroIsAPointLight) {
+  const std::string point =
+      "[[light]]\nname = \"bulb\"\nshape = \"sphere\"\nposition = [0, 0, 1]\nradius = 0\n"
+      "power = 10\n";
+  const Scene scene = load_ok(object_floor + point);
+  EXPECT_EQ(scene.lights[0].shape, LightShape::sphere);
+  EXPECT_EQ(scene.lights[0].radius, kPointLightRadius);
+  const std::string disk =
+      "[[light]]\nname = \"lamp\"\nshape = \"disk\"\nposition = [0, 0, 1]\n"
+      "normal = [0, 0, -1]\nradius = 0\npower = 10\n";
+  expect_error(object_floor + disk, "radius", "light 'lamp'", "'radius' must be a positive number");
 }
 
 TEST_F(SceneFile, NormalisesNormalAndOrthogonalisesUp) {
