@@ -62,6 +62,10 @@ class Light {
   std::uint64_t stream() const { return stream_; }
   LightShape shape() const { return desc_.shape; }
   Vec3 centre() const { return desc_.position; }
+  // A point light: a sphere of kPointLightRadius (scene.h), whose shadows are hard.
+  bool is_point() const {
+    return desc_.shape == LightShape::sphere && desc_.radius <= kPointLightRadius;
+  }
   // Emitting surface area in m² (a sphere's whole surface; a rectangle or disk's one side).
   double area() const;
   // Radiant exitance per channel, W/m², averaged over the light: color · power / area, times the

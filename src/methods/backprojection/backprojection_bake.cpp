@@ -437,16 +437,18 @@ class LightPairs final : public PairSource {
   std::vector<TileBlockers> prepared_;  // per listed tile
 };
 
-// A textured light: clear tiles and texels are 1, the rest the reference's own estimate.
-void bake_textured_light(const TexelSpace& space, const BackprojectionInputs& in, std::size_t l,
-                         LightMix& mix, RouteCounts& counts) {
+// A light baked by rays alone: clear tiles and texels are 1, the rest the reference's own
+// estimate at `samples` rays: a textured light's (the estimator weighs a uniform light only), or a
+// point's at one ray, which is exact (its shadows are hard: nothing to estimate or interpolate).
+void bake_light_by_rays(const TexelSpace& space, const BackprojectionInputs& in, std::size_t l,
+                        int samples, LightMix& mix, RouteCounts& counts) {
   const Light& light = (*in.lights)[l];
   const double offset = in.rays->surface_offset();
   const TileShafts tiles = tile_shafts(space, *in.culler, light, offset, kTileCandidates);
   std::atomic<std::int64_t> clear{0}, traced{0}, rays{0};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, space.texels.size(), 64),
                     [&](const auto& r) {
-                      ShadowRays batch(in.samples);
+                      ShadowRays batch(samples);
                       std::vector<Vec2> strata;
                       std::int64_t local_clear = 0, local_traced = 0, local_rays = 0;
                       for (std::size_t t = r.begin(); t != r.end(); ++t) {
@@ -464,7 +466,7 @@ void bake_textured_light(const TexelSpace& space, const BackprojectionInputs& in
                           continue;
                         }
                         Vec3 v;
-                        if (!estimate_visibility(tx, light, *in.rays, in.samples, in.seed,
+                        if (!estimate_visibility(tx, light, *in.rays, samples, in.seed,
                                                  in.stream, space.width, batch, strata, &v))
                           continue;
                         mix.set(l, t, v);
@@ -503,8 +505,8 @@ MixedImages bake_backprojection(const TexelSpace& space, const BackprojectionInp
   LightMix mix(space, lights, in.quantity, LightMix::Order::light_major, in.keep_per_light);
   RouteCounts counts;
   for (std::size_t l = 0; l < lights.size(); ++l) {
-    if (lights[l].textured()) {
-      bake_textured_light(space, in, l, mix, counts);
+    if (lights[l].textured() || lights[l].is_point()) {
+      bake_light_by_rays(space, in, l, lights[l].is_point() ? 1 : in.samples, mix, counts);
       continue;
     }
     const LightField field = backprojection_light(space, in, l);

@@ -19,7 +19,8 @@
 //   traced        The same estimate with the blocking of each pair of cells found by a shadow ray
 //                 to a fixed point of the light, where a shaft holds more polygons than listing
 //                 them is worth; or, for a textured light, the reference's own estimate at
-//                 `samples` rays (the estimator weighs a uniform light only).
+//                 `samples` rays (the estimator weighs a uniform light only); or, for a point
+//                 light, one ray to it (exact: its shadows are hard).
 #pragma once
 
 #include <array>
