@@ -466,8 +466,8 @@ void bake_light_by_rays(const TexelSpace& space, const BackprojectionInputs& in,
                           continue;
                         }
                         Vec3 v;
-                        if (!estimate_visibility(tx, light, *in.rays, samples, in.seed,
-                                                 in.stream, space.width, batch, strata, &v))
+                        if (!estimate_visibility(tx, light, *in.rays, samples, in.seed, in.stream,
+                                                 space.width, batch, strata, &v))
                           continue;
                         mix.set(l, t, v);
                         ++local_traced;
