@@ -126,7 +126,7 @@ class SeamStitcher {
   SeamDifference difference(const Image& image, const std::vector<std::uint8_t>& arbitrary,
                             double scale) const;
   // Solves for the image's seam texels, every channel, each kept within the values around it.
-  void stitch(Image& image, const std::vector<std::uint8_t>& arbitrary) const;
+  void stitch(Image& image, const std::vector<std::uint8_t>& arbitrary, SeamSolver solver) const;
 
  private:
   struct Sample {
@@ -260,7 +260,8 @@ SeamDifference SeamStitcher::difference(const Image& image,
   return out;
 }
 
-void SeamStitcher::stitch(Image& image, const std::vector<std::uint8_t>& arbitrary) const {
+void SeamStitcher::stitch(Image& image, const std::vector<std::uint8_t>& arbitrary,
+                          SeamSolver solver) const {
   const std::size_t n = texel_.size();
   if (n == 0) return;
   // Covered texels keep their baked values with kCoveredPrior, margin texels with kMarginPrior;
@@ -354,7 +355,9 @@ void SeamStitcher::stitch(Image& image, const std::vector<std::uint8_t>& arbitra
     const Eigen::SparseMatrix<double> normal = seam_terms + priors;
     if (round == 0) {
       ldlt.analyzePattern(normal);
-      direct = ldlt.factor_entries() <= kMaxFactorEntriesPerUnknown * double(n);
+      direct = solver == SeamSolver::automatic
+                   ? ldlt.factor_entries() <= kMaxFactorEntriesPerUnknown * double(n)
+                   : solver == SeamSolver::factorised;
     }
     if (direct) {
       ldlt.factorize(normal);
@@ -397,7 +400,8 @@ void SeamStitcher::stitch(Image& image, const std::vector<std::uint8_t>& arbitra
 
 SeamReport stitch_seams(const std::vector<SeamEdge>& seams,
                         const std::vector<std::uint8_t>& covered,
-                        const std::vector<SeamImage>& images, double scale, bool solve) {
+                        const std::vector<SeamImage>& images, double scale, bool solve,
+                        SeamSolver solver) {
   SeamReport report;
   if (images.empty() || seams.empty()) return report;
   const SeamImage& first = images.front();
@@ -409,7 +413,7 @@ SeamReport stitch_seams(const std::vector<SeamEdge>& seams,
     return report;
   }
   report.texels = stitcher.texels();
-  for (const SeamImage& image : images) stitcher.stitch(*image.image, image.arbitrary);
+  for (const SeamImage& image : images) stitcher.stitch(*image.image, image.arbitrary, solver);
   report.after = stitcher.difference(*first.image, first.arbitrary, scale);
   return report;
 }

@@ -52,6 +52,10 @@ struct SeamImage {
   std::vector<std::uint8_t> arbitrary;
 };
 
+// How the least-squares system is solved: factored (Eigen's LDLᵀ) where its factor stays sparse
+// and by conjugate gradients where it would fill in (automatic), or always one way (for tests).
+enum class SeamSolver { automatic, factorised, iterative };
+
 // Stitches `images` (all width × height of one receiver) along `seams`, each on its own, and
 // reports on the first (its differences against `scale`: 1 for a visibility, the largest value
 // for an irradiance); with `solve` false, only measures them (after = before, texels 0).
@@ -59,6 +63,7 @@ struct SeamImage {
 // margin) are freer to move than covered ones, which hold baked values.
 SeamReport stitch_seams(const std::vector<SeamEdge>& seams,
                         const std::vector<std::uint8_t>& covered,
-                        const std::vector<SeamImage>& images, double scale, bool solve = true);
+                        const std::vector<SeamImage>& images, double scale, bool solve = true,
+                        SeamSolver solver = SeamSolver::automatic);
 
 }  // namespace sb

@@ -90,21 +90,34 @@ TEST(Seams, FoundWhereTheSurfaceIsSmoothAndTheUvsPart) {
 
 // Chart a (x in [8, 24)) holds 0.2 + 0.01 y, chart b (x in [40, 56)) 0.5 + 0.01 y: a seam from
 // a's right border to b's left border whose sides differ by 0.3 before stitching.
+// Two charts of a 64² lightmap, x in [8, 24) and [40, 56), rows 8 to 40, their values 0.3 apart
+// and dilated by 4 texels, and the seam between their inner borders.
+struct TwoCharts {
+  static constexpr int side = 64;
+  Image image{side, side, 1, 0.0f};
+  std::vector<std::uint8_t> covered = std::vector<std::uint8_t>(std::size_t(side * side), 0);
+  std::vector<SeamEdge> seams;
+  TwoCharts() {
+    for (int y = 8; y < 40; ++y)
+      for (int x = 8; x < 56; ++x) {
+        if (x >= 24 && x < 40) continue;
+        covered[std::size_t(y * side + x)] = 1;
+        image.at(x, y)[0] = float((x < 24 ? 0.2 : 0.5) + 0.01 * y);
+      }
+    dilate(image, covered, 4);
+    const double top = 1 - 8.0 / side, bottom = 1 - 40.0 / side;
+    seams = {{{Vec2(24.0 / side, top), Vec2(24.0 / side, bottom)},
+              {Vec2(40.0 / side, top), Vec2(40.0 / side, bottom)}}};
+  }
+};
+
 TEST(Seams, StitchingMakesBothSidesLookUpTheSame) {
-  const int side = 64;
-  Image image(side, side, 1, 0.0f);
-  std::vector<std::uint8_t> covered(std::size_t(side * side), 0);
-  for (int y = 8; y < 40; ++y)
-    for (int x = 8; x < 56; ++x) {
-      if (x >= 24 && x < 40) continue;
-      covered[std::size_t(y * side + x)] = 1;
-      image.at(x, y)[0] = float((x < 24 ? 0.2 : 0.5) + 0.01 * y);
-    }
-  dilate(image, covered, 4);
+  TwoCharts charts;
+  const int side = TwoCharts::side;
+  Image& image = charts.image;
+  const std::vector<std::uint8_t>& covered = charts.covered;
   const Image baked = image;
-  const double top = 1 - 8.0 / side, bottom = 1 - 40.0 / side;
-  const std::vector<SeamEdge> seams = {{{Vec2(24.0 / side, top), Vec2(24.0 / side, bottom)},
-                                        {Vec2(40.0 / side, top), Vec2(40.0 / side, bottom)}}};
+  const std::vector<SeamEdge>& seams = charts.seams;
   ASSERT_GT(largest_seam_difference(image, seams), 0.1);
 
   const SeamReport report = stitch_seams(seams, covered, {{&image, {}}}, 1.0);
@@ -127,6 +140,25 @@ TEST(Seams, StitchingMakesBothSidesLookUpTheSame) {
         EXPECT_EQ(v, v0) << x << ", " << y;
       }
     }
+}
+
+// The conjugate gradients (what the bake uses where the factor would fill in) reach the
+// factorisation's answer on the same two charts.
+TEST(Seams, IterativeSolveAgreesWithTheFactorisation) {
+  TwoCharts charts;
+  Image& image = charts.image;
+  const std::vector<std::uint8_t>& covered = charts.covered;
+  const std::vector<SeamEdge>& seams = charts.seams;
+  Image factorised = image, iterative = image;
+  stitch_seams(seams, covered, {{&factorised, {}}}, 1.0, true, SeamSolver::factorised);
+  const SeamReport report =
+      stitch_seams(seams, covered, {{&iterative, {}}}, 1.0, true, SeamSolver::iterative);
+  EXPECT_LT(report.after.largest, 1e-4);
+  float largest = 0;
+  for (std::size_t i = 0; i < image.pixels.size(); ++i)
+    largest = std::max(largest, std::abs(factorised.pixels[i] - iterative.pixels[i]));
+  EXPECT_LT(largest, 1e-5);
+  EXPECT_GT(largest_seam_difference(image, seams), 0.1);  // there was something to stitch
 }
 
 TEST(Seams, MeasuredOnlyWhenNotSolved) {
