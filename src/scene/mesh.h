@@ -5,6 +5,8 @@
 
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 
+#include <array>
+#include <bit>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -68,6 +70,14 @@ Expected<Mesh> build_object_mesh(const ObjectDesc& obj, const RawMeshFile& file,
 // `texture_uv` holds them (mesh_import.cpp).
 void add_triangle(TriMesh& mesh, TriMesh::VertexHandle a, TriMesh::VertexHandle b,
                   TriMesh::VertexHandle c, std::vector<Vec2>& texture_uv);
+
+// A point's coordinates bit for bit, to match points that are the same exactly (the two sides of
+// a mesh edge whose vertices were split for their UVs or normals).
+using PositionBits = std::array<std::uint64_t, 3>;
+inline PositionBits position_bits(const Vec3& p) {
+  return {std::bit_cast<std::uint64_t>(p.x()), std::bit_cast<std::uint64_t>(p.y()),
+          std::bit_cast<std::uint64_t>(p.z())};
+}
 
 // World-space triangle of face f, as three points.
 struct Triangle {

@@ -67,10 +67,7 @@ Status override_objects(const std::filesystem::path& file, const toml::table& ta
     if (receiver) o->receiver = *receiver;
     if (blocker) o->blocker = *blocker;
     if (allow_uncovered) o->allow_uncovered = *allow_uncovered;
-    if (uv) {
-      o->auto_uv = *uv == TableReader::kAutoUvSet;
-      o->uv_channel = o->auto_uv ? 0 : *uv;
-    }
+    if (uv) set_uv(*o, *uv);
     if (scale) o->lightmap_scale = *scale;
     o->line = int(r.line());
   }

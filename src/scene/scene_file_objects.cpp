@@ -6,6 +6,11 @@
 
 namespace sb {
 
+void set_uv(ObjectDesc& obj, int uv_set) {
+  obj.auto_uv = uv_set == TableReader::kAutoUvSet;
+  obj.uv_channel = obj.auto_uv ? 0 : uv_set;
+}
+
 bool is_file_name_char(char c) {
   return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' ||
          c == '.' || c == '-';
@@ -56,10 +61,7 @@ Expected<ObjectDesc> read_object(const std::filesystem::path& file, const toml::
   if (auto v = r.boolean("receiver")) obj.receiver = *v;
   if (auto v = r.boolean("blocker")) obj.blocker = *v;
   if (auto v = r.boolean("allow_uncovered")) obj.allow_uncovered = *v;
-  if (auto v = r.uv_set("uv", kMaxUvChannels - 1)) {
-    obj.auto_uv = *v == TableReader::kAutoUvSet;
-    obj.uv_channel = obj.auto_uv ? 0 : *v;
-  }
+  if (auto v = r.uv_set("uv", kMaxUvChannels - 1)) set_uv(obj, *v);
   obj.transform = read_placement(r);
   if (auto v = r.number("lightmap_scale", "a number > 0", is_positive)) obj.lightmap_scale = *v;
   if (r.failed()) return r.error();

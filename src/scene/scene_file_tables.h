@@ -15,6 +15,9 @@
 
 namespace sb {
 
+// An object's lightmap UVs as TableReader::uv_set read them: a channel, or generated.
+void set_uv(ObjectDesc& obj, int uv_set);
+
 // The [bake] table.
 Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::table& table);
 

@@ -12,7 +12,6 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <map>
@@ -33,9 +32,9 @@ namespace {
 
 double cos_deg(double degrees) { return std::cos(degrees * std::numbers::pi / 180.0); }
 
-// The cone of normals (about the chart's mean) a chart grows within. 60° makes a cylinder's side
-// three charts; wider cones (90° measured) give fewer charts on bumpy meshes but a wider texel
-// density spread, and need the bisection below more often.
+// The cone of normals (about the chart's mean) a chart grows within. 60° makes a 32-segment
+// cylinder's side four charts; wider cones (90° measured) give fewer charts on bumpy meshes but a
+// wider texel density spread, and need the bisection below more often.
 constexpr double kConeDegrees = 60.0;
 // Charts whose normals all lie within this of their mean are projected on its plane: exact for
 // flat ones, and LSCM would only add rounding.
@@ -47,12 +46,6 @@ constexpr double kMaxAreaSpread = 2.0;
 
 // Two border edges closer in space than this fraction of their length are a crack's two lips.
 constexpr double kCrackFraction = 1e-3;
-
-using PositionBits = std::array<std::uint64_t, 3>;
-PositionBits bits_of(const Vec3& p) {
-  return {std::bit_cast<std::uint64_t>(p.x()), std::bit_cast<std::uint64_t>(p.y()),
-          std::bit_cast<std::uint64_t>(p.z())};
-}
 
 struct Face {
   std::array<TriMesh::VertexHandle, 3> vertex;
@@ -87,7 +80,7 @@ Surface surface_of(const TriMesh& mesh) {
   // runs it each way and the vertex normals agree at both ends.
   std::map<std::array<std::uint64_t, 6>, std::vector<std::pair<int, int>>> directed;
   auto key = [](const Vec3& a, const Vec3& b) {
-    const PositionBits x = bits_of(a), y = bits_of(b);
+    const PositionBits x = position_bits(a), y = position_bits(b);
     return std::array<std::uint64_t, 6>{x[0], x[1], x[2], y[0], y[1], y[2]};
   };
   for (std::size_t f = 0; f < s.faces.size(); ++f)
@@ -253,7 +246,7 @@ std::optional<ChartUvs> flatten(const Surface& s, const std::vector<int>& chart,
     const Face& face = s.faces[std::size_t(f)];
     std::array<int, 3> t{};
     for (std::size_t k = 0; k < 3; ++k) {
-      const auto [it, added] = index.try_emplace(bits_of(face.p[k]), int(positions.size()));
+      const auto [it, added] = index.try_emplace(position_bits(face.p[k]), int(positions.size()));
       if (added) positions.push_back(face.p[k]);
       t[k] = it->second;
     }
@@ -279,23 +272,21 @@ std::optional<ChartUvs> flatten(const Surface& s, const std::vector<int>& chart,
     const Vec3 bt(b, sign + mean.y() * mean.y() * a, -mean.y());
     for (const Vec3& p : positions) uv.emplace_back(p.dot(t), p.dot(bt));
   }
-  ChartUvs out;
+  const auto corners = [&](const std::array<int, 3>& t) {
+    return std::array<Vec2, 3>{uv[std::size_t(t[0])], uv[std::size_t(t[1])], uv[std::size_t(t[2])]};
+  };
   double uv_area = 0;
-  for (const auto& t : triangles) {
-    out.push_back({uv[std::size_t(t[0])], uv[std::size_t(t[1])], uv[std::size_t(t[2])]});
-    uv_area += signed_area(out.back());
-  }
+  for (const auto& t : triangles) uv_area += signed_area(corners(t));
   if (uv_area < 0) {  // a mirrored flattening: turn it over
     for (Vec2& p : uv) p.x() = -p.x();
-    for (auto& t : out)
-      for (Vec2& p : t) p.x() = -p.x();
     uv_area = -uv_area;
   }
   if (!(uv_area > 0)) return std::nullopt;
   const double scale = std::sqrt(world_area / uv_area);
   for (Vec2& p : uv) p *= scale;
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    for (Vec2& p : out[i]) p *= scale;
+  ChartUvs out;
+  for (std::size_t i = 0; i < triangles.size(); ++i) {
+    out.push_back(corners(triangles[i]));
     const double area = signed_area(out[i]), surface = s.faces[std::size_t(chart[i])].area;
     if (!(area > 0)) return std::nullopt;  // flipped: the chart folds
     if (area > kMaxAreaSpread * surface || area * kMaxAreaSpread < surface) return std::nullopt;
@@ -385,15 +376,17 @@ std::vector<std::vector<int>> bisect(const Surface& s, const std::vector<int>& c
     area += face.area;
   }
   mean /= area;
-  Mat3 covariance = Mat3::Zero();
-  for (std::size_t i = 0; i < chart.size(); ++i)
-    covariance +=
-        s.faces[std::size_t(chart[i])].area * (centre[i] - mean) * (centre[i] - mean).transpose();
-  const Eigen::SelfAdjointEigenSolver<Mat3> solver(covariance);
-  Vec3 axis = solver.eigenvectors().col(2);  // the largest eigenvalue's
+  Vec3 axis;
   if (fold && (fold->b - fold->a).norm() > 0) {
     axis = (fold->b - fold->a).normalized();
     mean = (fold->a + fold->b) / 2;
+  } else {
+    Mat3 covariance = Mat3::Zero();
+    for (std::size_t i = 0; i < chart.size(); ++i)
+      covariance +=
+          s.faces[std::size_t(chart[i])].area * (centre[i] - mean) * (centre[i] - mean).transpose();
+    const Eigen::SelfAdjointEigenSolver<Mat3> solver(covariance);
+    axis = solver.eigenvectors().col(2);  // the largest eigenvalue's
   }
   std::vector<char> side(s.faces.size(), -1);  // −1: not in the chart
   std::size_t below = 0;

@@ -28,7 +28,6 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -59,13 +58,6 @@ class MeasuredLdlt : public Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> {
 constexpr int kMaxRounds = 8;
 // Vertex normals on the two sides closer than this cosine are one smooth surface.
 const double kSmoothCos = std::cos(kSmoothEdgeDegrees * std::numbers::pi / 180.0);
-
-using PositionBits = std::array<std::uint64_t, 3>;
-
-PositionBits bits_of(const TriMesh::Point& p) {
-  return {std::bit_cast<std::uint64_t>(p[0]), std::bit_cast<std::uint64_t>(p[1]),
-          std::bit_cast<std::uint64_t>(p[2])};
-}
 
 // One side of a boundary edge: its end points' bits in a canonical order, and the halfedge of
 // its triangle that runs along it.
@@ -144,12 +136,16 @@ class SeamStitcher {
 
 std::vector<SeamEdge> find_seams(const Mesh& mesh) {
   const TriMesh& m = mesh.mesh;
+  const auto point = [&](TriMesh::VertexHandle v) {
+    const TriMesh::Point& p = m.point(v);
+    return Vec3(p[0], p[1], p[2]);
+  };
   std::vector<BorderSide> sides;
   for (const auto h : m.halfedges()) {
     if (m.is_boundary(h) || !m.is_boundary(m.opposite_halfedge_handle(h))) continue;
     BorderSide side;
-    side.first = bits_of(m.point(m.from_vertex_handle(h)));
-    side.second = bits_of(m.point(m.to_vertex_handle(h)));
+    side.first = position_bits(point(m.from_vertex_handle(h)));
+    side.second = position_bits(point(m.to_vertex_handle(h)));
     if (side.second < side.first) {
       std::swap(side.first, side.second);
       side.reversed = true;
