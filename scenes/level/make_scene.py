@@ -11,6 +11,9 @@ level.glb (Y up, metres, as Blender's glTF exporter writes it):
   down), an emissive disc of radius 0.2 m, a point light, a spot light and a sun
   (KHR_lights_punctual).
 
+lamp.glb is a second level whose only lights are emissive meshes of other shapes (mesh lights):
+a paper lantern and a wall tube over a table and a chair in a corner (build_lamps).
+
 level.fbx is level.glb exported as FBX with Blender's defaults (Y up, unit scale applied).
 
 level_mm.glb uses an engine's conventions instead: the same room modelled in millimetres under a
@@ -61,21 +64,29 @@ def at_origin(obj):
     obj.location = centre
 
 
+def corner(width, depth, height):
+    """A floor of width x depth metres centred on the origin, a back wall along its far edge and
+    a side wall along its left one, 0.1 m thick and `height` tall, each placed by its origin."""
+    bpy.ops.mesh.primitive_plane_add(size=1.0)
+    floor = bpy.context.active_object
+    floor.name = "floor"
+    floor.scale = (width, depth, 1.0)
+    ba.apply_transform(floor)
+    x, y = width / 2, depth / 2
+    back_wall = ba.box_between("back_wall", (-x, y - 0.1, 0.0), (x, y, height))
+    side_wall = ba.box_between("side_wall", (-x, -y, 0.0), (-x + 0.1, y - 0.1, height))
+    at_origin(back_wall)
+    at_origin(side_wall)
+    return floor, back_wall, side_wall
+
+
 def build(unit=1.0, lights=True):
     """The room, in units of `unit` metres (1: metres, 0.001: millimetres): built in metres, then
     its mesh data and locations scaled by 1 / unit under a root empty scaled by unit. Returns its
     objects."""
     ba.reset()
     surface = material("plaster")
-    bpy.ops.mesh.primitive_plane_add(size=1.0)
-    floor = bpy.context.active_object
-    floor.name = "floor"
-    floor.scale = (5.0, 4.0, 1.0)
-    ba.apply_transform(floor)
-    back_wall = ba.box_between("back_wall", (-2.5, 1.9, 0.0), (2.5, 2.0, 2.6))
-    side_wall = ba.box_between("side_wall", (-2.5, -2.0, 0.0), (-2.4, 1.9, 2.6))
-    at_origin(back_wall)
-    at_origin(side_wall)
+    floor, back_wall, side_wall = corner(5.0, 4.0, 2.6)
 
     table = ba.table("table", 1.2, 0.8)
     table.location = (0.3, 0.2, 0.0)
@@ -187,3 +198,43 @@ bpy.ops.object.select_all(action="SELECT")
 bpy.ops.export_scene.fbx(filepath=os.path.join(here, "level.fbx"), use_selection=False,
                          object_types={"MESH", "LIGHT", "EMPTY"}, use_mesh_modifiers=True,
                          mesh_smooth_type="FACE", bake_anim=False)
+
+
+def build_lamps():
+    """lamp.glb: a reading corner lit only by emissive meshes that are no rectangle or disc, so
+    mesh lights: a paper lantern (a UV sphere of 16 segments and 8 rings, radius 0.25 m) hanging
+    above a table, and a wall tube (a cylinder of 16 sides, 1 m long, radius 0.03 m, capped)
+    along the back wall; their outsides emit."""
+    ba.reset()
+    surface = material("plaster")
+    floor, back_wall, side_wall = corner(3.0, 3.0, 2.4)
+    table = ba.table("table", 1.0, 0.7)
+    table.location = (0.0, 0.3, 0.0)
+    table.rotation_euler = (0.0, 0.0, math.radians(-6.0))
+    chair = ba.chair("chair")
+    chair.location = (0.1, -0.35, 0.0)
+    chair.rotation_euler = (0.0, 0.0, math.radians(175.0))
+    objects = [floor, back_wall, side_wall, table, chair]
+    for obj in objects:
+        obj.data.materials.clear()
+        obj.data.materials.append(surface)
+        ba.lightmap_uvs_smart(obj, gap=0.01)
+
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=16, ring_count=8, radius=0.25,
+                                         location=(0.1, 0.3, 1.6))
+    lantern = bpy.context.active_object
+    lantern.name = "lantern"
+    lantern.data.materials.append(material("lantern_emission", emission=(1.0, 0.85, 0.6),
+                                           strength=3.0))
+    bpy.ops.mesh.primitive_cylinder_add(vertices=16, radius=0.03, depth=1.0,
+                                        end_fill_type="NGON", location=(-0.6, 1.3, 1.9),
+                                        rotation=(0.0, math.pi / 2, 0.0))
+    tube = bpy.context.active_object
+    tube.name = "wall_tube"
+    tube.data.materials.append(material("tube_emission", emission=(0.85, 0.9, 1.0),
+                                        strength=20.0))
+    return objects
+
+
+build_lamps()
+export_level(os.path.join(here, "lamp.glb"))

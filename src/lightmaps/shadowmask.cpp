@@ -7,11 +7,12 @@
 
 namespace sb {
 
-void apply_shadowmask_range(Image& light_visibility, const Light& light, const TexelSpace& space) {
-  const double range = light.desc().shadowmask_range;
+void apply_shadowmask_range(Image& light_visibility, const LightDesc& light,
+                            const TexelSpace& space) {
+  const double range = light.shadowmask_range;
   if (!std::isfinite(range)) return;
   for (const Texel& t : space.texels) {
-    if ((t.position.cast<double>() - light.centre()).norm() <= range) continue;
+    if ((t.position.cast<double>() - light.position).norm() <= range) continue;
     float* px = light_visibility.at(t.x, t.y);
     px[0] = 1.0f;
     px[1] = 0.0f;

@@ -28,7 +28,8 @@ inline constexpr int kShadowmaskChannels = 4;
 
 // Clears the influence of `light` at the covered texels of `space` farther than its
 // shadowmask_range from its centre (there the mask holds 1 for it).
-void apply_shadowmask_range(Image& light_visibility, const Light& light, const TexelSpace& space);
+void apply_shadowmask_range(Image& light_visibility, const LightDesc& light,
+                            const TexelSpace& space);
 
 // Which lights' influences meet: overlaps[a·L + b] for lights a, b of L.
 struct LightOverlaps {

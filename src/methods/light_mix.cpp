@@ -14,11 +14,20 @@ LightMix::LightMix(const TexelSpace& space, const std::vector<Light>& lights, Qu
     set_values_.assign(lights.size(), std::vector<Vec3f>(space.texels.size(), Vec3f::Zero()));
     set_flags_.assign(lights.size(), std::vector<std::uint8_t>(space.texels.size(), 0));
   }
-  if (keep_.values) out_.per_light.assign(lights.size(), Image(space.width, space.height, 3, 0.0f));
+  const std::size_t outputs = output_count(lights);
+  if (keep_.values) out_.per_light.assign(outputs, Image(space.width, space.height, 3, 0.0f));
   if (keep_.visibility) {
     Image unreached(space.width, space.height, 2, 0.0f);
     for (std::size_t i = 0; i < unreached.pixels.size(); i += 2) unreached.pixels[i] = 1.0f;
-    out_.per_light_visibility.assign(lights.size(), unreached);
+    out_.per_light_visibility.assign(outputs, unreached);
+  }
+  // A mesh light's triangles are summed per texel until finish(): Σ H0·V and Σ H0.
+  if (keep_.any()) {
+    std::vector<int> parts(outputs, 0);
+    for (const Light& l : lights) ++parts[std::size_t(l.output())];
+    sums_.resize(outputs);
+    for (std::size_t o = 0; o < outputs; ++o)
+      if (parts[o] > 1) sums_[o].assign(space.texels.size(), Sum{});
   }
 }
 
@@ -29,9 +38,19 @@ Vec3 LightMix::unoccluded(std::size_t light, std::size_t texel) const {
 
 void LightMix::keep(std::size_t light, std::size_t texel, const Vec3& h0, const Vec3& v) {
   if (!keep_.any()) return;
+  const std::size_t output = std::size_t(lights_[light].output());
+  if (!sums_[output].empty()) {
+    sums_[output][texel].h += h0.cwiseProduct(v);
+    sums_[output][texel].h0 += h0;
+    return;
+  }
+  keep_output(output, texel, h0, v);
+}
+
+void LightMix::keep_output(std::size_t output, std::size_t texel, const Vec3& h0, const Vec3& v) {
   const Texel& t = space_.texels[texel];
   if (keep_.values) {
-    float* px = out_.per_light[light].at(t.x, t.y);
+    float* px = out_.per_light[output].at(t.x, t.y);
     for (int c = 0; c < 3; ++c) {
       const double value =
           quantity_ == Quantity::irradiance ? h0[c] * v[c] : (h0[c] > 0 ? v[c] : 0);
@@ -40,7 +59,7 @@ void LightMix::keep(std::size_t light, std::size_t texel, const Vec3& h0, const 
   }
   const double weight = h0.sum();
   if (keep_.visibility && weight > 0) {
-    float* px = out_.per_light_visibility[light].at(t.x, t.y);
+    float* px = out_.per_light_visibility[output].at(t.x, t.y);
     px[0] = float(h0.dot(v) / weight);
     px[1] = 1.0f;
   }
@@ -101,6 +120,16 @@ MixedImages LightMix::finish() {
                           write(t, sum);
                         }
                       });
+  }
+  // A mesh light's images from its triangles' sums: V = Σ H0·V / Σ H0 per channel.
+  for (std::size_t o = 0; o < sums_.size(); ++o) {
+    for (std::size_t t = 0; t < sums_[o].size(); ++t) {
+      const Sum& sum = sums_[o][t];
+      if (!(sum.h0.maxCoeff() > 0)) continue;
+      Vec3 v = Vec3::Zero();
+      for (int c = 0; c < 3; ++c) v[c] = sum.h0[c] > 0 ? sum.h[c] / sum.h0[c] : 0.0;
+      keep_output(o, t, sum.h0, v);
+    }
   }
   return std::move(out_);
 }

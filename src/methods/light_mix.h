@@ -24,7 +24,8 @@ struct KeepPerLight {
   bool any() const { return values || visibility; }
 };
 
-// A method's values for one receiver: the combined image and, when kept, per light
+// A method's values for one receiver: the combined image and, when kept, per light of the scene
+// (a mesh light's triangles together, by the same rule: V = Σ H0·V / Σ H0 over them)
 //  - per_light: light l's V_l, or H0_l·V_l for irradiance, at the texels where it counts, 0
 //    elsewhere; width × height RGB, uncovered texels 0;
 //  - per_light_visibility: two channels, light l's visibility (its H0-weighted mean over colour
@@ -63,6 +64,7 @@ class LightMix {
 
  private:
   void keep(std::size_t light, std::size_t texel, const Vec3& h0, const Vec3& v);
+  void keep_output(std::size_t output, std::size_t texel, const Vec3& h0, const Vec3& v);
 
   const TexelSpace& space_;
   const std::vector<Light>& lights_;
@@ -73,6 +75,9 @@ class LightMix {
   // empty for texel-major ones.
   std::vector<std::vector<Vec3f>> set_values_;
   std::vector<std::vector<std::uint8_t>> set_flags_;
+  // Per scene light (Light::output): its triangles' sums per texel, for a mesh light whose
+  // images are kept; empty for the others.
+  std::vector<std::vector<Sum>> sums_;
 };
 
 }  // namespace sb

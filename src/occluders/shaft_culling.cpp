@@ -160,17 +160,17 @@ struct ShaftCuller::Impl {
     Vec3 centre = c;
     double r = 0;
     switch (light.shape()) {
-      case LightShape::rectangle: {
+      case LightShape::rectangle:
+      case LightShape::triangle: {
         if ((p - c).dot(light.normal()) - reach(light.normal()) <= 0) return false;
-        const double hw = 0.5 * light.desc().width, hh = 0.5 * light.desc().height;
-        const Vec3& right = light.right();
-        const Vec3& up = light.up();
-        base = {c - hw * right - hh * up, c + hw * right - hh * up, c + hw * right + hh * up,
-                c - hw * right + hh * up};
-        corners = 4;
+        std::array<Vec3, 4> outline;
+        corners = light.outline(outline);
+        for (int k = 0; k < corners; ++k) base[std::size_t(k)] = outline[std::size_t(k)];
         base_normal = light.normal();
         break;
       }
+      case LightShape::mesh:
+        return false;  // baked as its triangles
       case LightShape::disk:
       case LightShape::sphere: {
         if (light.shape() == LightShape::disk) {

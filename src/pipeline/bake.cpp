@@ -112,10 +112,17 @@ std::vector<SeamImage> seam_images(const Scene& scene, ReceiverBake& out, const 
   std::vector<const Light*> all;
   for (const Light& l : lights) all.push_back(&l);
   std::vector<SeamImage> images = {{&out.image, arbitrary_texels(visibility, space, all)}};
+  // The lights a scene light is made of: itself, or a mesh light's triangles.
+  const auto parts = [&](std::size_t output) {
+    std::vector<const Light*> of;
+    for (const Light& l : lights)
+      if (std::size_t(l.output()) == output) of.push_back(&l);
+    return of;
+  };
   for (std::size_t l = 0; l < out.per_light.size(); ++l)
-    images.push_back({&out.per_light[l], arbitrary_texels(visibility, space, {&lights[l]})});
+    images.push_back({&out.per_light[l], arbitrary_texels(visibility, space, parts(l))});
   for (std::size_t l = 0; l < out.per_light_visibility.size(); ++l)
-    images.push_back({&out.per_light_visibility[l], arbitrary_texels(true, space, {&lights[l]})});
+    images.push_back({&out.per_light_visibility[l], arbitrary_texels(true, space, parts(l))});
   return images;
 }
 
@@ -277,11 +284,14 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     total_texels += std::int64_t(spaces.back().texels.size());
     layouts.push_back(check_uv_layout(meshes[i], spaces.back(), scene.bake.margin));
     // Which lights reach any of its texels (for the warning about lights that reach nothing).
-    reached[r].assign(lights.size(), 0);
-    for (std::size_t l = 0; l < lights.size(); ++l)
+    reached[r].assign(scene.lights.size(), 0);
+    for (const Light& light : lights) {
+      std::uint8_t& reaches = reached[r][std::size_t(light.output())];
       for (const Texel& t : spaces.back().texels)
-        if ((reached[r][l] = lights[l].reaches(t.position.cast<double>(), t.normal.cast<double>())))
+        if (!reaches &&
+            (reaches = light.reaches(t.position.cast<double>(), t.normal.cast<double>())))
           break;
+    }
     const std::string where = object_location(scene.file, obj) + ": ";
     if (spaces.back().texels.empty()) {
       const UvLayoutReport& uv = layouts.back();
@@ -347,7 +357,7 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     out.per_light = std::move(baked->images.per_light);
     out.per_light_visibility = std::move(baked->images.per_light_visibility);
     for (std::size_t l = 0; l < out.per_light_visibility.size(); ++l)
-      apply_shadowmask_range(out.per_light_visibility[l], lights[l], spaces[r]);
+      apply_shadowmask_range(out.per_light_visibility[l], scene.lights[l], spaces[r]);
     out.report = std::move(baked->report);
     out.rays = baked->rays;
     result.shadow_rays += baked->rays;

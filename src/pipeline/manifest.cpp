@@ -94,9 +94,11 @@ class FieldReader {
   void read(const char* key, LightShape& out) {
     std::string text;
     read(key, text);
-    if (status_ &&
-        !parse_enum(text, {LightShape::rectangle, LightShape::disk, LightShape::sphere}, out))
-      fail(key, "\"rectangle\", \"disk\" or \"sphere\"");
+    if (status_ && !parse_enum(text,
+                               {LightShape::rectangle, LightShape::disk, LightShape::sphere,
+                                LightShape::triangle, LightShape::mesh},
+                               out))
+      fail(key, "\"rectangle\", \"disk\", \"sphere\", \"triangle\" or \"mesh\"");
   }
   template <typename T>
   void read_optional(const char* key, std::optional<T>& out) {

@@ -194,6 +194,26 @@ std::optional<LightDesc> planar_light(const std::vector<Vec3>& corners) {
   return light;
 }
 
+// The light an emissive part that is no rectangle or disc makes: a mesh light of its triangles
+// (those of some area, front side counter-clockwise), at their area-weighted centroid; nullopt
+// when they have no area.
+std::optional<LightDesc> mesh_light(std::vector<Vec3> corners) {
+  LightDesc light;
+  light.shape = LightShape::mesh;
+  Vec3 centroid = Vec3::Zero();
+  double area = 0;
+  for (std::size_t i = 0; i + 2 < corners.size(); i += 3) {
+    const double a = 0.5 * (corners[i + 1] - corners[i]).cross(corners[i + 2] - corners[i]).norm();
+    if (!(a > 0)) continue;
+    light.corners.insert(light.corners.end(), {corners[i], corners[i + 1], corners[i + 2]});
+    centroid += a * (corners[i] + corners[i + 1] + corners[i + 2]) / 3.0;
+    area += a;
+  }
+  if (!(area > 0)) return std::nullopt;
+  light.position = centroid / area;
+  return light;
+}
+
 // Bytes a level's meshes take once built, per triangle placed: an allowance for OpenMesh's
 // half-edges and attributes, the ray tracer's copy and the shafts' bounds (not measured; the
 // bake's own memory check, which counts its lightmaps, is what refuses real levels).
@@ -302,13 +322,21 @@ Expected<LevelContents> import_level(const fs::path& file, const Affine3& placem
       const RawMeshPart& part = raw->parts[p];
       if (part.material >= emission.size() || !(emission[part.material].maxCoeff() > 0)) continue;
       const std::string& node = raw->nodes[n].name;
-      const std::optional<LightDesc> shape =
-          planar_light(world_triangles(part, placement * world[n]));
+      std::vector<Vec3> triangles = world_triangles(part, placement * world[n]);
+      std::optional<LightDesc> shape = planar_light(triangles);
+      if (!shape) shape = mesh_light(std::move(triangles));
       if (!shape) {
         level.warnings.push_back(fmt::format(
-            "{}: node '{}': its emissive material '{}' is on a mesh that is not a planar "
-            "rectangle or disc, which is not a light shape yet; it is left out",
+            "{}: node '{}': its emissive material '{}' is on a mesh of no area; it is left out",
             where, node, raw->materials[part.material].name));
+        continue;
+      }
+      if (shape->corners.size() / 3 > kMaxMeshLightTriangles) {
+        level.warnings.push_back(fmt::format(
+            "{}: node '{}': its emissive material '{}' is on a mesh of {} triangles, more than "
+            "the {} a mesh light may have (each is baked as a light of its own); it is left out",
+            where, node, raw->materials[part.material].name, shape->corners.size() / 3,
+            kMaxMeshLightTriangles));
         continue;
       }
       LightDesc light = *shape;

@@ -12,17 +12,19 @@
 //   set where every part of it has one, else the first;
 // - a mesh part whose material emits (glTF emissiveFactor × KHR_materials_emissive_strength) is
 //   a light, not a surface: a planar rectangle or a planar disc becomes a rectangle or disk light
-//   emitting from its front side, of radiant exitance π × the emission (the emission read as
-//   radiance, W/(m²·sr), as Blender's Emission shader and its glTF exporter take it);
-// - point and spot lights (glTF's KHR_lights_punctual, FBX's lights) become sphere lights of
-//   radius 0.25 m (Blender's default light radius, which its glTF importer gives them too) of
-//   power 4π × intensity / 683 for glTF (candela to watts, as Blender's exporter and importer
-//   convert) and the intensity as watts otherwise (as Blender's FBX exporter writes the light's
-//   power); a spot keeps its cone (LightDesc::spot_axis), which scales its irradiance;
+//   emitting from its front side, any other emissive mesh a mesh light of its triangles (front
+//   sides, at most kMaxMeshLightTriangles of them), of radiant exitance π × the emission (the
+//   emission read as radiance, W/(m²·sr), as Blender's Emission shader and its glTF exporter
+//   take it);
+// - point and spot lights (glTF's KHR_lights_punctual, FBX's lights) become point lights (scene.h,
+//   kPointLightRadius) of power 4π × intensity / 683 for glTF (candela to watts, as Blender's
+//   exporter and importer convert) and the intensity as watts otherwise (as Blender's FBX
+//   exporter writes the light's power); a spot keeps its cone (LightDesc::spot_axis), which
+//   scales its irradiance;
 // - directional lights become suns (sun_light.h) of Blender's 0.526° and the light's irradiance
 //   (lux / 683 for glTF, W/m² otherwise);
-// - emissive meshes of other shapes and area or ambient lights are not read yet: each is a
-//   warning naming it.
+// - area and ambient lights are not read: each is a warning naming it, as is an emissive mesh of
+//   no area or of too many triangles.
 #pragma once
 
 #include <filesystem>
@@ -35,6 +37,10 @@
 #include "scene/scene.h"
 
 namespace sb {
+
+// The most triangles an emissive mesh may have to be a mesh light: every method bakes each as a
+// light of its own, so the bake's time grows with their number (docs/methods.md, mesh lights).
+inline constexpr std::size_t kMaxMeshLightTriangles = 1024;
 
 struct LevelContents {
   std::vector<ObjectDesc> objects;

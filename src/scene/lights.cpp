@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "core/image_io.h"
@@ -146,9 +147,17 @@ double polygon_form_factor(const Vec3* polygon, int count, const Vec3& n) {
   return std::abs(sum) / (2.0 * kPi);
 }
 
-Light::Light(const LightDesc& desc, std::shared_ptr<const Image> texture)
-    : desc_(desc), texture_(std::move(texture)) {
-  if (desc_.shape == LightShape::sphere) {
+Light::Light(const LightDesc& desc, std::shared_ptr<const Image> texture, int output)
+    : desc_(desc), output_(output), texture_(std::move(texture)) {
+  if (desc_.shape == LightShape::triangle && desc_.corners.size() == 3) {
+    // Its plane from its corners, counter-clockwise seen from the emitting side; `up` towards
+    // its first corner.
+    const std::vector<Vec3>& c = desc_.corners;
+    desc_.position = (c[0] + c[1] + c[2]) / 3.0;
+    desc_.normal = (c[1] - c[0]).cross(c[2] - c[0]).normalized();
+    desc_.up = (c[0] - desc_.position).normalized();
+  }
+  if (desc_.shape == LightShape::sphere || desc_.shape == LightShape::mesh) {
     up_ = Vec3::UnitZ();
     right_ = Vec3::UnitX();
   } else {
@@ -162,6 +171,20 @@ Light::Light(const LightDesc& desc, std::shared_ptr<const Image> texture)
   for (const unsigned char c : desc_.name) stream_ = (stream_ ^ c) * 0x100000001b3ull;
   exitance_ = desc_.color * (desc_.power / area());
   if (texture_) exitance_ = exitance_.cwiseProduct(texture_mean(*texture_));
+}
+
+int Light::outline(std::array<Vec3, 4>& corners) const {
+  if (desc_.shape == LightShape::rectangle) {
+    const Vec3 hw = 0.5 * desc_.width * right_, hh = 0.5 * desc_.height * up_;
+    const Vec3& c = desc_.position;
+    corners = {c - hw - hh, c + hw - hh, c + hw + hh, c - hw + hh};
+    return 4;
+  }
+  if (desc_.shape == LightShape::triangle && desc_.corners.size() == 3) {
+    corners = {desc_.corners[0], desc_.corners[1], desc_.corners[2], desc_.corners[2]};
+    return 3;
+  }
+  return 0;
 }
 
 Vec3 Light::tint(const Vec2& local) const {
@@ -183,6 +206,19 @@ double Light::extent_across(const Vec3& axis) const {
     case LightShape::disk:
     case LightShape::sphere:
       return 2 * desc_.radius;  // an ellipse's major axis, or the sphere's outline
+    case LightShape::triangle: {
+      // Its longest side seen across the axis.
+      std::array<Vec3, 4> c;
+      outline(c);
+      double longest = 0;
+      for (int k = 0; k < 3; ++k) {
+        const Vec3 side = c[std::size_t(k)] - c[std::size_t((k + 1) % 3)];
+        longest = std::max(longest, (side - side.dot(axis) * axis).norm());
+      }
+      return longest;
+    }
+    case LightShape::mesh:
+      break;
   }
   return 0;
 }
@@ -196,6 +232,15 @@ Vec2 Light::half_extents(const Vec3& e1, const Vec3& e2) const {
         return desc_.radius * std::sqrt(std::max(0.0, 1.0 - std::pow(desc_.normal.dot(e), 2)));
       case LightShape::sphere:
         return desc_.radius;
+      case LightShape::triangle: {
+        // About the centroid: the farthest corner along e (an outline's bounding box about
+        // the centre, as the other shapes' are).
+        double half = 0;
+        for (const Vec3& c : desc_.corners) half = std::max(half, std::abs((c - centre()).dot(e)));
+        return half;
+      }
+      case LightShape::mesh:
+        break;
     }
     return 0.0;
   };
@@ -211,10 +256,21 @@ Vec3 Light::source_image(const Vec3& offset, const Vec3& axis) const {
   if (std::abs(facing) < 1e-9) return Vec3::Zero();  // seen edge-on: no area
   const Vec3 on_light = offset - axis * (offset.dot(desc_.normal) / facing);
   const Vec2 local(on_light.dot(right_), on_light.dot(up_));
-  const bool inside =
-      desc_.shape == LightShape::rectangle
-          ? std::abs(local.x()) <= 0.5 * desc_.width && std::abs(local.y()) <= 0.5 * desc_.height
-          : local.squaredNorm() <= desc_.radius * desc_.radius;
+  bool inside = false;
+  if (desc_.shape == LightShape::rectangle) {
+    inside = std::abs(local.x()) <= 0.5 * desc_.width && std::abs(local.y()) <= 0.5 * desc_.height;
+  } else if (desc_.shape == LightShape::disk) {
+    inside = local.squaredNorm() <= desc_.radius * desc_.radius;
+  } else if (desc_.shape == LightShape::triangle) {
+    // On the inner side of each edge (counter-clockwise about the normal).
+    const Vec3 x = centre() + on_light;
+    inside = true;
+    for (int k = 0; k < 3 && inside; ++k) {
+      const Vec3& a = desc_.corners[std::size_t(k)];
+      const Vec3& b = desc_.corners[std::size_t((k + 1) % 3)];
+      inside = (b - a).cross(x - a).dot(desc_.normal) >= 0;
+    }
+  }
   return inside ? tint(local) : Vec3::Zero();
 }
 
@@ -226,6 +282,15 @@ double Light::area() const {
       return kPi * desc_.radius * desc_.radius;
     case LightShape::sphere:
       return 4.0 * kPi * desc_.radius * desc_.radius;
+    case LightShape::triangle:
+    case LightShape::mesh: {
+      double sum = 0;
+      for (std::size_t k = 0; k + 2 < desc_.corners.size(); k += 3) {
+        const std::vector<Vec3>& c = desc_.corners;
+        sum += 0.5 * (c[k + 1] - c[k]).cross(c[k + 2] - c[k]).norm();
+      }
+      return sum;
+    }
   }
   return 0;
 }
@@ -233,11 +298,13 @@ double Light::area() const {
 double Light::form_factor(const Vec3& y, const Vec3& n) const {
   const Vec3 c = desc_.position - y;
   switch (desc_.shape) {
-    case LightShape::rectangle: {
+    case LightShape::rectangle:
+    case LightShape::triangle: {
       if (c.dot(desc_.normal) >= 0) return 0.0;  // the point is behind the emitting side
-      const Vec3 hw = 0.5 * desc_.width * right_, hh = 0.5 * desc_.height * up_;
-      const std::array<Vec3, 4> corners = {c - hw - hh, c + hw - hh, c + hw + hh, c - hw + hh};
-      return polygon_form_factor(corners.data(), 4, n);
+      std::array<Vec3, 4> corners;
+      const int count = outline(corners);
+      for (int k = 0; k < count; ++k) corners[std::size_t(k)] -= y;
+      return polygon_form_factor(corners.data(), count, n);
     }
     case LightShape::disk:
       return disk_form_factor(c, desc_.normal, right_, up_, desc_.radius, n);
@@ -251,6 +318,8 @@ double Light::form_factor(const Vec3& y, const Vec3& n) const {
       const Vec3 a = orthogonal(axis);
       return disk_form_factor(sil_centre, axis, a, axis.cross(a), sil_radius, n);
     }
+    case LightShape::mesh:
+      break;  // baked as its triangles
   }
   return 0.0;
 }
@@ -278,6 +347,12 @@ bool Light::reaches(const Vec3& y, const Vec3& n) const {
       const double hh = 0.5 * desc_.height * std::abs(n.dot(up_));
       return n.dot(c) + hw + hh > 0;
     }
+    case LightShape::triangle: {
+      if (c.dot(desc_.normal) >= 0) return false;
+      double highest = -std::numeric_limits<double>::infinity();
+      for (const Vec3& corner : desc_.corners) highest = std::max(highest, n.dot(corner - y));
+      return highest > 0;
+    }
     case LightShape::disk:
       return c.dot(desc_.normal) < 0 &&
              n.dot(c) + desc_.radius * (n - n.dot(desc_.normal) * desc_.normal).norm() > 0;
@@ -290,6 +365,8 @@ bool Light::reaches(const Vec3& y, const Vec3& n) const {
       const double sil_radius = r * std::sqrt(d * d - r * r) / d;
       return n.dot(sil_centre) + sil_radius * (n - n.dot(axis) * axis).norm() > 0;
     }
+    case LightShape::mesh:
+      break;
   }
   return false;
 }
@@ -302,10 +379,17 @@ LightSample Light::sample(const Vec3& y, const Vec3& n, const Vec2& u) const {
   LightSample s;
   switch (desc_.shape) {
     case LightShape::rectangle:
-    case LightShape::disk: {
+    case LightShape::disk:
+    case LightShape::triangle: {
       Vec2 local;  // metres in the light's (right, up) frame
       if (desc_.shape == LightShape::rectangle) {
         local = Vec2((u.x() - 0.5) * desc_.width, (u.y() - 0.5) * desc_.height);
+      } else if (desc_.shape == LightShape::triangle) {
+        // Uniform by area: the square's strata folded onto the triangle by √u.
+        const std::vector<Vec3>& c = desc_.corners;
+        const double su = std::sqrt(u.x());
+        const Vec3 x = (1 - su) * c[0] + su * ((1 - u.y()) * c[1] + u.y() * c[2]) - centre();
+        local = Vec2(x.dot(right_), x.dot(up_));
       } else {
         // Shirley–Chiu concentric map: keeps the strata's shapes compact on the disk.
         const double a = 2 * u.x() - 1, b = 2 * u.y() - 1;
@@ -349,6 +433,8 @@ LightSample Light::sample(const Vec3& y, const Vec3& n, const Vec2& u) const {
       if (cos_receiver > 0) s.weight = cos_receiver;
       return s;
     }
+    case LightShape::mesh:
+      break;
   }
   return s;
 }
@@ -364,6 +450,13 @@ bool Light::partly_below_horizon(const Vec3& y, const Vec3& n) const {
       return n.dot(c) - desc_.radius * (n - n.dot(desc_.normal) * desc_.normal).norm() < 0;
     case LightShape::sphere:
       return n.dot(c) - desc_.radius < 0;
+    case LightShape::triangle: {
+      double lowest = std::numeric_limits<double>::infinity();
+      for (const Vec3& corner : desc_.corners) lowest = std::min(lowest, n.dot(corner - y));
+      return lowest < 0;
+    }
+    case LightShape::mesh:
+      break;
   }
   return true;
 }
@@ -387,10 +480,12 @@ HorizonPart Light::above_horizon(const Vec3& y, const Vec3& n) const {
   };
   const Vec3 c = desc_.position - y;
   switch (desc_.shape) {
-    case LightShape::rectangle: {
+    case LightShape::rectangle:
+    case LightShape::triangle: {
       if (c.dot(desc_.normal) >= 0) break;
-      const Vec3 hw = 0.5 * desc_.width * right_, hh = 0.5 * desc_.height * up_;
-      outline = {c - hw - hh, c + hw - hh, c + hw + hh, c - hw + hh};
+      std::array<Vec3, 4> corners;
+      const int count = this->outline(corners);
+      for (int k = 0; k < count; ++k) outline.push_back(corners[std::size_t(k)] - y);
       break;
     }
     case LightShape::disk:
@@ -406,6 +501,8 @@ HorizonPart Light::above_horizon(const Vec3& y, const Vec3& n) const {
       polygon(c * (1.0 - r * r / (d * d)), a, axis.cross(a), r * std::sqrt(d * d - r * r) / d);
       break;
     }
+    case LightShape::mesh:
+      break;
   }
   const std::vector<Vec3> clipped = clip_to_horizon(outline, n);
   double total = 0;
@@ -477,9 +574,37 @@ Expected<std::vector<Light>> make_lights(const std::vector<LightDesc>& descs,
       }
       texture = std::make_shared<const Image>(std::move(*image));
     }
-    lights.emplace_back(d, std::move(texture));
+    const int output = int(&d - descs.data());
+    if (d.shape == LightShape::mesh) {
+      for (const LightDesc& triangle : mesh_light_triangles(d))
+        lights.emplace_back(triangle, nullptr, output);
+    } else {
+      lights.emplace_back(d, std::move(texture), output);
+    }
   }
   return lights;
+}
+
+std::size_t output_count(const std::vector<Light>& lights) {
+  return lights.empty() ? 0 : std::size_t(lights.back().output()) + 1;
+}
+
+std::vector<LightDesc> mesh_light_triangles(const LightDesc& mesh) {
+  std::vector<LightDesc> out;
+  const double total = Light(mesh).area();
+  if (!(total > 0)) return out;
+  for (std::size_t k = 0; k + 2 < mesh.corners.size(); k += 3) {
+    LightDesc t = mesh;
+    t.shape = LightShape::triangle;
+    t.name = mesh.name + "#" + std::to_string(k / 3);
+    t.corners.assign(mesh.corners.begin() + std::ptrdiff_t(k),
+                     mesh.corners.begin() + std::ptrdiff_t(k + 3));
+    const double area = Light(t).area();
+    if (!(area > 0)) continue;  // a degenerate triangle emits nothing
+    t.power = mesh.power * area / total;
+    out.push_back(std::move(t));
+  }
+  return out;
 }
 
 }  // namespace sb

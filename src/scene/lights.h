@@ -2,6 +2,7 @@
 // (docs/design.md §1) and stratified sampling for the ray-traced reference.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -53,7 +54,10 @@ class Light {
  public:
   // `texture`, if given, is the emission image mapped over a rectangle or disk (linear RGB or
   // grey; row 0 is the top, along `up`).
-  explicit Light(const LightDesc& desc, std::shared_ptr<const Image> texture = nullptr);
+  // `output`: the index, among the scene's lights, of the light this one is or is a part of (a
+  // mesh light's triangles, make_lights): whose per-light images it adds to (LightMix).
+  explicit Light(const LightDesc& desc, std::shared_ptr<const Image> texture = nullptr,
+                 int output = 0);
 
   const LightDesc& desc() const { return desc_; }
   // The light's own random streams' key, from its name alone: a light is sampled the same way
@@ -61,7 +65,11 @@ class Light {
   // a bake of the scene with that light alone (docs/cli.md, per-light outputs).
   std::uint64_t stream() const { return stream_; }
   LightShape shape() const { return desc_.shape; }
+  int output() const { return output_; }
   Vec3 centre() const { return desc_.position; }
+  // A rectangle's four corners or a triangle's three (world metres, in order around it); 0 for
+  // the round shapes.
+  int outline(std::array<Vec3, 4>& corners) const;
   // A point light: a sphere of kPointLightRadius (scene.h), whose shadows are hard.
   bool is_point() const {
     return desc_.shape == LightShape::sphere && desc_.radius <= kPointLightRadius;
@@ -86,7 +94,8 @@ class Light {
   // (per channel, tint times 1) where the line through the point along `axis` meets the light,
   // 0 where it misses. A sphere is a uniform disk of its radius.
   Vec3 source_image(const Vec3& offset, const Vec3& axis) const;
-  // Unit axes of a rectangle or disk: right = up × normal; the normal is the emitting side.
+  // Unit axes of a rectangle, disk or triangle: right = up × normal; the normal is the emitting
+  // side.
   const Vec3& right() const { return right_; }
   const Vec3& up() const { return up_; }
   const Vec3& normal() const { return desc_.normal; }
@@ -124,15 +133,22 @@ class Light {
  private:
   LightDesc desc_;
   Vec3 right_, up_;
+  int output_ = 0;
   std::uint64_t stream_ = 0;
   Vec3 exitance_;
   std::shared_ptr<const Image> texture_;
 };
 
-// The scene's lights, with their textures read (through OpenImageIO, sRGB decoded to linear).
-// An unreadable texture is an error naming scene_file, the light and the image.
+// The scene's lights, with their textures read (through OpenImageIO, sRGB decoded to linear),
+// in scene order; a mesh light is its triangles, one triangle light each (named "<name>#<k>",
+// its share of the power by area), all with the mesh light's output index. An unreadable
+// texture is an error naming scene_file, the light and the image.
 Expected<std::vector<Light>> make_lights(const std::vector<LightDesc>& descs,
                                          const std::filesystem::path& scene_file);
+// How many of the scene's lights `lights` (from make_lights) stand for: the per-light images.
+std::size_t output_count(const std::vector<Light>& lights);
+// The triangle lights of a mesh light, from its description (LightDesc::corners).
+std::vector<LightDesc> mesh_light_triangles(const LightDesc& mesh);
 
 // Lambert's formula for the form factor of a planar polygon (vertices relative to the point,
 // either winding) seen from a point with unit normal n, after clipping the polygon to the

@@ -46,6 +46,10 @@ const char* to_string(LightShape s) {
       return "disk";
     case LightShape::sphere:
       return "sphere";
+    case LightShape::triangle:
+      return "triangle";
+    case LightShape::mesh:
+      return "mesh";
   }
   return "?";
 }

@@ -99,10 +99,10 @@ Status override_lights(const std::filesystem::path& file, const toml::table& tab
              fmt::format("'angle_deg' applies to suns, and '{}' is not one", light->name));
     if (radius && *radius == 0 && light->shape == LightShape::disk)
       r.fail("radius", fmt::format("'{}' is a disk: its radius must be > 0", light->name));
-    if (radius && light->shape == LightShape::rectangle)
+    if (radius && light->shape != LightShape::sphere && light->shape != LightShape::disk)
       r.fail("radius", fmt::format("'radius' applies to sphere and disk lights, and '{}' is a "
-                                   "rectangle",
-                                   light->name));
+                                   "{}",
+                                   light->name, to_string(light->shape)));
   }
   if (r.failed()) return r.error();
   for (LightDesc* light : targets) {

@@ -119,6 +119,52 @@ TEST(LevelFile, BlendersExportBecomesObjectsAndLights) {
               sun_light.unoccluded_irradiance(floor_centre, Vec3(0, 1, 0)).x(), 1e-3);
 }
 
+// scenes/level/lamp.glb: its emissive UV sphere and capped cylinder are neither rectangle nor
+// disc, so mesh lights of their triangles (front sides outwards), at their centroids, of power
+// π × emission × area; the bake takes each as its triangles (make_lights).
+TEST(LevelFile, EmissiveMeshesOfOtherShapesAreMeshLights) {
+  const fs::path file = fs::path(SB_SOURCE_DIR) / "scenes" / "level" / "lamp.glb";
+  auto scene = load_scene(file);
+  ASSERT_TRUE(scene) << scene.error().message;
+  ASSERT_EQ(scene->lights.size(), 2u);
+  const LightDesc* lantern = light_named(*scene, "lantern");
+  const LightDesc* tube = light_named(*scene, "wall_tube");
+  ASSERT_NE(lantern, nullptr);
+  ASSERT_NE(tube, nullptr);
+  EXPECT_EQ(lantern->shape, LightShape::mesh);
+  EXPECT_EQ(tube->shape, LightShape::mesh);
+  // 16 segments × 8 rings: 2 × 16 triangles at the poles, 6 × 16 quads between.
+  EXPECT_EQ(lantern->corners.size(), 3u * (32 + 192));
+  // 16 sides (32 triangles) and two 16-gon caps (14 each).
+  EXPECT_EQ(tube->corners.size(), 3u * (32 + 28));
+  // Blender's (0.1, 0.3, 1.6) is glTF's (0.1, 1.6, -0.3).
+  EXPECT_LT((lantern->position - Vec3(0.1, 1.6, -0.3)).norm(), 1e-4);
+  const Light whole(*lantern);
+  EXPECT_NEAR(lantern->power, std::numbers::pi * 3 * whole.area(), 1e-6 * lantern->power);
+  // Its area: a little less than the sphere's 4π r², and every triangle faces away from it.
+  EXPECT_GT(whole.area(), 0.9 * 4 * std::numbers::pi * 0.25 * 0.25);
+  EXPECT_LT(whole.area(), 4 * std::numbers::pi * 0.25 * 0.25);
+  auto lights = make_lights(scene->lights, file);
+  ASSERT_TRUE(lights) << lights.error().message;
+  EXPECT_EQ(lights->size(), 224u + 60u);
+  EXPECT_EQ(output_count(*lights), 2u);
+  for (const Light& l : *lights) {
+    const Vec3 out = l.centre() - (l.output() == 0 ? lantern->position : tube->position);
+    EXPECT_GT(l.normal().dot(out), 0) << l.desc().name;
+  }
+  // Seen from below the lantern, it is near a sphere light of its radius and power.
+  LightDesc sphere = *lantern;
+  sphere.shape = LightShape::sphere;
+  sphere.radius = 0.25;
+  sphere.corners.clear();
+  const Vec3 y = lantern->position - Vec3(0, 1.2, 0), n(0, 1, 0);
+  double h0 = 0;
+  for (const Light& l : *lights)
+    if (l.output() == 0) h0 += l.unoccluded_irradiance(y, n).x();
+  const double sphere_h0 = Light(sphere).unoccluded_irradiance(y, n).x();
+  EXPECT_NEAR(h0, sphere_h0, 0.03 * sphere_h0);
+}
+
 // The level baked as one file equals the same objects baked one file per object
 // (scenes/level/objects, each exported alone by Blender with its world transform): bit for bit
 // where the node has no parent, and within float rounding of the composed transforms where it

@@ -50,6 +50,18 @@ LightDesc sphere(double r) {
   return d;
 }
 
+// A tilted triangle, counter-clockwise seen from below (it emits downwards and sideways).
+LightDesc triangle() {
+  LightDesc d;
+  d.name = "triangle";
+  d.shape = LightShape::triangle;
+  d.corners = {Vec3(-0.3, -0.2, 1.3), Vec3(0.1, 0.35, 1.5), Vec3(0.4, -0.1, 1.2)};
+  if ((d.corners[1] - d.corners[0]).cross(d.corners[2] - d.corners[0]).z() > 0)
+    std::swap(d.corners[1], d.corners[2]);
+  d.power = 60;
+  return d;
+}
+
 // F = (1/π) ∫ cosθ_x⁺ cosθ_y⁺ / r² dA by the midpoint rule over the light's surface.
 double numeric_form_factor(const Light& light, const Vec3& y, const Vec3& n) {
   const LightDesc& d = light.desc();
@@ -67,6 +79,16 @@ double numeric_form_factor(const Light& light, const Vec3& y, const Vec3& n) {
         const Vec3 x = d.position + ((i + 0.5) / k - 0.5) * d.width * light.right() +
                        ((j + 0.5) / k - 0.5) * d.height * light.up();
         add(x, d.normal, d.width * d.height / (double(k) * k));
+      }
+  } else if (d.shape == LightShape::triangle) {
+    // The midpoint rule over k² similar sub-triangles (k(k+1)/2 upright, k(k−1)/2 upside down).
+    const int k = 1500;
+    const Vec3 a = d.corners[0], e1 = (d.corners[1] - a) / k, e2 = (d.corners[2] - a) / k;
+    const double cell = light.area() / (double(k) * k);
+    for (int i = 0; i < k; ++i)
+      for (int j = 0; i + j < k; ++j) {
+        add(a + (i + 1.0 / 3) * e1 + (j + 1.0 / 3) * e2, light.normal(), cell);
+        if (i + j + 1 < k) add(a + (i + 2.0 / 3) * e1 + (j + 2.0 / 3) * e2, light.normal(), cell);
       }
   } else if (d.shape == LightShape::disk) {
     const int kr = 1200, kp = 2400;
@@ -127,9 +149,68 @@ TEST(Lambert, SphereMatchesNumericalIntegration) {
   expect_matches_numerical_integration(sphere(0.2));
 }
 
+TEST(Lambert, TriangleMatchesNumericalIntegration) {
+  expect_matches_numerical_integration(triangle());
+}
+
+// A rectangle cut along a diagonal into two triangles of half its power each: their form
+// factors sum to the rectangle's (the rectangle's own code path) wherever the point is, the
+// horizon cutting them or not, and so do their irradiances.
+TEST(Lambert, TwoTrianglesMakeTheirRectangle) {
+  const LightDesc rect = rectangle(0.5, 0.3);
+  const Light r(rect);
+  std::array<Vec3, 4> c;
+  ASSERT_EQ(r.outline(c), 4);
+  LightDesc mesh = rect;
+  mesh.shape = LightShape::mesh;
+  // The outline runs counter-clockwise about the rectangle's normal.
+  mesh.corners = {c[0], c[1], c[2], c[0], c[2], c[3]};
+  const std::vector<LightDesc> halves = mesh_light_triangles(mesh);
+  ASSERT_EQ(halves.size(), 2u);
+  Rng rng(3);
+  for (int i = 0; i < 2000; ++i) {
+    const Vec3 y(4 * rng.next_double() - 2, 4 * rng.next_double() - 2, 3 * rng.next_double() - 1);
+    const Vec3 n = Vec3(rng.next_double() - 0.5, rng.next_double() - 0.5, rng.next_double() - 0.5)
+                       .normalized();
+    const Light a(halves[0]), b(halves[1]);
+    EXPECT_NEAR(a.form_factor(y, n) + b.form_factor(y, n), r.form_factor(y, n), 1e-12);
+    EXPECT_NEAR((a.unoccluded_irradiance(y, n) + b.unoccluded_irradiance(y, n)).x(),
+                r.unoccluded_irradiance(y, n).x(), 1e-9 * (1 + r.unoccluded_irradiance(y, n).x()));
+    EXPECT_EQ(a.reaches(y, n) || b.reaches(y, n), r.reaches(y, n)) << y.transpose();
+  }
+}
+
+// make_lights: a mesh light is its triangles, each named after it and its index, each with its
+// share of the power by area, all reporting the mesh light's output index.
+TEST(MeshLight, MakeLightsSplitsItIntoTrianglesOfOneOutput) {
+  LightDesc bulb = sphere(0.2);
+  LightDesc mesh;
+  mesh.name = "shade";
+  mesh.shape = LightShape::mesh;
+  mesh.power = 30;
+  const LightDesc t = triangle();
+  // The triangle and a copy twice its size, and a degenerate one that emits nothing.
+  mesh.corners = t.corners;
+  for (const Vec3& p : t.corners) mesh.corners.push_back(2 * p);
+  mesh.corners.insert(mesh.corners.end(), {Vec3::Zero(), Vec3::UnitX(), 2 * Vec3::UnitX()});
+  auto lights = make_lights({bulb, mesh}, "scene.toml");
+  ASSERT_TRUE(lights) << lights.error().message;
+  ASSERT_EQ(lights->size(), 3u);
+  EXPECT_EQ(output_count(*lights), 2u);
+  EXPECT_EQ((*lights)[0].output(), 0);
+  EXPECT_EQ((*lights)[1].output(), 1);
+  EXPECT_EQ((*lights)[2].output(), 1);
+  EXPECT_EQ((*lights)[1].desc().name, "shade#0");
+  EXPECT_EQ((*lights)[2].desc().name, "shade#1");
+  EXPECT_NEAR((*lights)[1].desc().power, 6.0, 1e-9);  // area 1 : 4
+  EXPECT_NEAR((*lights)[2].desc().power, 24.0, 1e-9);
+  // The same exitance on both: power over area.
+  EXPECT_NEAR((*lights)[1].exitance().x(), (*lights)[2].exitance().x(), 1e-9);
+}
+
 TEST(Lambert, ReachesIsFormFactorPositive) {
   Rng rng(5);
-  for (const LightDesc& d : {rectangle(0.5, 0.3), tilted_disk(0.25), sphere(0.2)}) {
+  for (const LightDesc& d : {rectangle(0.5, 0.3), tilted_disk(0.25), sphere(0.2), triangle()}) {
     const Light light(d);
     for (int i = 0; i < 20000; ++i) {
       const Vec3 y(4 * rng.next_double() - 2, 4 * rng.next_double() - 2, 3 * rng.next_double() - 1);
@@ -185,7 +266,7 @@ TEST(Lambert, IrradianceIsExitanceTimesFormFactor) {
 // The sampling weights, averaged with the right measure, reproduce the closed form: this ties
 // the reference's estimator to H0.
 TEST(LightSampling, WeightsIntegrateToFormFactor) {
-  for (const LightDesc& d : {rectangle(0.5, 0.3), tilted_disk(0.25), sphere(0.2)}) {
+  for (const LightDesc& d : {rectangle(0.5, 0.3), tilted_disk(0.25), sphere(0.2), triangle()}) {
     const Light light(d);
     for (const auto& p : probe_points()) {
       Rng rng(7);

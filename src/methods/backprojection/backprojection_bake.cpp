@@ -356,6 +356,17 @@ class LightPairs final : public PairSource {
         return 2 * d.radius * std::abs(light_.normal().dot(to)) / (distance * distance);
       case LightShape::sphere:
         return 2 * d.radius / distance;
+      case LightShape::triangle: {
+        // Its narrowest width: twice its area over its longest side.
+        double longest = 0;
+        for (int k = 0; k < 3; ++k)
+          longest = std::max(
+              longest, (d.corners[std::size_t(k)] - d.corners[std::size_t((k + 1) % 3)]).norm());
+        return 2 * light_.area() / std::max(longest, 1e-300) * std::abs(light_.normal().dot(to)) /
+               (distance * distance);
+      }
+      case LightShape::mesh:
+        break;
     }
     return 0;
   }

@@ -140,16 +140,19 @@ PenumbraEstimator::PenumbraEstimator(const Light& light, int rows, double light_
     rows_.enter[std::size_t(r)] = middle - half;
     rows_.leave[std::size_t(r)] = middle + half;
   };
-  if (light.shape() == LightShape::rectangle) {
-    const double hw = 0.5 * light.desc().width, hh = 0.5 * light.desc().height;
-    const double xs[4] = {-hw, hw, hw, -hw}, ys[4] = {-hh, -hh, hh, hh};
-    double t_max = 0;
-    for (int k = 0; k < 4; ++k) {
-      corners_[std::size_t(k)] = Vec2(c * xs[k] + s * ys[k], -s * xs[k] + c * ys[k]);
-      t_max = std::max(t_max, std::abs(corners_[std::size_t(k)].y()));
+  // A rectangle's four corners or a triangle's three (its last one twice: an edge of no length,
+  // which no row crosses), relative to the centre.
+  std::array<Vec3, 4> outline;
+  if (light.outline(outline) > 0) {
+    double t_min = kInfinity, t_max = -kInfinity;
+    for (std::size_t k = 0; k < 4; ++k) {
+      const Vec3 offset = outline[k] - light.centre();
+      corners_[k] = Vec2(offset.dot(row_axis_s_), offset.dot(row_axis_t_));
+      t_min = std::min(t_min, corners_[k].y());
+      t_max = std::max(t_max, corners_[k].y());
     }
-    rows_.pitch = 2 * t_max / n;
-    rows_.first = -t_max + 0.5 * rows_.pitch;
+    rows_.pitch = (t_max - t_min) / n;
+    rows_.first = t_min + 0.5 * rows_.pitch;
     for (int r = 0; r < n; ++r) {
       const double t = rows_.first + r * rows_.pitch;
       const auto [lo, hi] = polygon_chord(corners_, t);
@@ -160,7 +163,7 @@ PenumbraEstimator::PenumbraEstimator(const Light& light, int rows, double light_
       std::sort(cuts.begin(), cuts.end());
       double area = 0;
       for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
-        const double a = std::max(cuts[k], -t_max), b = std::min(cuts[k + 1], t_max);
+        const double a = std::max(cuts[k], t_min), b = std::min(cuts[k + 1], t_max);
         if (!(b > a)) continue;
         const auto [a0, a1] = polygon_chord(corners_, a);
         const auto [b0, b1] = polygon_chord(corners_, b);
@@ -225,9 +228,10 @@ const LightRows& PenumbraEstimator::rows_for(const LightFrame& f, const Vec3& po
   // The horizon in the light's plane: visible where α·s + β·t + γ > 0.
   const double alpha = normal.dot(f.s_axis), beta = normal.dot(f.t_axis);
   const double gamma = normal.dot(f.centre - position);
-  const bool rectangle = light_->shape() == LightShape::rectangle;
+  const bool polygon =
+      light_->shape() == LightShape::rectangle || light_->shape() == LightShape::triangle;
   bool cut = false;
-  if (rectangle) {
+  if (polygon) {
     for (const Vec2& p : corners_) cut = cut || alpha * p.x() + beta * p.y() + gamma < 0;
   } else {
     cut = gamma - f.radius * std::hypot(alpha, beta) < 0;
@@ -252,7 +256,7 @@ const LightRows& PenumbraEstimator::rows_for(const LightFrame& f, const Vec3& po
     t_hi = std::max(t_hi, p.y());
   };
   const auto above = [&](const Vec2& p) { return alpha * p.x() + beta * p.y() + gamma >= 0; };
-  if (rectangle) {
+  if (polygon) {
     for (std::size_t k = 0; k < 4; ++k) {
       const Vec2& a = corners_[k];
       const Vec2& b = corners_[(k + 1) % 4];
@@ -285,7 +289,7 @@ const LightRows& PenumbraEstimator::rows_for(const LightFrame& f, const Vec3& po
   for (int r = 0; r < row_count_; ++r) {
     const double t = scratch.first + r * scratch.pitch;
     double lo, hi;
-    if (rectangle) {
+    if (polygon) {
       std::tie(lo, hi) = polygon_chord(corners_, t);
     } else {
       hi = chord_half(t, f.radius);

@@ -21,11 +21,9 @@ namespace {
 std::vector<Vec3> light_outline(const Light& light) {
   std::vector<Vec3> pts;
   const Vec3 c = light.centre();
-  if (light.shape() == LightShape::rectangle) {
-    const Vec3 a = 0.5 * light.desc().width * light.right(),
-               b = 0.5 * light.desc().height * light.up();
-    for (const Vec3& p : {Vec3(c + a + b), Vec3(c + a - b), Vec3(c - a + b), Vec3(c - a - b)})
-      pts.push_back(p);
+  std::array<Vec3, 4> corners;
+  if (const int count = light.outline(corners); count > 0) {
+    pts.assign(corners.begin(), corners.begin() + count);
   } else if (light.shape() == LightShape::disk) {
     const int n = 16;  // circumscribed 16-gon
     const double r = light.desc().radius / std::cos(std::numbers::pi / n);

@@ -32,10 +32,9 @@ namespace {
 // Offsets of the light's outline (or, for a sphere, of its silhouette seen along `along`).
 std::vector<Vec3> outline(const Light& light, const Vec3& along) {
   std::vector<Vec3> pts;
-  if (light.shape() == LightShape::rectangle) {
-    const Vec3 a = 0.5 * light.desc().width * light.right(),
-               b = 0.5 * light.desc().height * light.up();
-    pts = {a + b, a - b, -a + b, -a - b};
+  std::array<Vec3, 4> corners;
+  if (const int count = light.outline(corners); count > 0) {
+    for (int k = 0; k < count; ++k) pts.push_back(corners[std::size_t(k)] - light.centre());
     return pts;
   }
   Vec3 u = light.right(), v = light.up();
@@ -120,13 +119,18 @@ SourceKernel source_kernel(const Light& light, const ProjectionFrame& frame,
   const Vec3 along = view_ray(frame, view);
   Vec3 axis_u = light.right(), axis_v = light.up();
   double extent_u = light.desc().width, extent_v = light.desc().height;
-  const bool round = light.shape() != LightShape::rectangle;
+  const bool round = light.shape() == LightShape::disk || light.shape() == LightShape::sphere;
+  const bool triangle = light.shape() == LightShape::triangle;
   if (round) {
     extent_u = extent_v = 2 * light.desc().radius;
     if (light.shape() == LightShape::sphere) {
       axis_u = along.unitOrthogonal();
       axis_v = along.cross(axis_u);
     }
+  } else if (triangle) {  // its box about the centre, cells outside it left out
+    const Vec2 half = light.half_extents(axis_u, axis_v);
+    extent_u = 2 * half.x();
+    extent_v = 2 * half.y();
   }
   const double px_per_metre = scale * 1.5;  // perspective can stretch by r/(r − z)
   // Each sample stands for a cell of the light, and is splatted as that cell's bounding box
@@ -149,6 +153,8 @@ SourceKernel source_kernel(const Light& light, const ProjectionFrame& frame,
     for (int i = 0; i < nu; ++i) {
       const double a = ((i + 0.5) / nu - 0.5) * extent_u;
       if (round && a * a + b * b > 0.25 * extent_u * extent_u) continue;
+      if (triangle && light.source_image(a * axis_u + b * axis_v, light.normal()).isZero())
+        continue;
       const double z = a * zu + b * zv;
       if (r - z <= 1e-9 * r) continue;  // at or beyond the receiver's depth
       const double stretch = r / (r - z);

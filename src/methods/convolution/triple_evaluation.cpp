@@ -28,9 +28,13 @@ constexpr double kRelativeSpan = 16.0;
 constexpr double kPenumbraPixels = 64.0;
 
 double light_radius(const Light& light) {
-  return light.shape() == LightShape::rectangle
-             ? 0.5 * std::hypot(light.desc().width, light.desc().height)
-             : light.desc().radius;
+  std::array<Vec3, 4> corners;
+  const int count = light.outline(corners);
+  if (count == 0) return light.desc().radius;
+  double radius = 0;  // the farthest corner from the centre
+  for (int k = 0; k < count; ++k)
+    radius = std::max(radius, (corners[std::size_t(k)] - light.centre()).norm());
+  return radius;
 }
 
 }  // namespace
