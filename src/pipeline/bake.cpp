@@ -26,6 +26,7 @@
 #include "scene/lights.h"
 #include "scene/mesh.h"
 #include "scene/mesh_reader.h"
+#include "scene/sun_light.h"
 #include "texels/auto_uv.h"
 #include "texels/lightmap_sizes.h"
 #include "texels/texel_space.h"
@@ -84,6 +85,21 @@ std::vector<const Mesh*> blocker_meshes(const Scene& scene, const std::vector<Me
   for (std::size_t i = 0; i < meshes.size(); ++i)
     if (scene.objects[i].blocker) blockers.push_back(&meshes[i]);
   return blockers;
+}
+
+// The scene's lights with every sun placed for the meshes' bounds (sun_light.h).
+std::vector<LightDesc> placed_lights(const Scene& scene, const std::vector<Mesh>& meshes) {
+  std::vector<LightDesc> lights = scene.lights;
+  Bounds3 bounds;
+  for (const Mesh& m : meshes)
+    for (const auto& v : m.mesh.vertices()) {
+      const auto& p = m.mesh.point(v);
+      bounds.extend(Vec3(p[0], p[1], p[2]));
+    }
+  if (bounds.empty()) return lights;
+  for (LightDesc& l : lights)
+    if (l.sun_angle_deg > 0) place_sun(l, bounds);
+  return lights;
 }
 
 // The covered texels whose value means nothing, for the seams' stitching (texels/seams.h): in a
@@ -218,7 +234,7 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   if (!loaded) return loaded.error();
   const std::vector<Mesh>& meshes = *loaded;
   const std::vector<int> sides = lightmap_sides(scene, meshes, &result.setup_warnings);
-  auto lights_or = make_lights(scene.lights, scene.file);
+  auto lights_or = make_lights(placed_lights(scene, meshes), scene.file);
   if (!lights_or) return lights_or.error();
   const std::vector<Light>& lights = *lights_or;
   // The receivers this bake does: all, or its shard's (as object indices, and their sides).
@@ -462,7 +478,7 @@ Expected<std::vector<std::string>> plan(const Scene& scene, const BakeOptions& o
   const std::vector<Mesh>& meshes = *loaded;
   const std::vector<int> sides = lightmap_sides(scene, meshes, nullptr);
   const ClusterTree clusters = build_clusters(blocker_meshes(scene, meshes));
-  auto lights = make_lights(scene.lights, scene.file);
+  auto lights = make_lights(placed_lights(scene, meshes), scene.file);
   if (!lights) return lights.error();
   BakeContext context;
   context.scene = &scene;

@@ -122,6 +122,10 @@ enum class LightShape { rectangle, disk, sphere, triangle, mesh };
 // above a texel's horizon (a sphere's closed form does not depend on its radius there).
 inline constexpr double kPointLightRadius = 1e-5;
 
+// A scene file's spot: the part of its cone over which it fades when `blend` is left out
+// (Blender's default spot blend).
+inline constexpr double kSpotBlend = 0.15;
+
 struct LightDesc {
   std::string name;
   LightShape shape = LightShape::rectangle;

@@ -5,6 +5,8 @@
 
 #include <numbers>
 
+#include "scene/sun_light.h"
+
 namespace sb {
 
 namespace {
@@ -18,6 +20,71 @@ Vec3 default_up(const Vec3& normal) {
   const Vec3 y = Vec3::UnitY();
   const Vec3 axis = (y - y.dot(normal) * normal).norm() < parallel_sine ? Vec3::UnitZ() : y;
   return (axis - axis.dot(normal) * normal).normalized();
+}
+
+// A spot's cone: `direction` (its axis), `cone_deg` (the whole cone's angle, as Blender's spot
+// size) and `blend` (the part of it over which the light fades, as Blender's spot blend).
+void read_cone(TableReader& r, LightDesc& light) {
+  if (r.require("direction")) {
+    if (auto v = r.vec3("direction", "3 finite numbers, not all zero", is_finite)) {
+      if (v->isZero(0)) r.fail_got("direction", "3 finite numbers, not all zero");
+      light.spot_axis = v->normalized();
+    }
+  }
+  if (r.require("cone_deg")) {
+    if (auto v = r.number("cone_deg", "a number of degrees in (0, 180)",
+                          [](double x) { return std::isfinite(x) && x > 0 && x < 180; }))
+      light.spot_outer = 0.5 * *v * std::numbers::pi / 180;
+  }
+  double blend = kSpotBlend;
+  if (auto v = r.number("blend", "a number in [0, 1]",
+                        [](double x) { return std::isfinite(x) && x >= 0 && x <= 1; }))
+    blend = *v;
+  light.spot_inner = light.spot_outer * (1 - blend);
+}
+
+// A sun: `direction` (where its light goes), `angle_deg` and `irradiance` on a surface facing
+// it, made a distant disk by sun_light (sun_light.h), placed for the scene by the bake.
+Expected<LightDesc> read_sun(TableReader& r, LightDesc light) {
+  for (const char* key :
+       {"position", "normal", "up", "size", "radius", "power", "texture", "cone_deg", "blend"})
+    r.forbid(key,
+             "does not apply to a sun, which is given by 'direction', 'angle_deg' and "
+             "'irradiance'");
+  Vec3 direction = Vec3(0, 0, -1);
+  if (r.require("direction")) {
+    if (auto v = r.vec3("direction", "3 finite numbers, not all zero", is_finite)) {
+      if (v->isZero(0)) r.fail_got("direction", "3 finite numbers, not all zero");
+      direction = v->normalized();
+    }
+  }
+  double angle = kSunAngleDeg;
+  if (auto v = r.number("angle_deg", "a number of degrees in (0, 10]",
+                        [](double x) { return std::isfinite(x) && x > 0 && x <= 10; }))
+    angle = *v;
+  double irradiance = 1;
+  if (r.require("irradiance")) {
+    if (auto v = r.number("irradiance", "a number > 0 (W/m² on a surface facing the sun)",
+                          [](double x) { return std::isfinite(x) && x > 0 && x <= 1e9; }))
+      irradiance = *v;
+  }
+  const std::string_view color_requirement = "3 finite numbers >= 0, not all zero";
+  if (auto v =
+          r.vec3("color", color_requirement, [](double x) { return std::isfinite(x) && x >= 0; })) {
+    if (v->isZero(0)) r.fail_got("color", color_requirement);
+    light.color = *v;
+  }
+  if (auto v = r.number("shadowmask_range", "a number > 0 (metres)", is_positive))
+    light.shadowmask_range = *v;
+  if (r.failed()) return r.error();
+  Bounds3 origin;
+  origin.extend(Vec3::Zero());
+  LightDesc sun = sun_light(direction, angle, irradiance, origin);
+  sun.name = light.name;
+  sun.line = light.line;
+  sun.color = light.color;
+  sun.shadowmask_range = light.shadowmask_range;
+  return sun;
 }
 
 }  // namespace
@@ -38,7 +105,9 @@ Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::ta
     }
   }
   r.check_known_keys({"name", "shape", "position", "normal", "up", "size", "radius", "color",
-                      "power", "texture", "shadowmask_range"});
+                      "power", "texture", "shadowmask_range", "direction", "angle_deg",
+                      "irradiance", "cone_deg", "blend"});
+  bool spot = false;
   if (r.require("shape")) {
     if (auto shape = r.string("shape")) {
       if (*shape == "rectangle") {
@@ -47,13 +116,26 @@ Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::ta
         light.shape = LightShape::disk;
       } else if (*shape == "sphere") {
         light.shape = LightShape::sphere;
+      } else if (*shape == "spot") {
+        light.shape = LightShape::sphere;
+        spot = true;
+      } else if (*shape == "sun") {
+        return read_sun(r, std::move(light));
       } else {
-        r.fail_got("shape", "\"rectangle\", \"disk\" or \"sphere\"");
+        r.fail_got("shape", "\"rectangle\", \"disk\", \"sphere\", \"spot\" or \"sun\"");
       }
     }
   }
   if (r.failed()) return r.error();  // every later key depends on the shape
-  const std::string shape_name = to_string(light.shape);
+  const std::string shape_name = spot ? "spot" : to_string(light.shape);
+  for (const char* key : {"angle_deg", "irradiance"})
+    r.forbid(key, fmt::format("applies only to sun lights, not {}", shape_name));
+  if (spot) {
+    read_cone(r, light);
+  } else {
+    for (const char* key : {"direction", "cone_deg", "blend"})
+      r.forbid(key, fmt::format("applies only to spot lights, not {}", shape_name));
+  }
   const bool is_rectangle = light.shape == LightShape::rectangle;
   const bool is_sphere = light.shape == LightShape::sphere;
 
@@ -62,7 +144,8 @@ Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::ta
   }
 
   if (is_sphere) {
-    r.forbid("normal", "applies only to rectangle and disk lights, not sphere");
+    r.forbid("normal",
+             fmt::format("applies only to rectangle and disk lights, not {}", shape_name));
   } else if (r.require("normal")) {
     if (auto v = r.vec3("normal", "3 finite numbers, not all zero", is_finite)) {
       if (v->isZero(0)) r.fail_got("normal", "3 finite numbers, not all zero");
@@ -102,6 +185,8 @@ Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::ta
 
   if (is_rectangle) {
     r.forbid("radius", "applies only to disk and sphere lights, not rectangle");
+  } else if (spot && !r.find("radius")) {
+    light.radius = kPointLightRadius;  // a spot is a point unless given a radius
   } else if (r.require("radius")) {
     // Both `radius = 0.1` and `radius = [0.1]` are accepted; a sphere's may be 0, a point light.
     const std::string_view requirement = is_sphere

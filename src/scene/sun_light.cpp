@@ -42,4 +42,15 @@ void set_sun_angle(LightDesc& sun, double angle_deg) {
   sun.sun_angle_deg = angle_deg;
 }
 
+void place_sun(LightDesc& sun, const Bounds3& bounds) {
+  const double half = 0.5 * sun.sun_angle_deg * std::numbers::pi / 180;
+  const double irradiance =
+      sun.power / (std::numbers::pi * sun.radius * sun.radius) * std::sin(half) * std::sin(half);
+  const LightDesc placed = sun_light(sun.normal, sun.sun_angle_deg, irradiance, bounds);
+  sun.position = placed.position;
+  sun.radius = placed.radius;
+  sun.up = placed.up;
+  sun.power = placed.power;
+}
+
 }  // namespace sb

@@ -31,6 +31,11 @@ LightDesc sun_light(const Vec3& direction, double angle_deg, double irradiance,
 // irradiance.
 void set_sun_angle(LightDesc& sun, double angle_deg);
 
+// Places a sun made by sun_light for a scene within `bounds` (its distance and centre as
+// sun_light puts them), keeping its direction, angle and irradiance. The bake places every sun
+// for its meshes' bounds: a scene file's sun is read before any mesh (placed for the origin).
+void place_sun(LightDesc& sun, const Bounds3& bounds);
+
 // The distance at which sun_light puts the disk for a scene within `bounds`, metres.
 double sun_distance(const Bounds3& bounds);
 

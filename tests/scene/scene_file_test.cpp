@@ -10,7 +10,9 @@
 #include <random>
 #include <string>
 
+#include "scene/lights.h"
 #include "scene/scene.h"
+#include "scene/sun_light.h"
 
 namespace sb {
 namespace {
@@ -442,6 +444,57 @@ TEST_F(SceneFile, RejectsBadRadius) {
       "[[light]]\nname = \"bulb\"\nshape = \"sphere\"\nposition = [0, 0, 1]\nradius = [-0.1]\n"
       "power = 10\n";
   expect_error(object_floor + negative, "radius", "light 'bulb'", "'radius'");
+}
+
+// A sun: its direction, Blender's angle unless given, its irradiance; a distant disk (placed for
+// the origin until the bake places it for its meshes) whose closed form is E cos θ.
+TEST_F(SceneFile, SunIsADirectionAnAngleAndAnIrradiance) {
+  const std::string sun =
+      "[[light]]\nname = \"sun\"\nshape = \"sun\"\ndirection = [0, -2, -2]\nirradiance = 800\n";
+  const Scene scene = load_ok(object_floor + sun);
+  ASSERT_EQ(scene.lights.size(), 1u);
+  const LightDesc& d = scene.lights[0];
+  EXPECT_EQ(d.shape, LightShape::disk);
+  EXPECT_EQ(d.sun_angle_deg, kSunAngleDeg);
+  EXPECT_LT((d.normal - Vec3(0, -1, -1).normalized()).norm(), 1e-12);
+  const Vec3 up(0, 0, 1);  // a floor facing up: cos θ = 1/√2
+  EXPECT_NEAR(Light(d).unoccluded_irradiance(Vec3(0.3, 0.2, 0), up).x(), 800 / std::sqrt(2.0),
+              1e-3 * 800);
+  const Scene wide = load_ok(object_floor + sun + "angle_deg = 2\n");
+  EXPECT_EQ(wide.lights[0].sun_angle_deg, 2.0);
+  expect_error(object_floor + sun + "position = [0, 0, 1]\n", "position", "light 'sun'",
+               "'position'");
+  expect_error(object_floor + sun + "power = 10\n", "power", "light 'sun'", "'power'");
+  expect_error(object_floor + sun + "angle_deg = 20\n", "angle_deg", "light 'sun'", "'angle_deg'");
+  const std::string no_irradiance =
+      "[[light]]\nname = \"sun\"\nshape = \"sun\"\ndirection = [0, 0, -1]\n";
+  expect_error(object_floor + no_irradiance, "[[light]]", "light 'sun'", "'irradiance'");
+  expect_error(object_floor + light_bulb + "irradiance = 3\n", "irradiance", "light 'bulb'",
+               "'irradiance'");
+}
+
+// A spot: a point light (or a sphere of `radius`) with a cone, Blender's spot size and blend.
+TEST_F(SceneFile, SpotIsAPointWithACone) {
+  const std::string spot =
+      "[[light]]\nname = \"spot\"\nshape = \"spot\"\nposition = [0, 0, 2]\n"
+      "direction = [0, 0, -1]\ncone_deg = 60\npower = 100\n";
+  const Scene scene = load_ok(object_floor + spot);
+  const LightDesc& d = scene.lights[0];
+  EXPECT_EQ(d.shape, LightShape::sphere);
+  EXPECT_EQ(d.radius, kPointLightRadius);
+  EXPECT_LT((d.spot_axis - Vec3(0, 0, -1)).norm(), 1e-12);
+  EXPECT_NEAR(d.spot_outer, std::numbers::pi / 6, 1e-12);
+  EXPECT_NEAR(d.spot_inner, std::numbers::pi / 6 * (1 - kSpotBlend), 1e-12);
+  const Light light(d);
+  EXPECT_EQ(light.spot_factor(Vec3(0, 0, 0)), 1.0);
+  EXPECT_EQ(light.spot_factor(Vec3(2, 0, 0)), 0.0);  // 45° off the axis, outside 30°
+  const Scene soft = load_ok(object_floor + spot + "blend = 1\nradius = 0.1\n");
+  EXPECT_EQ(soft.lights[0].spot_inner, 0.0);
+  EXPECT_EQ(soft.lights[0].radius, 0.1);
+  expect_error(object_floor + spot + "normal = [0, 0, -1]\n", "normal", "light 'spot'", "'normal'");
+  expect_error(object_floor + spot + "blend = 2\n", "blend", "light 'spot'", "'blend'");
+  expect_error(object_floor + light_bulb + "cone_deg = 30\n", "cone_deg", "light 'bulb'",
+               "'cone_deg'");
 }
 
 // A sphere of radius 0 is a point light, baked as a sphere of kPointLightRadius; a disk's radius
