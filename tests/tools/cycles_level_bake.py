@@ -131,6 +131,7 @@ def bake_direct(image):
 
 def save(name, pixels):
     image = bpy.data.images.new(name, args.res, args.res, float_buffer=True)
+    image.colorspace_settings.name = "Non-Color"  # written as it is, linear
     image.pixels[:] = pixels.ravel()
     image.filepath_raw = os.path.join(args.out, name + ".exr")
     image.file_format = "OPEN_EXR"
@@ -149,7 +150,10 @@ for name, receiver in receivers.items():
     diffuse = nodes.new("ShaderNodeBsdfDiffuse")
     diffuse.inputs["Color"].default_value = (1, 1, 1, 1)
     material.node_tree.links.new(diffuse.outputs["BSDF"], out.inputs["Surface"])
+    # Non-Color: the bake's values as they are. (A float image's default, scene-linear, came
+    # out of Blender 3.4's bake of a level as display-encoded values, V ≈ V_true^0.45.)
     image = bpy.data.images.new(name, args.res, args.res, float_buffer=True)
+    image.colorspace_settings.name = "Non-Color"
     texture = nodes.new("ShaderNodeTexImage")
     texture.image = image
     nodes.active = texture
