@@ -161,7 +161,7 @@ struct ShaftCuller::Impl {
     double r = 0;
     switch (light.shape()) {
       case LightShape::rectangle:
-      case LightShape::triangle: {
+      case LightShape::polygon: {
         if ((p - c).dot(light.normal()) - reach(light.normal()) <= 0) return false;
         std::array<Vec3, 4> outline;
         corners = light.outline(outline);

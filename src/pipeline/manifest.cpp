@@ -96,9 +96,9 @@ class FieldReader {
     read(key, text);
     if (status_ && !parse_enum(text,
                                {LightShape::rectangle, LightShape::disk, LightShape::sphere,
-                                LightShape::triangle, LightShape::mesh},
+                                LightShape::polygon, LightShape::mesh},
                                out))
-      fail(key, "\"rectangle\", \"disk\", \"sphere\", \"triangle\" or \"mesh\"");
+      fail(key, "\"rectangle\", \"disk\", \"sphere\", \"polygon\" or \"mesh\"");
   }
   template <typename T>
   void read_optional(const char* key, std::optional<T>& out) {

@@ -334,7 +334,8 @@ Expected<LevelContents> import_level(const fs::path& file, const Affine3& placem
       if (shape->corners.size() / 3 > kMaxMeshLightTriangles) {
         level.warnings.push_back(fmt::format(
             "{}: node '{}': its emissive material '{}' is on a mesh of {} triangles, more than "
-            "the {} a mesh light may have (each is baked as a light of its own); it is left out",
+            "the {} a mesh light may have (each of its triangles or quads is baked as a light); it "
+            "is left out",
             where, node, raw->materials[part.material].name, shape->corners.size() / 3,
             kMaxMeshLightTriangles));
         continue;

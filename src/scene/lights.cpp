@@ -19,6 +19,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numbers>
 
 #include "core/image_io.h"
@@ -149,12 +150,19 @@ double polygon_form_factor(const Vec3* polygon, int count, const Vec3& n) {
 
 Light::Light(const LightDesc& desc, std::shared_ptr<const Image> texture, int output)
     : desc_(desc), output_(output), texture_(std::move(texture)) {
-  if (desc_.shape == LightShape::triangle && desc_.corners.size() == 3) {
-    // Its plane from its corners, counter-clockwise seen from the emitting side; `up` towards
-    // its first corner.
+  if (desc_.shape == LightShape::polygon &&
+      (desc_.corners.size() == 3 || desc_.corners.size() == 4)) {
+    // Its plane from its corners, counter-clockwise seen from the emitting side (the fan from
+    // its first corner), its centre the area-weighted centroid; `up` towards its first corner.
     const std::vector<Vec3>& c = desc_.corners;
-    desc_.position = (c[0] + c[1] + c[2]) / 3.0;
-    desc_.normal = (c[1] - c[0]).cross(c[2] - c[0]).normalized();
+    Vec3 normal = Vec3::Zero(), centroid = Vec3::Zero();
+    for (std::size_t k = 1; k + 1 < c.size(); ++k) {
+      const Vec3 cross = (c[k] - c[0]).cross(c[k + 1] - c[0]);
+      normal += cross;
+      centroid += cross.norm() * (c[0] + c[k] + c[k + 1]) / 3.0;
+    }
+    desc_.position = centroid / normal.norm();
+    desc_.normal = normal.normalized();
     desc_.up = (c[0] - desc_.position).normalized();
   }
   if (desc_.shape == LightShape::sphere || desc_.shape == LightShape::mesh) {
@@ -180,9 +188,13 @@ int Light::outline(std::array<Vec3, 4>& corners) const {
     corners = {c - hw - hh, c + hw - hh, c + hw + hh, c - hw + hh};
     return 4;
   }
-  if (desc_.shape == LightShape::triangle && desc_.corners.size() == 3) {
+  if (desc_.shape == LightShape::polygon && desc_.corners.size() == 3) {
     corners = {desc_.corners[0], desc_.corners[1], desc_.corners[2], desc_.corners[2]};
     return 3;
+  }
+  if (desc_.shape == LightShape::polygon && desc_.corners.size() == 4) {
+    corners = {desc_.corners[0], desc_.corners[1], desc_.corners[2], desc_.corners[3]};
+    return 4;
   }
   return 0;
 }
@@ -206,15 +218,16 @@ double Light::extent_across(const Vec3& axis) const {
     case LightShape::disk:
     case LightShape::sphere:
       return 2 * desc_.radius;  // an ellipse's major axis, or the sphere's outline
-    case LightShape::triangle: {
-      // Its longest side seen across the axis.
+    case LightShape::polygon: {
+      // Its longest side or diagonal seen across the axis.
       std::array<Vec3, 4> c;
-      outline(c);
+      const int count = outline(c);
       double longest = 0;
-      for (int k = 0; k < 3; ++k) {
-        const Vec3 side = c[std::size_t(k)] - c[std::size_t((k + 1) % 3)];
-        longest = std::max(longest, (side - side.dot(axis) * axis).norm());
-      }
+      for (int i = 0; i < count; ++i)
+        for (int j = i + 1; j < count; ++j) {
+          const Vec3 side = c[std::size_t(i)] - c[std::size_t(j)];
+          longest = std::max(longest, (side - side.dot(axis) * axis).norm());
+        }
       return longest;
     }
     case LightShape::mesh:
@@ -232,7 +245,7 @@ Vec2 Light::half_extents(const Vec3& e1, const Vec3& e2) const {
         return desc_.radius * std::sqrt(std::max(0.0, 1.0 - std::pow(desc_.normal.dot(e), 2)));
       case LightShape::sphere:
         return desc_.radius;
-      case LightShape::triangle: {
+      case LightShape::polygon: {
         // About the centroid: the farthest corner along e (an outline's bounding box about
         // the centre, as the other shapes' are).
         double half = 0;
@@ -261,13 +274,14 @@ Vec3 Light::source_image(const Vec3& offset, const Vec3& axis) const {
     inside = std::abs(local.x()) <= 0.5 * desc_.width && std::abs(local.y()) <= 0.5 * desc_.height;
   } else if (desc_.shape == LightShape::disk) {
     inside = local.squaredNorm() <= desc_.radius * desc_.radius;
-  } else if (desc_.shape == LightShape::triangle) {
+  } else if (desc_.shape == LightShape::polygon) {
     // On the inner side of each edge (counter-clockwise about the normal).
     const Vec3 x = centre() + on_light;
     inside = true;
-    for (int k = 0; k < 3 && inside; ++k) {
-      const Vec3& a = desc_.corners[std::size_t(k)];
-      const Vec3& b = desc_.corners[std::size_t((k + 1) % 3)];
+    const std::size_t count = desc_.corners.size();
+    for (std::size_t k = 0; k < count && inside; ++k) {
+      const Vec3& a = desc_.corners[k];
+      const Vec3& b = desc_.corners[(k + 1) % count];
       inside = (b - a).cross(x - a).dot(desc_.normal) >= 0;
     }
   }
@@ -282,13 +296,18 @@ double Light::area() const {
       return kPi * desc_.radius * desc_.radius;
     case LightShape::sphere:
       return 4.0 * kPi * desc_.radius * desc_.radius;
-    case LightShape::triangle:
-    case LightShape::mesh: {
+    case LightShape::polygon: {  // the fan from its first corner
+      const std::vector<Vec3>& c = desc_.corners;
       double sum = 0;
-      for (std::size_t k = 0; k + 2 < desc_.corners.size(); k += 3) {
-        const std::vector<Vec3>& c = desc_.corners;
+      for (std::size_t k = 1; k + 1 < c.size(); ++k)
+        sum += 0.5 * (c[k] - c[0]).cross(c[k + 1] - c[0]).norm();
+      return sum;
+    }
+    case LightShape::mesh: {  // its triangles
+      const std::vector<Vec3>& c = desc_.corners;
+      double sum = 0;
+      for (std::size_t k = 0; k + 2 < c.size(); k += 3)
         sum += 0.5 * (c[k + 1] - c[k]).cross(c[k + 2] - c[k]).norm();
-      }
       return sum;
     }
   }
@@ -299,7 +318,7 @@ double Light::form_factor(const Vec3& y, const Vec3& n) const {
   const Vec3 c = desc_.position - y;
   switch (desc_.shape) {
     case LightShape::rectangle:
-    case LightShape::triangle: {
+    case LightShape::polygon: {
       if (c.dot(desc_.normal) >= 0) return 0.0;  // the point is behind the emitting side
       std::array<Vec3, 4> corners;
       const int count = outline(corners);
@@ -347,7 +366,7 @@ bool Light::reaches(const Vec3& y, const Vec3& n) const {
       const double hh = 0.5 * desc_.height * std::abs(n.dot(up_));
       return n.dot(c) + hw + hh > 0;
     }
-    case LightShape::triangle: {
+    case LightShape::polygon: {
       if (c.dot(desc_.normal) >= 0) return false;
       double highest = -std::numeric_limits<double>::infinity();
       for (const Vec3& corner : desc_.corners) highest = std::max(highest, n.dot(corner - y));
@@ -380,15 +399,28 @@ LightSample Light::sample(const Vec3& y, const Vec3& n, const Vec2& u) const {
   switch (desc_.shape) {
     case LightShape::rectangle:
     case LightShape::disk:
-    case LightShape::triangle: {
+    case LightShape::polygon: {
       Vec2 local;  // metres in the light's (right, up) frame
       if (desc_.shape == LightShape::rectangle) {
         local = Vec2((u.x() - 0.5) * desc_.width, (u.y() - 0.5) * desc_.height);
-      } else if (desc_.shape == LightShape::triangle) {
-        // Uniform by area: the square's strata folded onto the triangle by √u.
+      } else if (desc_.shape == LightShape::polygon) {
+        // Uniform by area: u.x picks a triangle of the fan by its share of the area (a quad's
+        // two), the rest of it and u.y fold the stratum onto that triangle by √u.
         const std::vector<Vec3>& c = desc_.corners;
-        const double su = std::sqrt(u.x());
-        const Vec3 x = (1 - su) * c[0] + su * ((1 - u.y()) * c[1] + u.y() * c[2]) - centre();
+        double ux = u.x();
+        std::size_t k = 1;
+        if (c.size() == 4) {
+          const double first = (c[1] - c[0]).cross(c[2] - c[0]).norm();
+          const double share = first / (first + (c[2] - c[0]).cross(c[3] - c[0]).norm());
+          if (ux < share) {
+            ux /= share;
+          } else {
+            ux = (ux - share) / (1 - share);
+            k = 2;
+          }
+        }
+        const double su = std::sqrt(std::clamp(ux, 0.0, 1.0));
+        const Vec3 x = (1 - su) * c[0] + su * ((1 - u.y()) * c[k] + u.y() * c[k + 1]) - centre();
         local = Vec2(x.dot(right_), x.dot(up_));
       } else {
         // Shirley–Chiu concentric map: keeps the strata's shapes compact on the disk.
@@ -450,7 +482,7 @@ bool Light::partly_below_horizon(const Vec3& y, const Vec3& n) const {
       return n.dot(c) - desc_.radius * (n - n.dot(desc_.normal) * desc_.normal).norm() < 0;
     case LightShape::sphere:
       return n.dot(c) - desc_.radius < 0;
-    case LightShape::triangle: {
+    case LightShape::polygon: {
       double lowest = std::numeric_limits<double>::infinity();
       for (const Vec3& corner : desc_.corners) lowest = std::min(lowest, n.dot(corner - y));
       return lowest < 0;
@@ -481,7 +513,7 @@ HorizonPart Light::above_horizon(const Vec3& y, const Vec3& n) const {
   const Vec3 c = desc_.position - y;
   switch (desc_.shape) {
     case LightShape::rectangle:
-    case LightShape::triangle: {
+    case LightShape::polygon: {
       if (c.dot(desc_.normal) >= 0) break;
       std::array<Vec3, 4> corners;
       const int count = this->outline(corners);
@@ -576,8 +608,7 @@ Expected<std::vector<Light>> make_lights(const std::vector<LightDesc>& descs,
     }
     const int output = int(&d - descs.data());
     if (d.shape == LightShape::mesh) {
-      for (const LightDesc& triangle : mesh_light_triangles(d))
-        lights.emplace_back(triangle, nullptr, output);
+      for (const LightDesc& part : mesh_light_parts(d)) lights.emplace_back(part, nullptr, output);
     } else {
       lights.emplace_back(d, std::move(texture), output);
     }
@@ -589,20 +620,66 @@ std::size_t output_count(const std::vector<Light>& lights) {
   return lights.empty() ? 0 : std::size_t(lights.back().output()) + 1;
 }
 
-std::vector<LightDesc> mesh_light_triangles(const LightDesc& mesh) {
+std::vector<LightDesc> mesh_light_parts(const LightDesc& mesh) {
   std::vector<LightDesc> out;
   const double total = Light(mesh).area();
   if (!(total > 0)) return out;
-  for (std::size_t k = 0; k + 2 < mesh.corners.size(); k += 3) {
-    LightDesc t = mesh;
-    t.shape = LightShape::triangle;
-    t.name = mesh.name + "#" + std::to_string(k / 3);
-    t.corners.assign(mesh.corners.begin() + std::ptrdiff_t(k),
-                     mesh.corners.begin() + std::ptrdiff_t(k + 3));
-    const double area = Light(t).area();
-    if (!(area > 0)) continue;  // a degenerate triangle emits nothing
-    t.power = mesh.power * area / total;
-    out.push_back(std::move(t));
+  const std::vector<Vec3>& c = mesh.corners;
+  const std::size_t triangles = c.size() / 3;
+  const auto corner = [&](std::size_t t, int k) -> const Vec3& {
+    return c[3 * t + std::size_t(k % 3)];
+  };
+  std::vector<Vec3> normal(triangles);
+  std::vector<double> area(triangles);
+  // Each triangle's edges by their ends (as they run in it), for the triangle across each.
+  std::map<std::array<double, 6>, std::pair<std::size_t, int>> edges;
+  const auto edge_key = [](const Vec3& a, const Vec3& b) {
+    return std::array<double, 6>{a.x(), a.y(), a.z(), b.x(), b.y(), b.z()};
+  };
+  for (std::size_t t = 0; t < triangles; ++t) {
+    const Vec3 cross = (corner(t, 1) - corner(t, 0)).cross(corner(t, 2) - corner(t, 0));
+    area[t] = 0.5 * cross.norm();
+    normal[t] = area[t] > 0 ? Vec3(cross.normalized()) : Vec3::Zero();
+    for (int k = 0; k < 3; ++k)
+      edges.emplace(edge_key(corner(t, k), corner(t, k + 1)), std::pair{t, k});
+  }
+  std::vector<std::uint8_t> taken(triangles, 0);
+  const auto add = [&](std::vector<Vec3> corners, double part_area) {
+    LightDesc part = mesh;
+    part.shape = LightShape::polygon;
+    part.name = mesh.name + "#" + std::to_string(out.size());
+    part.corners = std::move(corners);
+    part.power = mesh.power * part_area / total;
+    out.push_back(std::move(part));
+  };
+  for (std::size_t t = 0; t < triangles; ++t) {
+    if (taken[t] || !(area[t] > 0)) continue;  // a degenerate triangle emits nothing
+    taken[t] = 1;
+    bool paired = false;
+    for (int k = 0; k < 3 && !paired; ++k) {
+      // The triangle (p, q, r) and the one across p–q, (q, p, s): the quad p, s, q, r when the
+      // two lie in one plane, face the same way and make a convex outline.
+      const Vec3 &p = corner(t, k), &q = corner(t, k + 1), &r = corner(t, k + 2);
+      const auto across = edges.find(edge_key(q, p));
+      if (across == edges.end()) continue;
+      const auto [u, m] = across->second;
+      if (u == t || taken[u] || !(area[u] > 0) || normal[t].dot(normal[u]) < 1 - 1e-9) continue;
+      const Vec3& s_corner = corner(u, m + 2);
+      if (std::abs(normal[t].dot(s_corner - p)) > 1e-6 * (q - p).norm()) continue;
+      const std::vector<Vec3> quad = {p, s_corner, q, r};
+      bool convex = true;
+      for (int i = 0; i < 4 && convex; ++i) {
+        const Vec3& a = quad[std::size_t(i)];
+        const Vec3& b = quad[std::size_t((i + 1) % 4)];
+        const Vec3& d = quad[std::size_t((i + 2) % 4)];
+        convex = (b - a).cross(d - b).dot(normal[t]) > 0;
+      }
+      if (!convex) continue;
+      taken[u] = 1;
+      paired = true;
+      add(quad, area[t] + area[u]);
+    }
+    if (!paired) add({corner(t, 0), corner(t, 1), corner(t, 2)}, area[t]);
   }
   return out;
 }

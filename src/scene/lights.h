@@ -140,15 +140,18 @@ class Light {
 };
 
 // The scene's lights, with their textures read (through OpenImageIO, sRGB decoded to linear),
-// in scene order; a mesh light is its triangles, one triangle light each (named "<name>#<k>",
-// its share of the power by area), all with the mesh light's output index. An unreadable
-// texture is an error naming scene_file, the light and the image.
+// in scene order; a mesh light is its parts (mesh_light_parts), all with the mesh light's output
+// index. An unreadable texture is an error naming scene_file, the light and the image.
 Expected<std::vector<Light>> make_lights(const std::vector<LightDesc>& descs,
                                          const std::filesystem::path& scene_file);
 // How many of the scene's lights `lights` (from make_lights) stand for: the per-light images.
 std::size_t output_count(const std::vector<Light>& lights);
-// The triangle lights of a mesh light, from its description (LightDesc::corners).
-std::vector<LightDesc> mesh_light_triangles(const LightDesc& mesh);
+// The planar polygon lights a mesh light is baked as (LightDesc::corners): its triangles, two
+// of them joined into one quad wherever they share an edge, lie in one plane and make a convex
+// outline (a UV sphere's or a cylinder's quads: half the lights, half the bake's time for them);
+// named "<name>#<k>", each with its share of the power by area. Degenerate triangles are left
+// out.
+std::vector<LightDesc> mesh_light_parts(const LightDesc& mesh);
 
 // Lambert's formula for the form factor of a planar polygon (vertices relative to the point,
 // either winding) seen from a point with unit normal n, after clipping the polygon to the

@@ -109,11 +109,11 @@ struct ObjectDesc {
   std::vector<std::uint32_t> parts;
 };
 
-// A triangle is one planar triangle of a mesh light; a mesh light (an emissive mesh of a level
-// that is no planar quad or disc) is its triangles, each of them a triangle light when baked
-// (make_lights, scene/lights.h): every method bakes triangles, and a mesh light's outputs are
-// its triangles' combined by the one rule of methods/light_mix.h.
-enum class LightShape { rectangle, disk, sphere, triangle, mesh };
+// A polygon is a planar convex triangle or quad, a part of a mesh light; a mesh light (an
+// emissive mesh of a level that is no planar rectangle or disc) is its triangles, baked as
+// polygons (make_lights, scene/lights.h): every method bakes polygons, and a mesh light's
+// outputs are its parts' combined by the one rule of methods/light_mix.h.
+enum class LightShape { rectangle, disk, sphere, polygon, mesh };
 
 // A point light (a sphere light of radius 0 in a scene file, a level's point and spot lights) is
 // baked as a sphere of this radius, for every method: its penumbra, 10⁻⁵ m times a blocker's
@@ -149,8 +149,8 @@ struct LightDesc {
   double spot_inner = 0, spot_outer = 0;
   // A sun (a disk far away, sun_light.h): its angular diameter, degrees; 0 for other lights.
   double sun_angle_deg = 0;
-  // A triangle's three corners, or a mesh light's triangles (three corners each), world metres,
-  // counter-clockwise seen from the side they emit into (a mesh light's `position` is its
+  // A polygon's three or four corners, or a mesh light's triangles (three corners each), world
+  // metres, counter-clockwise seen from the side they emit into (a mesh light's `position` is its
   // area-weighted centroid, `normal` and `up` unused). Empty for other shapes.
   std::vector<Vec3> corners;
   int line = 0;

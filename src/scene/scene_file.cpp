@@ -46,8 +46,8 @@ const char* to_string(LightShape s) {
       return "disk";
     case LightShape::sphere:
       return "sphere";
-    case LightShape::triangle:
-      return "triangle";
+    case LightShape::polygon:
+      return "polygon";
     case LightShape::mesh:
       return "mesh";
   }

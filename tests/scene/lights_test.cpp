@@ -54,7 +54,7 @@ LightDesc sphere(double r) {
 LightDesc triangle() {
   LightDesc d;
   d.name = "triangle";
-  d.shape = LightShape::triangle;
+  d.shape = LightShape::polygon;
   d.corners = {Vec3(-0.3, -0.2, 1.3), Vec3(0.1, 0.35, 1.5), Vec3(0.4, -0.1, 1.2)};
   if ((d.corners[1] - d.corners[0]).cross(d.corners[2] - d.corners[0]).z() > 0)
     std::swap(d.corners[1], d.corners[2]);
@@ -80,7 +80,7 @@ double numeric_form_factor(const Light& light, const Vec3& y, const Vec3& n) {
                        ((j + 0.5) / k - 0.5) * d.height * light.up();
         add(x, d.normal, d.width * d.height / (double(k) * k));
       }
-  } else if (d.shape == LightShape::triangle) {
+  } else if (d.shape == LightShape::polygon) {
     // The midpoint rule over k² similar sub-triangles (k(k+1)/2 upright, k(k−1)/2 upside down).
     const int k = 1500;
     const Vec3 a = d.corners[0], e1 = (d.corners[1] - a) / k, e2 = (d.corners[2] - a) / k;
@@ -155,29 +155,58 @@ TEST(Lambert, TriangleMatchesNumericalIntegration) {
 
 // A rectangle cut along a diagonal into two triangles of half its power each: their form
 // factors sum to the rectangle's (the rectangle's own code path) wherever the point is, the
-// horizon cutting them or not, and so do their irradiances.
+// horizon cutting them or not, and so do their irradiances; and mesh_light_parts joins them
+// into one quad, which is the rectangle again.
 TEST(Lambert, TwoTrianglesMakeTheirRectangle) {
   const LightDesc rect = rectangle(0.5, 0.3);
   const Light r(rect);
   std::array<Vec3, 4> c;
   ASSERT_EQ(r.outline(c), 4);
+  LightDesc half_a = rect, half_b = rect;
+  half_a.shape = half_b.shape = LightShape::polygon;
+  // The outline runs counter-clockwise about the rectangle's normal.
+  half_a.corners = {c[0], c[1], c[2]};
+  half_b.corners = {c[0], c[2], c[3]};
+  half_a.power = half_b.power = 0.5 * rect.power;
   LightDesc mesh = rect;
   mesh.shape = LightShape::mesh;
-  // The outline runs counter-clockwise about the rectangle's normal.
   mesh.corners = {c[0], c[1], c[2], c[0], c[2], c[3]};
-  const std::vector<LightDesc> halves = mesh_light_triangles(mesh);
-  ASSERT_EQ(halves.size(), 2u);
+  const std::vector<LightDesc> parts = mesh_light_parts(mesh);
+  ASSERT_EQ(parts.size(), 1u);
+  ASSERT_EQ(parts[0].corners.size(), 4u);
+  const Light a(half_a), b(half_b), quad(parts[0]);
+  EXPECT_LT((quad.centre() - r.centre()).norm(), 1e-12);
+  EXPECT_LT((quad.normal() - r.normal()).norm(), 1e-12);
+  EXPECT_NEAR(quad.area(), r.area(), 1e-12);
   Rng rng(3);
   for (int i = 0; i < 2000; ++i) {
     const Vec3 y(4 * rng.next_double() - 2, 4 * rng.next_double() - 2, 3 * rng.next_double() - 1);
     const Vec3 n = Vec3(rng.next_double() - 0.5, rng.next_double() - 0.5, rng.next_double() - 0.5)
                        .normalized();
-    const Light a(halves[0]), b(halves[1]);
+    const double h0 = r.unoccluded_irradiance(y, n).x();
     EXPECT_NEAR(a.form_factor(y, n) + b.form_factor(y, n), r.form_factor(y, n), 1e-12);
-    EXPECT_NEAR((a.unoccluded_irradiance(y, n) + b.unoccluded_irradiance(y, n)).x(),
-                r.unoccluded_irradiance(y, n).x(), 1e-9 * (1 + r.unoccluded_irradiance(y, n).x()));
+    EXPECT_NEAR((a.unoccluded_irradiance(y, n) + b.unoccluded_irradiance(y, n)).x(), h0,
+                1e-9 * (1 + h0));
+    EXPECT_NEAR(quad.unoccluded_irradiance(y, n).x(), h0, 1e-9 * (1 + h0));
     EXPECT_EQ(a.reaches(y, n) || b.reaches(y, n), r.reaches(y, n)) << y.transpose();
+    EXPECT_EQ(quad.reaches(y, n), r.reaches(y, n)) << y.transpose();
   }
+}
+
+// Triangles that do not make a convex quad in one plane stay triangles: two of a square folded
+// along its diagonal, and two that make an arrowhead.
+TEST(MeshLight, OnlyConvexCoplanarPairsBecomeQuads) {
+  LightDesc mesh;
+  mesh.name = "m";
+  mesh.shape = LightShape::mesh;
+  mesh.power = 1;
+  const Vec3 p(0, 0, 0), q(1, 1, 0), r(0, 1, 0);
+  mesh.corners = {p, q, r, q, p, Vec3(1, 0, 0.2)};  // folded
+  EXPECT_EQ(mesh_light_parts(mesh).size(), 2u);
+  mesh.corners = {p, q, r, q, p, Vec3(0.4, 0.6, 0)};  // across p–q, inside the triangle's side
+  EXPECT_EQ(mesh_light_parts(mesh).size(), 2u);
+  mesh.corners = {p, q, r, q, p, Vec3(1, 0, 0)};  // a square
+  EXPECT_EQ(mesh_light_parts(mesh).size(), 1u);
 }
 
 // make_lights: a mesh light is its triangles, each named after it and its index, each with its

@@ -356,14 +356,15 @@ class LightPairs final : public PairSource {
         return 2 * d.radius * std::abs(light_.normal().dot(to)) / (distance * distance);
       case LightShape::sphere:
         return 2 * d.radius / distance;
-      case LightShape::triangle: {
-        // Its narrowest width: twice its area over its longest side.
+      case LightShape::polygon: {
+        // A width no wider than its narrowest: its area over its longest side or diagonal
+        // (twice that for a triangle, whose height it is).
         double longest = 0;
-        for (int k = 0; k < 3; ++k)
-          longest = std::max(
-              longest, (d.corners[std::size_t(k)] - d.corners[std::size_t((k + 1) % 3)]).norm());
-        return 2 * light_.area() / std::max(longest, 1e-300) * std::abs(light_.normal().dot(to)) /
-               (distance * distance);
+        for (const Vec3& a : d.corners)
+          for (const Vec3& b : d.corners) longest = std::max(longest, (a - b).norm());
+        const double factor = d.corners.size() == 3 ? 2.0 : 1.0;
+        return factor * light_.area() / std::max(longest, 1e-300) *
+               std::abs(light_.normal().dot(to)) / (distance * distance);
       }
       case LightShape::mesh:
         break;

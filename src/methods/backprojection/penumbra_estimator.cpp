@@ -229,7 +229,7 @@ const LightRows& PenumbraEstimator::rows_for(const LightFrame& f, const Vec3& po
   const double alpha = normal.dot(f.s_axis), beta = normal.dot(f.t_axis);
   const double gamma = normal.dot(f.centre - position);
   const bool polygon =
-      light_->shape() == LightShape::rectangle || light_->shape() == LightShape::triangle;
+      light_->shape() == LightShape::rectangle || light_->shape() == LightShape::polygon;
   bool cut = false;
   if (polygon) {
     for (const Vec2& p : corners_) cut = cut || alpha * p.x() + beta * p.y() + gamma < 0;

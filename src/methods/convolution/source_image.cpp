@@ -120,7 +120,7 @@ SourceKernel source_kernel(const Light& light, const ProjectionFrame& frame,
   Vec3 axis_u = light.right(), axis_v = light.up();
   double extent_u = light.desc().width, extent_v = light.desc().height;
   const bool round = light.shape() == LightShape::disk || light.shape() == LightShape::sphere;
-  const bool triangle = light.shape() == LightShape::triangle;
+  const bool triangle = light.shape() == LightShape::polygon;
   if (round) {
     extent_u = extent_v = 2 * light.desc().radius;
     if (light.shape() == LightShape::sphere) {
