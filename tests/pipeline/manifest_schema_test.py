@@ -21,8 +21,8 @@ jsonschema.Draft202012Validator.check_schema(SCHEMA)
 VALIDATOR = jsonschema.Draft202012Validator(SCHEMA)
 
 # Bakes covering every shape the manifest takes: the default files, the convolution's own
-# entries, per-light images and masks with a light left out, atlases with glTF and RGBM, and
-# irradiance.
+# entries, per-light images and masks with a light left out, atlases with glTF and RGBM,
+# irradiance, and a level's mesh lights.
 BAKES = {
     "default": ["scenes/showcase/scene.toml", "--resolution", "32", "--samples", "4"],
     "convolution": ["scenes/showcase/scene.toml", "--resolution", "32", "--samples", "4",
@@ -33,6 +33,7 @@ BAKES = {
               "--samples", "2"],
     "half": ["scenes/showcase/scene.toml", "--resolution", "32", "--samples", "4",
              "--encoding", "half-exr", "--quantity", "irradiance", "--per-light"],
+    "mesh_lights": ["scenes/level/lamp.glb", "--resolution", "16", "--per-light", "--shadowmask"],
 }
 
 
