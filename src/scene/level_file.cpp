@@ -1,4 +1,4 @@
-// Levels (level_file.h): a mesh file's nodes as objects, its emissive rectangles and discs and its
+// Levels (level_file.h): a mesh file's nodes as objects, its emissive meshes and its
 // KHR_lights_punctual lights as lights.
 #include "scene/level_file.h"
 
@@ -309,7 +309,7 @@ Expected<LevelContents> import_level(const fs::path& file, const Affine3& placem
   }
   if (scene_bounds.empty()) scene_bounds.extend(Vec3::Zero());
 
-  // Lights: emissive rectangles and discs, then the file's punctual lights.
+  // Lights: emissive rectangles, discs and other meshes, then the file's punctual lights.
   std::set<std::string> light_names;
   const auto light_name = [&](const std::string& node) {
     std::string name = safe_name(node);
@@ -424,10 +424,16 @@ Expected<Scene> load_level_scene(const fs::path& file) {
   if (scene.objects.empty())
     return scene_error(file.string() + ": no node places a mesh, so there is nothing to bake");
   if (scene.lights.empty()) {
+    // What was left out is the reason more often than not: say how many, and the first.
+    std::string left_out;
+    if (!scene.warnings.empty())
+      left_out = fmt::format(" ({} warning(s) while reading it, the first: {})",
+                             scene.warnings.size(), scene.warnings.front());
     return scene_error(file.string() +
-                       ": holds no light shadowbake reads (KHR_lights_punctual point or spot "
-                       "lights, or emissive rectangles and discs); add one, or bake it from a "
-                       "scene file that imports it and adds [[light]] tables");
+                       ": holds no light shadowbake reads (KHR_lights_punctual point, spot or "
+                       "directional lights, or emissive meshes); add one, or bake it from a "
+                       "scene file that imports it and adds [[light]] tables" +
+                       left_out);
   }
   if (std::none_of(scene.objects.begin(), scene.objects.end(),
                    [](const ObjectDesc& o) { return o.receiver; }))

@@ -460,6 +460,49 @@ TEST_F(HandWrittenLevel, BadNodesAndEmissionAreOneLineErrors) {
   }
 }
 
+// An OBJ level (its .mtl's Ke is the emission) with a folded emissive strip of `triangles`
+// triangles 2 m over a 4 × 4 m floor.
+fs::path write_strip_obj(const fs::path& dir, int triangles) {
+  std::ofstream(dir / "strip.mtl") << "newmtl plaster\nKd 0.8 0.8 0.8\nnewmtl lamp\nKd 0 0 0\n"
+                                      "Ke 1 1 1\n";
+  const fs::path file = dir / "strip.obj";
+  std::ofstream obj(file);
+  obj << "mtllib strip.mtl\no floor\nv -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\n";
+  const int columns = triangles / 2 + 1;
+  for (int i = 0; i < columns; ++i) {
+    const double x = -1 + 2.0 * i / (columns - 1), y = 2 + 0.1 * (i % 2);  // folded
+    obj << fmt::format("v {} {} -0.2\nv {} {} 0.2\n", x, y, x, y);
+  }
+  obj << "usemtl plaster\nf 1 3 2\nf 1 4 3\no strip\nusemtl lamp\n";
+  for (int i = 0; i + 1 < columns; ++i) {
+    const int a = 5 + 2 * i, b = a + 1, c = a + 2, d = a + 3;
+    obj << fmt::format("f {} {} {}\nf {} {} {}\n", a, d, b, a, c, d);
+  }
+  return file;
+}
+
+// An emissive mesh of another shape from an OBJ is a mesh light; one of more than
+// kMaxMeshLightTriangles is left out with a warning naming it, which the error of a level left
+// with no light repeats.
+TEST_F(HandWrittenLevel, FoldedEmissiveStripIsAMeshLightUnlessTooLarge) {
+  {
+    auto scene = load_level_scene(write_strip_obj(dir_, 100));
+    ASSERT_TRUE(scene) << scene.error().message;
+    ASSERT_EQ(scene->lights.size(), 1u);
+    EXPECT_EQ(scene->lights[0].shape, LightShape::mesh);
+    EXPECT_EQ(scene->lights[0].corners.size(), 3u * 100);
+    auto baked = bake(*scene);
+    ASSERT_TRUE(baked) << baked.error().message;
+  }
+  auto scene = load_level_scene(write_strip_obj(dir_, 1100));
+  ASSERT_FALSE(scene);
+  const std::string& message = scene.error().message;
+  EXPECT_EQ(message.find('\n'), std::string::npos);
+  EXPECT_NE(message.find("holds no light"), std::string::npos) << message;
+  EXPECT_NE(message.find("node 'strip'"), std::string::npos) << message;
+  EXPECT_NE(message.find("1100 triangles, more than the 1024"), std::string::npos) << message;
+}
+
 // 100,000 instances of one mesh: read, and refused by the bake's memory check with its estimate
 // (each is a receiver with a 512² lightmap), not built until memory runs out.
 TEST_F(HandWrittenLevel, HundredThousandInstancesAreRefusedWithTheirCost) {
