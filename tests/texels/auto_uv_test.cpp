@@ -3,6 +3,8 @@
 // density gives, the mesh's faces and texture UVs kept, and a side too small for the charts.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -159,6 +161,57 @@ TEST(AutoUv, ACrackIsNotAFold) {
   auto made = generate_lightmap_uvs(m, side_target(64));
   ASSERT_TRUE(made) << made.error().message;
   EXPECT_EQ(made->charts, 1);
+}
+
+// A ramp winding `turns` turns (a helicoid, radii 0.3 to 1 m, rising 0.2 m a turn), 72 segments
+// a turn: its normals stay within 6° of up, so it grows as one smooth chart.
+Mesh helical_ramp(double turns) {
+  Mesh m;
+  m.name = "ramp";
+  const int around = int(72 * turns), across = 4;
+  std::vector<TriMesh::VertexHandle> v;
+  for (int i = 0; i <= around; ++i) {
+    const double angle = 2 * std::numbers::pi * turns * i / around;
+    const double rise = 0.2 * angle / (2 * std::numbers::pi);
+    for (int j = 0; j <= across; ++j) {
+      const double r = 0.3 + 0.7 * j / across;
+      v.push_back(
+          m.mesh.add_vertex(TriMesh::Point(r * std::cos(angle), r * std::sin(angle), rise)));
+      // The helicoid's normal: across the radial and tangential directions.
+      const Vec3 radial(std::cos(angle), std::sin(angle), 0);
+      const Vec3 along(-r * std::sin(angle), r * std::cos(angle), 0.2 / (2 * std::numbers::pi));
+      const Vec3 n = radial.cross(along).normalized();
+      m.mesh.set_normal(v.back(), TriMesh::Normal(n.x(), n.y(), n.z()));
+    }
+  }
+  std::vector<Vec2> unused;
+  const auto at = [&](int i, int j) { return v[std::size_t(i * (across + 1) + j)]; };
+  for (int i = 0; i < around; ++i)
+    for (int j = 0; j < across; ++j) {
+      add_triangle(m.mesh, at(i, j), at(i, j + 1), at(i + 1, j + 1), unused);
+      add_triangle(m.mesh, at(i, j), at(i + 1, j + 1), at(i + 1, j), unused);
+    }
+  m.mesh.update_face_normals();
+  return m;
+}
+
+// Flattened, the ramp laps over itself once it winds more than a turn: at 0.9 turns it stays one
+// chart, at 1.5 the chart folds and is cut where it does (in two, not shattered), and the layout
+// has no texel two charts claim.
+TEST(AutoUv, AChartThatFoldsIsCut) {
+  Mesh short_ramp = helical_ramp(0.9);
+  auto one = generate_lightmap_uvs(short_ramp, side_target(256));
+  ASSERT_TRUE(one) << one.error().message;
+  EXPECT_EQ(one->charts, 1);
+  Mesh m = helical_ramp(1.5);
+  auto made = generate_lightmap_uvs(m, side_target(256));
+  ASSERT_TRUE(made) << made.error().message;
+  EXPECT_EQ(made->charts, 2);
+  const TexelSpace space = rasterise_texels(m, 256, 256);
+  const UvLayoutReport layout = check_uv_layout(m, space, 4);
+  EXPECT_EQ(layout.overlapping_texels, 0);
+  EXPECT_EQ(layout.texels_near_other_charts, 0);
+  EXPECT_LT(layout.stretch, 1.05);
 }
 
 TEST(AutoUv, ChartsThatCannotFitTheSideAreAnError) {
