@@ -21,7 +21,7 @@ LightMix::LightMix(const TexelSpace& space, const std::vector<Light>& lights, Qu
     for (std::size_t i = 0; i < unreached.pixels.size(); i += 2) unreached.pixels[i] = 1.0f;
     out_.per_light_visibility.assign(outputs, unreached);
   }
-  // A mesh light's triangles are summed per texel until finish(): Σ H0·V and Σ H0.
+  // A mesh light's parts are summed per texel until finish(): Σ H0·V and Σ H0.
   if (keep_.any()) {
     std::vector<int> parts(outputs, 0);
     for (const Light& l : lights) ++parts[std::size_t(l.output())];
@@ -121,7 +121,7 @@ MixedImages LightMix::finish() {
                         }
                       });
   }
-  // A mesh light's images from its triangles' sums: V = Σ H0·V / Σ H0 per channel.
+  // A mesh light's images from its parts' sums: V = Σ H0·V / Σ H0 per channel.
   for (std::size_t o = 0; o < sums_.size(); ++o) {
     for (std::size_t t = 0; t < sums_[o].size(); ++t) {
       const Sum& sum = sums_[o][t];

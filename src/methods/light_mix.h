@@ -25,7 +25,7 @@ struct KeepPerLight {
 };
 
 // A method's values for one receiver: the combined image and, when kept, per light of the scene
-// (a mesh light's triangles together, by the same rule: V = Σ H0·V / Σ H0 over them)
+// (a mesh light's parts together, by the same rule: V = Σ H0·V / Σ H0 over them)
 //  - per_light: light l's V_l, or H0_l·V_l for irradiance, at the texels where it counts, 0
 //    elsewhere; width × height RGB, uncovered texels 0;
 //  - per_light_visibility: two channels, light l's visibility (its H0-weighted mean over colour
@@ -75,7 +75,7 @@ class LightMix {
   // empty for texel-major ones.
   std::vector<std::vector<Vec3f>> set_values_;
   std::vector<std::vector<std::uint8_t>> set_flags_;
-  // Per scene light (Light::output): its triangles' sums per texel, for a mesh light whose
+  // Per scene light (Light::output): its parts' sums per texel, for a mesh light whose
   // images are kept; empty for the others.
   std::vector<std::vector<Sum>> sums_;
 };

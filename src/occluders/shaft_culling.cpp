@@ -170,7 +170,7 @@ struct ShaftCuller::Impl {
         break;
       }
       case LightShape::mesh:
-        return false;  // baked as its triangles
+        return false;  // baked as its parts
       case LightShape::disk:
       case LightShape::sphere: {
         if (light.shape() == LightShape::disk) {

@@ -90,6 +90,9 @@ std::vector<const Mesh*> blocker_meshes(const Scene& scene, const std::vector<Me
 // The scene's lights with every sun placed for the meshes' bounds (sun_light.h).
 std::vector<LightDesc> placed_lights(const Scene& scene, const std::vector<Mesh>& meshes) {
   std::vector<LightDesc> lights = scene.lights;
+  if (std::none_of(lights.begin(), lights.end(),
+                   [](const LightDesc& l) { return l.sun_angle_deg > 0; }))
+    return lights;
   Bounds3 bounds;
   for (const Mesh& m : meshes)
     for (const auto& v : m.mesh.vertices()) {
@@ -303,10 +306,10 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     reached[r].assign(scene.lights.size(), 0);
     for (const Light& light : lights) {
       std::uint8_t& reaches = reached[r][std::size_t(light.output())];
-      for (const Texel& t : spaces.back().texels)
-        if (!reaches &&
-            (reaches = light.reaches(t.position.cast<double>(), t.normal.cast<double>())))
-          break;
+      for (const Texel& t : spaces.back().texels) {
+        if (reaches) break;  // this light, or another part of its mesh light
+        reaches = light.reaches(t.position.cast<double>(), t.normal.cast<double>());
+      }
     }
     const std::string where = object_location(scene.file, obj) + ": ";
     if (spaces.back().texels.empty()) {

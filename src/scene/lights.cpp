@@ -338,7 +338,7 @@ double Light::form_factor(const Vec3& y, const Vec3& n) const {
       return disk_form_factor(sil_centre, axis, a, axis.cross(a), sil_radius, n);
     }
     case LightShape::mesh:
-      break;  // baked as its triangles
+      break;  // baked as its parts
   }
   return 0.0;
 }

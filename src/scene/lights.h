@@ -55,7 +55,7 @@ class Light {
   // `texture`, if given, is the emission image mapped over a rectangle or disk (linear RGB or
   // grey; row 0 is the top, along `up`).
   // `output`: the index, among the scene's lights, of the light this one is or is a part of (a
-  // mesh light's triangles, make_lights): whose per-light images it adds to (LightMix).
+  // mesh light's parts, make_lights): whose per-light images it adds to (LightMix).
   explicit Light(const LightDesc& desc, std::shared_ptr<const Image> texture = nullptr,
                  int output = 0);
 
@@ -67,8 +67,8 @@ class Light {
   LightShape shape() const { return desc_.shape; }
   int output() const { return output_; }
   Vec3 centre() const { return desc_.position; }
-  // A rectangle's four corners or a triangle's three (world metres, in order around it); 0 for
-  // the round shapes.
+  // A rectangle's four corners or a polygon's three or four (world metres, in order around it;
+  // a triangle's last corner repeated in the fourth slot); 0 for the round shapes.
   int outline(std::array<Vec3, 4>& corners) const;
   // A point light: a sphere of kPointLightRadius (scene.h), whose shadows are hard.
   bool is_point() const {
@@ -94,7 +94,7 @@ class Light {
   // (per channel, tint times 1) where the line through the point along `axis` meets the light,
   // 0 where it misses. A sphere is a uniform disk of its radius.
   Vec3 source_image(const Vec3& offset, const Vec3& axis) const;
-  // Unit axes of a rectangle, disk or triangle: right = up × normal; the normal is the emitting
+  // Unit axes of a rectangle, disk or polygon: right = up × normal; the normal is the emitting
   // side.
   const Vec3& right() const { return right_; }
   const Vec3& up() const { return up_; }

@@ -140,7 +140,7 @@ PenumbraEstimator::PenumbraEstimator(const Light& light, int rows, double light_
     rows_.enter[std::size_t(r)] = middle - half;
     rows_.leave[std::size_t(r)] = middle + half;
   };
-  // A rectangle's four corners or a triangle's three (its last one twice: an edge of no length,
+  // A rectangle's or polygon's corners (a triangle's last one twice: an edge of no length,
   // which no row crosses), relative to the centre.
   std::array<Vec3, 4> outline;
   if (light.outline(outline) > 0) {

@@ -174,8 +174,8 @@ class PenumbraEstimator {
   int row_count_;
   LightRows rows_;  // all of the light (a sphere's: of the unit disk)
   double light_offset_;
-  Vec3 row_axis_s_, row_axis_t_;  // a rectangle's, disk's or triangle's frame (world)
-  std::array<Vec2, 4> corners_;   // a rectangle's or triangle's corners in (s, t)
+  Vec3 row_axis_s_, row_axis_t_;  // a rectangle's, disk's or polygon's frame (world)
+  std::array<Vec2, 4> corners_;   // a rectangle's or polygon's corners in (s, t)
 };
 
 // The angle between a light's own axes and its rows, radians: far from 0°, 45° and 90°, the

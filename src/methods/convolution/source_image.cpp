@@ -120,14 +120,14 @@ SourceKernel source_kernel(const Light& light, const ProjectionFrame& frame,
   Vec3 axis_u = light.right(), axis_v = light.up();
   double extent_u = light.desc().width, extent_v = light.desc().height;
   const bool round = light.shape() == LightShape::disk || light.shape() == LightShape::sphere;
-  const bool triangle = light.shape() == LightShape::polygon;
+  const bool polygon = light.shape() == LightShape::polygon;
   if (round) {
     extent_u = extent_v = 2 * light.desc().radius;
     if (light.shape() == LightShape::sphere) {
       axis_u = along.unitOrthogonal();
       axis_v = along.cross(axis_u);
     }
-  } else if (triangle) {  // its box about the centre, cells outside it left out
+  } else if (polygon) {  // its box about the centre, cells outside it left out
     const Vec2 half = light.half_extents(axis_u, axis_v);
     extent_u = 2 * half.x();
     extent_v = 2 * half.y();
@@ -153,8 +153,7 @@ SourceKernel source_kernel(const Light& light, const ProjectionFrame& frame,
     for (int i = 0; i < nu; ++i) {
       const double a = ((i + 0.5) / nu - 0.5) * extent_u;
       if (round && a * a + b * b > 0.25 * extent_u * extent_u) continue;
-      if (triangle && light.source_image(a * axis_u + b * axis_v, light.normal()).isZero())
-        continue;
+      if (polygon && light.source_image(a * axis_u + b * axis_v, light.normal()).isZero()) continue;
       const double z = a * zu + b * zv;
       if (r - z <= 1e-9 * r) continue;  // at or beyond the receiver's depth
       const double stretch = r / (r - z);
