@@ -67,6 +67,7 @@ struct BakeArgs {
   std::optional<std::string> method, quantity;
   std::optional<int> resolution, samples;
   std::optional<double> texels_per_metre;
+  std::optional<double> ao_distance;
   std::optional<std::string> encoding;
   std::optional<int> atlas_size, atlas_padding;
   bool per_light = false, shadowmask = false, gltf = false, no_atlas = false;
@@ -103,13 +104,25 @@ int bake_scene(const BakeArgs& args, const std::string& scene_file, const std::s
     spec->balance = args.balance;
     shard = *spec;
   }
-  auto scene = sb::load_scene(scene_file);
+  // Ambient occlusion asked for here needs no light in the file.
+  const bool ambient_occlusion =
+      args.quantity == "ambient-occlusion" || args.method == "ambient-occlusion";
+  auto scene = sb::load_scene(scene_file, !ambient_occlusion);
   if (!scene) return fail(scene.error());
   auto& settings = scene->bake;
   if (args.method) settings.method = *args.method;
-  if (args.quantity)
-    settings.quantity =
-        *args.quantity == "irradiance" ? sb::Quantity::irradiance : sb::Quantity::visibility;
+  if (args.quantity) {
+    settings.quantity = *args.quantity == "irradiance"          ? sb::Quantity::irradiance
+                        : *args.quantity == "ambient-occlusion" ? sb::Quantity::ambient_occlusion
+                                                                : sb::Quantity::visibility;
+  }
+  if (args.quantity || args.method) {
+    if (sb::Status paired = sb::pair_quantity_and_method(
+            settings, args.quantity.has_value(), args.method.has_value(), "--quantity/--method");
+        !paired)
+      return fail(paired.error());
+  }
+  if (args.ao_distance) settings.ao_distance = *args.ao_distance;
   if (args.resolution) {
     settings.resolution = *args.resolution;
     settings.texels_per_metre = 0;
@@ -259,6 +272,7 @@ Runner add_bake_command(CLI::App& app) {
     int resolution = 0, samples = 0;
     std::int64_t seed = 0;
     double error_texels = 1;
+    double ao_distance = 10;
     std::string max_memory;
     double texels_per_metre = 0;
     std::string encoding, shard, balance;
@@ -281,8 +295,15 @@ Runner add_bake_command(CLI::App& app) {
   auto* method_opt =
       bake->add_option("--method", o->method, "bake method (overrides [bake] method)")
           ->check(CLI::IsMember(sb::known_methods()));
-  auto* quantity_opt = bake->add_option("--quantity", o->quantity, "visibility or irradiance")
-                           ->check(CLI::IsMember({"visibility", "irradiance"}));
+  auto* quantity_opt =
+      bake->add_option("--quantity", o->quantity,
+                       "visibility, irradiance or ambient-occlusion (overrides [bake] quantity)")
+          ->check(CLI::IsMember({"visibility", "irradiance", "ambient-occlusion"}));
+  auto* ao_distance_opt =
+      bake->add_option("--ao-distance", o->ao_distance,
+                       "ambient occlusion: metres within which a blocker occludes (overrides "
+                       "[bake] ao_distance)")
+          ->check(CLI::Range(1e-6, 1e6));
   auto* resolution_opt = bake->add_option("--resolution", o->resolution, "texels per side")
                              ->check(CLI::Range(1, 16384));
   auto* density_opt =
@@ -344,6 +365,7 @@ Runner add_bake_command(CLI::App& app) {
   return [=]() {
     if (*method_opt) o->args.method = o->method;
     if (*quantity_opt) o->args.quantity = o->quantity;
+    if (*ao_distance_opt) o->args.ao_distance = o->ao_distance;
     if (*resolution_opt) o->args.resolution = o->resolution;
     if (*density_opt) o->args.texels_per_metre = o->texels_per_metre;
     if (!o->shard.empty()) o->args.shard = o->shard;

@@ -1,6 +1,8 @@
 #include "core/sampling.h"
 
+#include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <numeric>
 
 namespace sb {
@@ -36,6 +38,12 @@ void stratified_samples(int count, Rng& rng, std::vector<Vec2>& out) {
     const int i = order[k] % nx, j = order[k] / nx;
     out.emplace_back((i + rng.next_double()) / nx, (j + rng.next_double()) / ny);
   }
+}
+
+Vec3 cosine_direction(const Vec3& n, const Vec2& u) {
+  const double r = std::sqrt(u.x()), phi = 2.0 * std::numbers::pi * u.y();
+  const Vec3 a = n.unitOrthogonal(), b = n.cross(a);
+  return r * std::cos(phi) * a + r * std::sin(phi) * b + std::sqrt(std::max(0.0, 1.0 - u.x())) * n;
 }
 
 }  // namespace sb

@@ -40,4 +40,9 @@ std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t a, std::uint64_t b =
 // estimate stays unbiased.
 void stratified_samples(int count, Rng& rng, std::vector<Vec2>& out);
 
+// The unit direction that u ∈ [0,1)² maps to under cosine-weighted sampling of the hemisphere
+// about unit n (Malley's method: a uniform point of the unit disk lifted onto the hemisphere), so
+// its density is cos θ / π; stratified u give stratified directions.
+Vec3 cosine_direction(const Vec3& n, const Vec2& u);
+
 }  // namespace sb

@@ -10,7 +10,7 @@
 namespace sb {
 
 double encoding_scale(Encoding encoding, Quantity quantity, double peak) {
-  if (quantity == Quantity::visibility || !(peak > 0) || !std::isfinite(peak)) return 1.0;
+  if (quantity != Quantity::irradiance || !(peak > 0) || !std::isfinite(peak)) return 1.0;
   switch (encoding) {
     case Encoding::linear_exr:
     case Encoding::half_exr:

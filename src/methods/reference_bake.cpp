@@ -3,7 +3,9 @@
 // light, one shadow ray each; the light's visibility is the ratio estimate Σ w·v / Σ w (lights.cpp
 // says why), per colour channel with w scaled by the light's texture at the sample, its
 // unoccluded irradiance H0 is exact (for a textured light, see Light::unoccluded_irradiance),
-// and H = H0 · V. Parallel over texels with
+// and H = H0 · V. A sky is estimated as itself, not as its parts: rays over the whole sky
+// (occluders/sky_rays.h), its H0 and V from the same directions, added as its first part's.
+// Parallel over texels with
 // oneTBB; each texel has its own random stream, so the result is the same for any thread count.
 #include "methods/reference_bake.h"
 
@@ -11,6 +13,7 @@
 #include <tbb/parallel_for.h>
 
 #include "occluders/shadow_rays.h"
+#include "occluders/sky_rays.h"
 
 namespace sb {
 
@@ -21,32 +24,45 @@ MixedImages bake_reference(const TexelSpace& space, const ReferenceInputs& in,
   LightMix mix(space, lights, in.quantity, LightMix::Order::texel_major, in.keep_per_light);
   std::atomic<std::int64_t> traced{0};
 
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, space.texels.size(), 64),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      std::vector<Vec2> strata;
-                      ShadowRays batch(in.samples);
-                      std::int64_t local_rays = 0;
-                      for (std::size_t t = range.begin(); t != range.end(); ++t) {
-                        const Texel& texel = space.texels[t];
-                        LightMix::Sum sum;
-                        for (std::size_t l = 0; l < lights.size(); ++l) {
-                          const Vec3 h0 = mix.unoccluded(l, t);
-                          if (h0.maxCoeff() <= 0) continue;
-                          Vec3 v;
-                          if (!estimate_visibility(texel, lights[l], rays, in.samples, in.seed,
-                                                   in.stream, space.width, batch, strata, &v))
-                            continue;
-                          local_rays += batch.size();
-                          mix.add(sum, l, t, h0, v);
-                        }
-                        mix.write(t, sum);
-                      }
-                      traced += local_rays;
-                      if (in.texels_done) {
-                        const auto done = (*in.texels_done += std::int64_t(range.size()));
-                        if (in.progress) in.progress(double(done));
-                      }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, space.texels.size(), 64),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        std::vector<Vec2> strata;
+        ShadowRays batch(in.samples);
+        SkyRays sky_rays;
+        std::int64_t local_rays = 0;
+        for (std::size_t t = range.begin(); t != range.end(); ++t) {
+          const Texel& texel = space.texels[t];
+          LightMix::Sum sum;
+          for (std::size_t l = 0; l < lights.size(); ++l) {
+            if (const Sky* sky = lights[l].sky()) {
+              // The whole sky at its first part; its other parts add nothing.
+              if (l > 0 && lights[l - 1].sky() == sky) continue;
+              Vec3 h0, v;
+              if (estimate_sky(texel, *sky, rays, in.samples, in.seed,
+                               stream_seed(in.stream, lights[l].stream()), space.width,
+                               (lights[l].centre() - texel.position.cast<double>()).norm(),
+                               sky_rays, &h0, &v, &local_rays))
+                mix.add(sum, l, t, h0, v);
+              continue;
+            }
+            const Vec3 h0 = mix.unoccluded(l, t);
+            if (h0.maxCoeff() <= 0) continue;
+            Vec3 v;
+            if (!estimate_visibility(texel, lights[l], rays, in.samples, in.seed, in.stream,
+                                     space.width, batch, strata, &v))
+              continue;
+            local_rays += batch.size();
+            mix.add(sum, l, t, h0, v);
+          }
+          mix.write(t, sum);
+        }
+        traced += local_rays;
+        if (in.texels_done) {
+          const auto done = (*in.texels_done += std::int64_t(range.size()));
+          if (in.progress) in.progress(double(done));
+        }
+      });
   if (rays_traced) *rays_traced += traced.load();
   return mix.finish();
 }

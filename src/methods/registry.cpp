@@ -1,4 +1,5 @@
 // The registry of bake methods: a new method adds its entry here (one line) and its own files.
+#include "methods/ambient_occlusion.h"
 #include "methods/backprojection/backprojection_method.h"
 #include "methods/baselines.h"
 #include "methods/convolution/traced_convolution.h"
@@ -9,9 +10,10 @@ namespace sb {
 
 const std::vector<MethodEntry>& method_registry() {
   static const std::vector<MethodEntry> entries = {
-      backprojection_method(),  convolution_method(),         accumulation_method(),
-      shadow_map_method("pcf"), shadow_map_method("pcss"),    shadow_map_method("adaptive-pcf"),
-      erosion_method(),         shadow_map_method("chun-oh"), reference_method(),
+      backprojection_method(),    convolution_method(),         accumulation_method(),
+      shadow_map_method("pcf"),   shadow_map_method("pcss"),    shadow_map_method("adaptive-pcf"),
+      erosion_method(),           shadow_map_method("chun-oh"), reference_method(),
+      ambient_occlusion_method(),
   };
   return entries;
 }

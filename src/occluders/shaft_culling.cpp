@@ -170,6 +170,7 @@ struct ShaftCuller::Impl {
         break;
       }
       case LightShape::mesh:
+      case LightShape::sky:
         return false;  // baked as its parts
       case LightShape::disk:
       case LightShape::sphere: {

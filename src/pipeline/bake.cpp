@@ -26,6 +26,7 @@
 #include "scene/lights.h"
 #include "scene/mesh.h"
 #include "scene/mesh_reader.h"
+#include "scene/sky.h"
 #include "scene/sun_light.h"
 #include "texels/auto_uv.h"
 #include "texels/lightmap_sizes.h"
@@ -87,12 +88,13 @@ std::vector<const Mesh*> blocker_meshes(const Scene& scene, const std::vector<Me
   return blockers;
 }
 
-// The scene's lights with every sun placed for the meshes' bounds (sun_light.h).
+// The scene's lights with every sun and sky placed for the meshes' bounds (sun_light.h, sky.h).
 std::vector<LightDesc> placed_lights(const Scene& scene, const std::vector<Mesh>& meshes) {
   std::vector<LightDesc> lights = scene.lights;
-  if (std::none_of(lights.begin(), lights.end(),
-                   [](const LightDesc& l) { return l.sun_angle_deg > 0; }))
-    return lights;
+  const auto at_infinity = [](const LightDesc& l) {
+    return l.sun_angle_deg > 0 || l.shape == LightShape::sky;
+  };
+  if (std::none_of(lights.begin(), lights.end(), at_infinity)) return lights;
   Bounds3 bounds;
   for (const Mesh& m : meshes)
     for (const auto& v : m.mesh.vertices()) {
@@ -100,8 +102,10 @@ std::vector<LightDesc> placed_lights(const Scene& scene, const std::vector<Mesh>
       bounds.extend(Vec3(p[0], p[1], p[2]));
     }
   if (bounds.empty()) return lights;
-  for (LightDesc& l : lights)
+  for (LightDesc& l : lights) {
     if (l.sun_angle_deg > 0) place_sun(l, bounds);
+    if (l.shape == LightShape::sky) place_sky(l, bounds);
+  }
   return lights;
 }
 
@@ -148,7 +152,7 @@ std::vector<SeamImage> seam_images(const Scene& scene, ReceiverBake& out, const 
 // What a seam's lookup difference is measured against (SeamReport): 1 for a visibility, the
 // image's largest value for an irradiance (1 where it is black).
 double seam_scale(const Scene& scene, const Image& image) {
-  if (scene.bake.quantity == Quantity::visibility || image.pixels.empty()) return 1.0;
+  if (scene.bake.quantity != Quantity::irradiance || image.pixels.empty()) return 1.0;
   const float largest = *std::max_element(image.pixels.begin(), image.pixels.end());
   return largest > 0 ? double(largest) : 1.0;
 }
@@ -215,6 +219,21 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     return scene_error(scene.file.string() + ": [bake]: unknown method '" + scene.bake.method +
                        "' (known: " + known + ")");
   }
+  const bool ambient_occlusion = scene.bake.quantity == Quantity::ambient_occlusion;
+  {
+    BakeSettings settings = scene.bake;
+    if (Status paired =
+            pair_quantity_and_method(settings, true, true, scene.file.string() + ": [bake]");
+        !paired)
+      return paired.error();
+  }
+  if (ambient_occlusion && (scene.output.per_light || scene.output.shadowmask))
+    return scene_error(scene.file.string() +
+                       ": [output]: per-light images and shadow masks are images of lights; an "
+                       "ambient-occlusion bake has none (leave out per_light and shadowmask)");
+  if (!ambient_occlusion && scene.lights.empty())
+    return scene_error(scene.file.string() + ": no light: a " + to_string(scene.bake.quantity) +
+                       " bake needs at least one (an ambient-occlusion bake needs none)");
   const std::string advice =
       scene.bake.texels_per_metre > 0
           ? "lower 'texels_per_metre' (--texels-per-metre) or raise max_memory (--max-memory)"
@@ -304,11 +323,11 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     layouts.push_back(check_uv_layout(meshes[i], spaces.back(), scene.bake.margin));
     // Which lights reach any of its texels (for the warning about lights that reach nothing).
     reached[r].assign(scene.lights.size(), 0);
-    for (const Light& light : lights) {
-      std::uint8_t& reaches = reached[r][std::size_t(light.output())];
+    for (std::size_t l = 0; !ambient_occlusion && l < lights.size(); ++l) {
+      std::uint8_t& reaches = reached[r][std::size_t(lights[l].output())];
       for (const Texel& t : spaces.back().texels) {
         if (reaches) break;  // this light, or another part of its mesh light
-        reaches = light.reaches(t.position.cast<double>(), t.normal.cast<double>());
+        reaches = lights[l].reaches(t.position.cast<double>(), t.normal.cast<double>());
       }
     }
     const std::string where = object_location(scene.file, obj) + ": ";
@@ -416,7 +435,8 @@ void finish_bake(const Scene& scene, BakeResult& result, bool whole) {
   // most often a normal pointing the wrong way: say so.
   std::int64_t texels = 0;
   for (const ReceiverBake& r : result.receivers) texels += r.covered_texels;
-  for (std::size_t l = 0; whole && texels > 0 && l < scene.lights.size(); ++l) {
+  const bool lit = scene.bake.quantity != Quantity::ambient_occlusion;
+  for (std::size_t l = 0; whole && lit && texels > 0 && l < scene.lights.size(); ++l) {
     bool reached = false;
     for (const ReceiverBake& r : result.receivers)
       reached = reached || (l < r.lights_reached.size() && r.lights_reached[l]);

@@ -79,8 +79,10 @@ class FieldReader {
   void read(const char* key, Quantity& out) {
     std::string text;
     read(key, text);
-    if (status_ && !parse_enum(text, {Quantity::visibility, Quantity::irradiance}, out))
-      fail(key, "\"visibility\" or \"irradiance\"");
+    if (status_ &&
+        !parse_enum(text, {Quantity::visibility, Quantity::irradiance, Quantity::ambient_occlusion},
+                    out))
+      fail(key, "\"visibility\", \"irradiance\" or \"ambient-occlusion\"");
   }
   void read(const char* key, Encoding& out) {
     std::string text;
@@ -96,9 +98,9 @@ class FieldReader {
     read(key, text);
     if (status_ && !parse_enum(text,
                                {LightShape::rectangle, LightShape::disk, LightShape::sphere,
-                                LightShape::polygon, LightShape::mesh},
+                                LightShape::polygon, LightShape::mesh, LightShape::sky},
                                out))
-      fail(key, "\"rectangle\", \"disk\", \"sphere\", \"polygon\" or \"mesh\"");
+      fail(key, "\"rectangle\", \"disk\", \"sphere\", \"polygon\", \"mesh\" or \"sky\"");
   }
   template <typename T>
   void read_optional(const char* key, std::optional<T>& out) {

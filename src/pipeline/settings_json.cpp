@@ -68,6 +68,7 @@ json settings_to_json(const BakeSettings& b, const OutputSettings& o) {
                {"method", b.method},
                {"quantity", to_string(b.quantity)},
                {"samples", b.samples},
+               {"ao_distance", b.ao_distance},
                {"margin", b.margin},
                {"seams", b.seams},
                {"seed", b.seed},
@@ -106,7 +107,9 @@ Status settings_from_json(const json& j, const std::string& where, BakeSettings&
   r.read("resolution", b.resolution);
   r.read("texels_per_metre", b.texels_per_metre);
   r.read("method", b.method);
-  r.read_enum("quantity", b.quantity, {Quantity::visibility, Quantity::irradiance});
+  r.read_enum("quantity", b.quantity,
+              {Quantity::visibility, Quantity::irradiance, Quantity::ambient_occlusion});
+  r.read("ao_distance", b.ao_distance);
   r.read("samples", b.samples);
   r.read("margin", b.margin);
   r.read("seams", b.seams);

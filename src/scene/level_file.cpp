@@ -413,7 +413,7 @@ Expected<LevelContents> import_level(const fs::path& file, const Affine3& placem
   return level;
 }
 
-Expected<Scene> load_level_scene(const fs::path& file) {
+Expected<Scene> load_level_scene(const fs::path& file, bool need_lights) {
   Scene scene;
   scene.file = file;
   auto level = import_level(file, Affine3::Identity(), 0);
@@ -423,7 +423,7 @@ Expected<Scene> load_level_scene(const fs::path& file) {
   scene.warnings = std::move(level->warnings);
   if (scene.objects.empty())
     return scene_error(file.string() + ": no node places a mesh, so there is nothing to bake");
-  if (scene.lights.empty()) {
+  if (scene.lights.empty() && need_lights) {
     // What was left out is the reason more often than not: say how many, and the first.
     std::string left_out;
     if (!scene.warnings.empty())

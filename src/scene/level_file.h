@@ -59,6 +59,6 @@ bool is_level_file(const std::filesystem::path& file);
 
 // A scene of one level file alone: the default [bake] and [output] settings, the file's objects
 // and lights. Errors as load_scene's.
-Expected<Scene> load_level_scene(const std::filesystem::path& file);
+Expected<Scene> load_level_scene(const std::filesystem::path& file, bool need_lights = true);
 
 }  // namespace sb

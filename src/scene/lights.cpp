@@ -23,6 +23,7 @@
 #include <numbers>
 
 #include "core/image_io.h"
+#include "scene/sky.h"
 
 namespace sb {
 
@@ -148,8 +149,9 @@ double polygon_form_factor(const Vec3* polygon, int count, const Vec3& n) {
   return std::abs(sum) / (2.0 * kPi);
 }
 
-Light::Light(const LightDesc& desc, std::shared_ptr<const Image> texture, int output)
-    : desc_(desc), output_(output), texture_(std::move(texture)) {
+Light::Light(const LightDesc& desc, std::shared_ptr<const Image> texture, int output,
+             std::shared_ptr<const Sky> sky)
+    : desc_(desc), output_(output), texture_(std::move(texture)), sky_(std::move(sky)) {
   if (desc_.shape == LightShape::polygon &&
       (desc_.corners.size() == 3 || desc_.corners.size() == 4)) {
     // Its plane from its corners, counter-clockwise seen from the emitting side (the fan from
@@ -165,7 +167,8 @@ Light::Light(const LightDesc& desc, std::shared_ptr<const Image> texture, int ou
     desc_.normal = normal.normalized();
     desc_.up = (c[0] - desc_.position).normalized();
   }
-  if (desc_.shape == LightShape::sphere || desc_.shape == LightShape::mesh) {
+  if (desc_.shape == LightShape::sphere || desc_.shape == LightShape::mesh ||
+      desc_.shape == LightShape::sky) {
     up_ = Vec3::UnitZ();
     right_ = Vec3::UnitX();
   } else {
@@ -231,6 +234,7 @@ double Light::extent_across(const Vec3& axis) const {
       return longest;
     }
     case LightShape::mesh:
+    case LightShape::sky:
       break;
   }
   return 0;
@@ -253,6 +257,7 @@ Vec2 Light::half_extents(const Vec3& e1, const Vec3& e2) const {
         return half;
       }
       case LightShape::mesh:
+      case LightShape::sky:
         break;
     }
     return 0.0;
@@ -310,6 +315,8 @@ double Light::area() const {
         sum += 0.5 * (c[k + 1] - c[k]).cross(c[k + 2] - c[k]).norm();
       return sum;
     }
+    case LightShape::sky:
+      break;  // baked as its parts
   }
   return 0;
 }
@@ -338,6 +345,7 @@ double Light::form_factor(const Vec3& y, const Vec3& n) const {
       return disk_form_factor(sil_centre, axis, a, axis.cross(a), sil_radius, n);
     }
     case LightShape::mesh:
+    case LightShape::sky:
       break;  // baked as its parts
   }
   return 0.0;
@@ -385,6 +393,7 @@ bool Light::reaches(const Vec3& y, const Vec3& n) const {
       return n.dot(sil_centre) + sil_radius * (n - n.dot(axis) * axis).norm() > 0;
     }
     case LightShape::mesh:
+    case LightShape::sky:
       break;
   }
   return false;
@@ -466,6 +475,7 @@ LightSample Light::sample(const Vec3& y, const Vec3& n, const Vec2& u) const {
       return s;
     }
     case LightShape::mesh:
+    case LightShape::sky:
       break;
   }
   return s;
@@ -488,6 +498,7 @@ bool Light::partly_below_horizon(const Vec3& y, const Vec3& n) const {
       return lowest < 0;
     }
     case LightShape::mesh:
+    case LightShape::sky:
       break;
   }
   return true;
@@ -534,6 +545,7 @@ HorizonPart Light::above_horizon(const Vec3& y, const Vec3& n) const {
       break;
     }
     case LightShape::mesh:
+    case LightShape::sky:
       break;
   }
   const std::vector<Vec3> clipped = clip_to_horizon(outline, n);
@@ -596,6 +608,15 @@ Expected<std::vector<Light>> make_lights(const std::vector<LightDesc>& descs,
   lights.reserve(descs.size());
   for (const auto& d : descs) {
     std::shared_ptr<const Image> texture;
+    const int output = int(&d - descs.data());
+    if (d.shape == LightShape::sky) {
+      auto sky = make_sky(d, scene_file);
+      if (!sky) return sky.error();
+      const double distance = d.radius > 0 ? d.radius : 1e4;
+      for (const LightDesc& part : (*sky)->parts(d, d.position, distance, d.sky_parts))
+        lights.emplace_back(part, nullptr, output, *sky);
+      continue;
+    }
     if (!d.texture.empty()) {
       auto image = read_image(d.texture, /*linearise=*/true);
       const std::string where = scene_file.string() + ":" + std::to_string(d.line) + ": light '" +
@@ -606,7 +627,6 @@ Expected<std::vector<Light>> make_lights(const std::vector<LightDesc>& descs,
       }
       texture = std::make_shared<const Image>(std::move(*image));
     }
-    const int output = int(&d - descs.data());
     if (d.shape == LightShape::mesh) {
       for (const LightDesc& part : mesh_light_parts(d)) lights.emplace_back(part, nullptr, output);
     } else {

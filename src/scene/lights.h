@@ -24,6 +24,7 @@ struct LightSample {
 };
 
 class Light;
+class Sky;
 
 // The part of a light above the horizon of a point (Light::above_horizon), for the reference's
 // samples: where the whole light is above, sample() as it is; where the horizon cuts it, the
@@ -56,8 +57,9 @@ class Light {
   // grey; row 0 is the top, along `up`).
   // `output`: the index, among the scene's lights, of the light this one is or is a part of (a
   // mesh light's parts, make_lights): whose per-light images it adds to (LightMix).
+  // `sky`: the sky this light is a part of (make_lights), whose own rays the reference traces.
   explicit Light(const LightDesc& desc, std::shared_ptr<const Image> texture = nullptr,
-                 int output = 0);
+                 int output = 0, std::shared_ptr<const Sky> sky = nullptr);
 
   const LightDesc& desc() const { return desc_; }
   // The light's own random streams' key, from its name alone: a light is sampled the same way
@@ -66,6 +68,8 @@ class Light {
   std::uint64_t stream() const { return stream_; }
   LightShape shape() const { return desc_.shape; }
   int output() const { return output_; }
+  // The sky this light is a part of, or null.
+  const Sky* sky() const { return sky_.get(); }
   Vec3 centre() const { return desc_.position; }
   // A rectangle's four corners or a polygon's three or four (world metres, in order around it;
   // a triangle's last corner repeated in the fourth slot); 0 for the round shapes.
@@ -137,11 +141,13 @@ class Light {
   std::uint64_t stream_ = 0;
   Vec3 exitance_;
   std::shared_ptr<const Image> texture_;
+  std::shared_ptr<const Sky> sky_;
 };
 
 // The scene's lights, with their textures read (through OpenImageIO, sRGB decoded to linear),
-// in scene order; a mesh light is its parts (mesh_light_parts), all with the mesh light's output
-// index. An unreadable texture is an error naming scene_file, the light and the image.
+// in scene order; a mesh light is its parts (mesh_light_parts), a sky its (Sky::parts, about its
+// position at its radius: place_sky), each part with its light's output index. An unreadable
+// texture is an error naming scene_file, the light and the image.
 Expected<std::vector<Light>> make_lights(const std::vector<LightDesc>& descs,
                                          const std::filesystem::path& scene_file);
 // How many of the scene's lights `lights` (from make_lights) stand for: the per-light images.

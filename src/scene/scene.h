@@ -16,7 +16,10 @@
 
 namespace sb {
 
-enum class Quantity { visibility, irradiance };
+// visibility V = H / H0 and irradiance H of the lights (methods/light_mix.h); ambient occlusion,
+// the cosine-weighted open fraction of the hemisphere within [bake] ao_distance, no light taking
+// part (methods/ambient_occlusion.h; baked by the method of that name alone).
+enum class Quantity { visibility, irradiance, ambient_occlusion };
 
 // How the occluded fractions O_i of different blocker clusters over one texel combine
 // (docs/design.md §5): `product` takes V = ∏(1 − O_i), clusters hiding independent parts of the
@@ -46,8 +49,10 @@ struct BakeSettings {
   double texels_per_metre = 0;
   std::string method = "backprojection";
   Quantity quantity = Quantity::visibility;
-  int samples = 256;  // light samples per texel, for sampling methods
-  int margin = 4;     // texels of dilation around UV charts
+  int samples = 256;  // light samples per texel, for sampling methods (rays, for ambient occlusion)
+  // ambient occlusion: metres along a ray within which a blocker occludes it (Blender's default)
+  double ao_distance = 10.0;
+  int margin = 4;  // texels of dilation around UV charts
   // After dilation, adjust the texels along UV seams so that bilinear lookups on the two sides
   // agree (texels/seams.h); false leaves them as baked, and only measures the seams.
   bool seams = true;
@@ -113,7 +118,9 @@ struct ObjectDesc {
 // emissive mesh of a level that is no planar rectangle or disc) is its triangles, baked as
 // polygons (make_lights, scene/lights.h): every method bakes polygons, and a mesh light's
 // outputs are its parts' combined by the one rule of methods/light_mix.h.
-enum class LightShape { rectangle, disk, sphere, polygon, mesh };
+// A sky (scene/sky.h) is light from every direction at infinity, uniform or an environment map;
+// like a mesh light it is baked as polygon parts (make_lights), a sphere of them far away.
+enum class LightShape { rectangle, disk, sphere, polygon, mesh, sky };
 
 // A point light (a sphere light of radius 0 in a scene file, a level's point and spot lights) is
 // baked as a sphere of this radius, for every method: its penumbra, 10⁻⁵ m times a blocker's
@@ -126,6 +133,10 @@ inline constexpr double kPointLightRadius = 1e-5;
 // (Blender's default spot blend).
 inline constexpr double kSpotBlend = 0.15;
 
+// The polygons a sky is baked as unless its light says otherwise (scene/sky.h): an icosahedron's
+// 20 faces split by flux up to this many (exact for a uniform sky at any number).
+inline constexpr int kSkyParts = 80;
+
 struct LightDesc {
   std::string name;
   LightShape shape = LightShape::rectangle;
@@ -137,7 +148,7 @@ struct LightDesc {
   double radius = 0;              // disk and sphere; metres (kPointLightRadius for a point)
   Vec3 color = Vec3(1, 1, 1);     // per-channel scale of the emitted power
   double power = 0;               // watts (for colour (1,1,1) and a white texture)
-  std::filesystem::path texture;  // optional emission image over a rectangle or disk; resolved
+  std::filesystem::path texture;  // emission image over a rectangle or disk, a sky's map; resolved
   // The shadow mask's reach (metres from the light's surface): beyond it the light's channel may
   // be given to another light (lightmaps/shadowmask.h). Infinite: wherever the light reaches.
   // The bake itself does not cut the light off.
@@ -153,6 +164,13 @@ struct LightDesc {
   // metres, counter-clockwise seen from the side they emit into (a mesh light's `position` is its
   // area-weighted centroid, `normal` and `up` unused). Empty for other shapes.
   std::vector<Vec3> corners;
+  // A sky: radiance color · sky_strength W/m²/sr (Blender's Background colour and Strength),
+  // times its map (`texture`, equirectangular) where it has one, the map turned by
+  // sky_rotation_deg about +Z; baked as up to sky_parts polygons (scene/sky.h) on the sphere of
+  // `radius` metres about `position`, which the bake places for the scene (place_sky).
+  double sky_strength = 1;
+  double sky_rotation_deg = 0;
+  int sky_parts = kSkyParts;
   int line = 0;
 };
 
@@ -200,7 +218,16 @@ struct Scene {
 // Reads and validates a scene file. Every problem is an Error naming the file, the line, the item
 // and what is wrong; unknown keys are errors, not ignored. A file that is not .toml is a level
 // (level_file.h), baked alone with the default settings.
-Expected<Scene> load_scene(const std::filesystem::path& file);
+// `need_lights` false: a scene without lights is no error (an ambient-occlusion bake's, which the
+// command line may ask for on a file that says nothing of it).
+Expected<Scene> load_scene(const std::filesystem::path& file, bool need_lights = true);
+
+// Quantity "ambient-occlusion" is baked by method "ambient-occlusion" and that method bakes only
+// it: makes the two agree where one of them was left at its default (`quantity_given`,
+// `method_given`: whether the scene or command line set them), else an error "<where>: ..."
+// naming both.
+Status pair_quantity_and_method(BakeSettings& bake, bool quantity_given, bool method_given,
+                                const std::string& where);
 
 // "file:line: object 'name'", where messages about an object start; "file: object 'name'" for an
 // object of a level baked alone (line 0: no scene file line stands for it).

@@ -34,6 +34,8 @@ const char* to_string(Quantity q) {
       return "visibility";
     case Quantity::irradiance:
       return "irradiance";
+    case Quantity::ambient_occlusion:
+      return "ambient-occlusion";
   }
   return "?";
 }
@@ -50,8 +52,30 @@ const char* to_string(LightShape s) {
       return "polygon";
     case LightShape::mesh:
       return "mesh";
+    case LightShape::sky:
+      return "sky";
   }
   return "?";
+}
+
+Status pair_quantity_and_method(BakeSettings& bake, bool quantity_given, bool method_given,
+                                const std::string& where) {
+  constexpr const char* ao = "ambient-occlusion";
+  const bool ao_quantity = bake.quantity == Quantity::ambient_occlusion;
+  const bool ao_method = bake.method == ao;
+  if (ao_quantity == ao_method) return Ok{};
+  if (ao_quantity && !method_given) {
+    bake.method = ao;
+    return Ok{};
+  }
+  if (ao_method && !quantity_given) {
+    bake.quantity = Quantity::ambient_occlusion;
+    return Ok{};
+  }
+  return scene_error(fmt::format(
+      "{}: quantity '{}' and method '{}' do not go together: ambient occlusion is baked by "
+      "method 'ambient-occlusion', which bakes nothing else",
+      where, to_string(bake.quantity), bake.method));
 }
 
 Affine3 object_transform(const Vec3& translate, const Vec3& rotate_deg, const Vec3& scale) {
@@ -160,8 +184,8 @@ Status add_unique(const std::filesystem::path& file, const char* kind, std::vect
 
 }  // namespace
 
-Expected<Scene> load_scene(const std::filesystem::path& file) {
-  if (is_level_file(file)) return load_level_scene(file);
+Expected<Scene> load_scene(const std::filesystem::path& file, bool need_lights) {
+  if (is_level_file(file)) return load_level_scene(file, need_lights);
   Expected<std::string> text = read_text(file);
   if (!text) return text.error();
 
@@ -235,7 +259,7 @@ Expected<Scene> load_scene(const std::filesystem::path& file) {
   if (scene.objects.empty()) {
     return located_error(file, 0, "scene", "no [[object]] table; a scene needs at least one");
   }
-  if (scene.lights.empty()) {
+  if (scene.lights.empty() && need_lights && scene.bake.quantity != Quantity::ambient_occlusion) {
     return located_error(
         file, 0, "scene",
         "no light: no [[light]] table, and no light imported; a scene needs at least one");

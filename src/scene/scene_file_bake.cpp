@@ -14,6 +14,7 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
                       "method",
                       "quantity",
                       "samples",
+                      "ao_distance",
                       "margin",
                       "seams",
                       "seed",
@@ -59,9 +60,15 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
       bake.quantity = Quantity::visibility;
     } else if (*v == "irradiance") {
       bake.quantity = Quantity::irradiance;
+    } else if (*v == "ambient-occlusion") {
+      bake.quantity = Quantity::ambient_occlusion;
     } else {
-      r.fail_got("quantity", "\"visibility\" or \"irradiance\"");
+      r.fail_got("quantity", "\"visibility\", \"irradiance\" or \"ambient-occlusion\"");
     }
+  }
+  if (auto v = r.number("ao_distance", "a number > 0 (metres)",
+                        [](double x) { return std::isfinite(x) && x > 0 && x <= 1e6; })) {
+    bake.ao_distance = *v;
   }
   if (auto v = r.integer("samples", 1, int_max)) bake.samples = static_cast<int>(*v);
   if (auto v = r.integer("margin", 0, int_max)) bake.margin = static_cast<int>(*v);
@@ -138,6 +145,15 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
     }
   }
   if (r.failed()) return r.error();
+  // Where a mismatch of quantity and method is reported: the quantity's line, else the method's.
+  if (const toml::node* given = r.find("quantity") ? r.find("quantity") : r.find("method")) {
+    const std::string where =
+        fmt::format("{}:{}: [bake]", file.string(), given->source().begin.line);
+    if (Status paired = pair_quantity_and_method(bake, r.find("quantity") != nullptr,
+                                                 r.find("method") != nullptr, where);
+        !paired)
+      return paired.error();
+  }
   return bake;
 }
 

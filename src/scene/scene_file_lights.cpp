@@ -46,8 +46,8 @@ void read_cone(TableReader& r, LightDesc& light) {
 // A sun: `direction` (where its light goes), `angle_deg` and `irradiance` on a surface facing
 // it, made a distant disk by sun_light (sun_light.h), placed for the scene by the bake.
 Expected<LightDesc> read_sun(TableReader& r, LightDesc light) {
-  for (const char* key :
-       {"position", "normal", "up", "size", "radius", "power", "texture", "cone_deg", "blend"})
+  for (const char* key : {"position", "normal", "up", "size", "radius", "power", "texture",
+                          "cone_deg", "blend", "strength", "map", "rotation_deg", "parts"})
     r.forbid(key,
              "does not apply to a sun, which is given by 'direction', 'angle_deg' and "
              "'irradiance'");
@@ -87,6 +87,37 @@ Expected<LightDesc> read_sun(TableReader& r, LightDesc light) {
   return sun;
 }
 
+// A sky: `color` and `strength` (its radiance, W/m²/sr, as Blender's Background), an optional
+// equirectangular `map` and its `rotation_deg` about +Z, and the `parts` it is baked as
+// (scene/sky.h); placed around the scene by the bake.
+Expected<LightDesc> read_sky(TableReader& r, const std::filesystem::path& file, LightDesc light) {
+  for (const char* key : {"position", "normal", "up", "size", "radius", "power", "texture",
+                          "direction", "angle_deg", "irradiance", "cone_deg", "blend"})
+    r.forbid(key,
+             "does not apply to a sky, which is given by 'color', 'strength', 'map', "
+             "'rotation_deg' and 'parts'");
+  light.shape = LightShape::sky;
+  const std::string_view color_requirement = "3 finite numbers >= 0, not all zero";
+  if (auto v =
+          r.vec3("color", color_requirement, [](double x) { return std::isfinite(x) && x >= 0; })) {
+    if (v->isZero(0)) r.fail_got("color", color_requirement);
+    light.color = *v;
+  }
+  if (auto v = r.number("strength", "a number > 0 (radiance, W/m²/sr)",
+                        [](double x) { return std::isfinite(x) && x > 0 && x <= 1e9; }))
+    light.sky_strength = *v;
+  if (r.find("map")) {
+    if (auto map = existing_file(r, file, "map", "environment map")) light.texture = *map;
+  }
+  if (auto v = r.number("rotation_deg", "a finite number of degrees", is_finite))
+    light.sky_rotation_deg = *v;
+  if (auto v = r.integer("parts", 20, 4096)) light.sky_parts = static_cast<int>(*v);
+  if (auto v = r.number("shadowmask_range", "a number > 0 (metres)", is_positive))
+    light.shadowmask_range = *v;
+  if (r.failed()) return r.error();
+  return light;
+}
+
 }  // namespace
 
 Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::table& table,
@@ -104,9 +135,11 @@ Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::ta
       }
     }
   }
-  r.check_known_keys({"name", "shape", "position", "normal", "up", "size", "radius", "color",
-                      "power", "texture", "shadowmask_range", "direction", "angle_deg",
-                      "irradiance", "cone_deg", "blend"});
+  r.check_known_keys({"name",      "shape",      "position",         "normal",
+                      "up",        "size",       "radius",           "color",
+                      "power",     "texture",    "shadowmask_range", "direction",
+                      "angle_deg", "irradiance", "cone_deg",         "blend",
+                      "strength",  "map",        "rotation_deg",     "parts"});
   bool spot = false;
   if (r.require("shape")) {
     if (auto shape = r.string("shape")) {
@@ -121,8 +154,10 @@ Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::ta
         spot = true;
       } else if (*shape == "sun") {
         return read_sun(r, std::move(light));
+      } else if (*shape == "sky") {
+        return read_sky(r, file, std::move(light));
       } else {
-        r.fail_got("shape", "\"rectangle\", \"disk\", \"sphere\", \"spot\" or \"sun\"");
+        r.fail_got("shape", "\"rectangle\", \"disk\", \"sphere\", \"spot\", \"sun\" or \"sky\"");
       }
     }
   }
@@ -130,6 +165,8 @@ Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::ta
   const std::string shape_name = spot ? "spot" : to_string(light.shape);
   for (const char* key : {"angle_deg", "irradiance"})
     r.forbid(key, fmt::format("applies only to sun lights, not {}", shape_name));
+  for (const char* key : {"strength", "map", "rotation_deg", "parts"})
+    r.forbid(key, fmt::format("applies only to sky lights, not {}", shape_name));
   if (spot) {
     read_cone(r, light);
   } else {

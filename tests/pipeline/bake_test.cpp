@@ -54,6 +54,35 @@ TEST(Bake, ReportsRaysAndTimes) {
   EXPECT_GE(result->bake_seconds, 0.0);
 }
 
+// Ambient occlusion through the whole pipeline, with the scene's light taken away: at the floor's
+// centre, under the 0.6 m square blocker 0.5 m up, the occluded fraction is the square's form
+// factor, four corner rectangles of X = Y = 0.3 / 0.5 each F = (1/π)·X/√(1+X²)·atan(Y/√(1+X²)).
+TEST(Bake, AmbientOcclusionNeedsNoLightAndMatchesTheFormFactor) {
+  Scene scene = parallel_scene(32, 1024);
+  scene.lights.clear();
+  scene.bake.quantity = Quantity::ambient_occlusion;
+  auto mismatched = bake(scene);
+  ASSERT_FALSE(mismatched);
+  EXPECT_NE(mismatched.error().message.find("do not go together"), std::string::npos);
+  scene.bake.method = "ambient-occlusion";
+  auto result = bake(scene);
+  ASSERT_TRUE(result) << result.error().message;
+  const Image& img = result->receivers[0].image;
+  const double x = 0.6, k = x / std::sqrt(1 + x * x);
+  const double expected = 1 - 4 * k * std::atan(k) / M_PI;
+  double centre = 0;
+  for (int y = 15; y <= 16; ++y)
+    for (int xx = 15; xx <= 16; ++xx) centre += img.at(xx, y)[0] / 4.0;
+  EXPECT_NEAR(centre, expected, 0.02);
+  EXPECT_GT(img.at(0, 0)[0], centre);  // a corner of the floor sees more of the sky
+  EXPECT_TRUE(result->warnings.empty()) << result->warnings.front();
+  // Per-light images have no light to be of.
+  scene.output.per_light = true;
+  auto per_light = bake(scene);
+  ASSERT_FALSE(per_light);
+  EXPECT_NE(per_light.error().message.find("[output]"), std::string::npos);
+}
+
 TEST(Bake, UnknownMethodIsAnError) {
   Scene scene = parallel_scene(16, 16);
   scene.bake.method = "nonsense";
@@ -76,7 +105,8 @@ TEST(Bake, ReportsSettingsTheMethodIgnores) {
     if (w.find("does not use it") != std::string::npos) ignored.push_back(w);
   ASSERT_EQ(ignored.size(), 1u);
   EXPECT_NE(ignored[0].find("scene.toml:7: [bake] samples: method 'pcf' does not use it (read by "
-                            "backprojection, convolution, accumulation, adaptive-pcf, reference)"),
+                            "backprojection, convolution, accumulation, adaptive-pcf, reference, "
+                            "ambient-occlusion)"),
             std::string::npos)
       << ignored[0];
   scene.bake.method = "reference";

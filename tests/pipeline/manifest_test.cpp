@@ -165,7 +165,8 @@ TEST(Manifest, RejectsMissingOrMistypedKeys) {
   j = manifest_to_json(full_manifest());
   j["quantity"] = "brightness";
   EXPECT_EQ(error_of(j.dump()),
-            "m.json: quantity in the bake's manifest is not \"visibility\" or \"irradiance\"");
+            "m.json: quantity in the bake's manifest is not \"visibility\", \"irradiance\" or "
+            "\"ambient-occlusion\"");
 
   j = manifest_to_json(full_manifest());
   j["receivers"][0]["resolution"] = json::array({64});

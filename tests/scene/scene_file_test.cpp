@@ -265,7 +265,7 @@ TEST_F(SceneFile, RejectsUnknownMethod) {
   const std::string text = "[bake]\nmethod = \"foo\"\n" + object_floor + light_panel;
   expect_error(text, "method", "[bake]",
                "unknown method 'foo' (known: backprojection, convolution, accumulation, pcf, "
-               "pcss, adaptive-pcf, erosion, chun-oh, reference)");
+               "pcss, adaptive-pcf, erosion, chun-oh, reference, ambient-occlusion)");
 }
 
 TEST_F(SceneFile, ReadsAndChecksMethodSettings) {
@@ -565,6 +565,30 @@ TEST_F(SceneFile, RejectsSceneWithoutLightsObjectsOrReceivers) {
   EXPECT_EQ(error_of(object_floor + "receiver = false\n" + light_panel)
                 .rfind(file + ": scene: no object has 'receiver' = true", 0),
             0u);
+}
+
+// Ambient occlusion needs no light, and is its method's only quantity: either key implies the
+// other, and the two set apart are an error at the quantity's line.
+TEST_F(SceneFile, AmbientOcclusionNeedsNoLightAndPairsQuantityWithMethod) {
+  Scene ao =
+      load_ok("[bake]\nquantity = \"ambient-occlusion\"\nao_distance = 0.5\n" + object_floor);
+  EXPECT_EQ(ao.bake.quantity, Quantity::ambient_occlusion);
+  EXPECT_EQ(ao.bake.method, "ambient-occlusion");
+  EXPECT_EQ(ao.bake.ao_distance, 0.5);
+  EXPECT_TRUE(ao.lights.empty());
+  ao = load_ok("[bake]\nmethod = \"ambient-occlusion\"\n" + object_floor + light_panel);
+  EXPECT_EQ(ao.bake.quantity, Quantity::ambient_occlusion);
+  EXPECT_EQ(ao.bake.ao_distance, 10.0);  // Blender's default
+  expect_error("[bake]\nmethod = \"reference\"\nquantity = \"ambient-occlusion\"\n" + object_floor,
+               "quantity", "[bake]", "do not go together");
+  expect_error("[bake]\nquantity = \"irradiance\"\nmethod = \"ambient-occlusion\"\n" +
+                   object_floor + light_panel,
+               "quantity", "[bake]", "'ambient-occlusion'");
+  expect_error("[bake]\nao_distance = -1\n" + object_floor + light_panel, "ao_distance", "[bake]",
+               "'ao_distance'");
+  // Any other quantity still needs a light.
+  EXPECT_NE(error_of("[bake]\nquantity = \"irradiance\"\n" + object_floor).find("no light"),
+            std::string::npos);
 }
 
 TEST_F(SceneFile, RejectsTableWhereArrayOfTablesIsExpected) {

@@ -367,6 +367,7 @@ class LightPairs final : public PairSource {
                std::abs(light_.normal().dot(to)) / (distance * distance);
       }
       case LightShape::mesh:
+      case LightShape::sky:
         break;
     }
     return 0;

@@ -1,0 +1,102 @@
+// Ambient occlusion by rays against closed forms. Under a parallel ceiling at height h, a ray at
+// angle θ from the floor's normal meets it after h / cos θ, so within a distance d it is blocked
+// when cos θ > h / d; cosine-weighted, P(cos θ ≤ c) = c², so A = (h / d)² for h < d and 1 for
+// h ≥ d. Beside a wall, every ray leaving towards it is blocked: A = 1/2.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "methods/ambient_occlusion.h"
+#include "support/test_scenes.h"
+
+namespace sb {
+namespace {
+
+// A square of half-width `half` centred on `centre`, spanned by unit axes a and b, two triangles.
+Mesh square(const Vec3& centre, const Vec3& a, const Vec3& b, double half) {
+  Mesh m;
+  m.name = "square";
+  TriMesh& t = m.mesh;
+  TriMesh::VertexHandle v[4];
+  const double st[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+  for (int i = 0; i < 4; ++i) {
+    const Vec3 p = centre + half * (st[i][0] * a + st[i][1] * b);
+    v[i] = t.add_vertex(TriMesh::Point(p.x(), p.y(), p.z()));
+  }
+  t.add_face(v[0], v[1], v[2]);
+  t.add_face(v[0], v[2], v[3]);
+  return m;
+}
+
+// Texels facing up on the floor z = 0 at x ∈ [x0, x1], y = 0.
+TexelSpace floor_texels(double x0, double x1, int n) {
+  TexelSpace s;
+  s.width = n;
+  s.height = 1;
+  s.covered.assign(std::size_t(n), 1);
+  for (int i = 0; i < n; ++i) {
+    Texel t;
+    t.x = i;
+    t.position = t.shadow_origin = Vec3f(float(x0 + (x1 - x0) * i / (n - 1)), 0.0f, 0.0f);
+    t.normal = t.geometric_normal = Vec3f::UnitZ();
+    s.texels.push_back(t);
+  }
+  return s;
+}
+
+// Per texel A, and their mean.
+std::vector<double> occlusion(const Mesh& blocker, const TexelSpace& space, double distance,
+                              int samples, double* mean) {
+  auto rays = RayScene::build({&blocker});
+  EXPECT_TRUE(rays);
+  AmbientOcclusionInputs in;
+  in.rays = &*rays;
+  in.distance = distance;
+  in.samples = samples;
+  in.seed = 5;
+  std::int64_t traced = 0;
+  const Image image = bake_ambient_occlusion(space, in, &traced);
+  EXPECT_EQ(traced, std::int64_t(space.texels.size()) * samples);
+  std::vector<double> a;
+  *mean = 0;
+  for (const Texel& t : space.texels) {
+    a.push_back(image.at(t.x, t.y)[0]);
+    EXPECT_EQ(image.at(t.x, t.y)[0], image.at(t.x, t.y)[2]);
+    *mean += a.back() / double(space.texels.size());
+  }
+  return a;
+}
+
+TEST(AmbientOcclusion, UnderAParallelCeilingIsTheSquareOfHeightOverDistance) {
+  const Mesh ceiling = square(Vec3(0, 0, 1), Vec3::UnitX(), Vec3::UnitY(), 200);
+  const TexelSpace space = floor_texels(-1, 1, 64);
+  for (const double d : {1.25, 2.0, 4.0}) {
+    double mean = 0;
+    const double expected = 1.0 / (d * d);
+    for (double a : occlusion(ceiling, space, d, 256, &mean)) EXPECT_NEAR(a, expected, 0.08) << d;
+    EXPECT_NEAR(mean, expected, 0.006) << d;
+  }
+  // Nearer than the ceiling nothing occludes; far beyond it nearly every ray is closed.
+  double mean = 0;
+  for (double a : occlusion(ceiling, space, 0.9, 64, &mean)) EXPECT_EQ(a, 1.0);
+  occlusion(ceiling, space, 1e4, 64, &mean);
+  EXPECT_LT(mean, 1e-3);
+}
+
+TEST(AmbientOcclusion, BesideAWallHalfTheHemisphereIsClosed) {
+  const Mesh wall = square(Vec3(0, 0, 0), Vec3::UnitY(), Vec3::UnitZ(), 200);
+  const TexelSpace space = floor_texels(0.05, 1.0, 32);
+  double mean = 0;
+  occlusion(wall, space, 1e3, 256, &mean);
+  EXPECT_NEAR(mean, 0.5, 0.005);
+  // Within 0.2 m, a texel 0.1 m from the wall has a ray closed where its component towards the
+  // wall exceeds 0.1 / 0.2. Cosine-weighted directions are uniform points of the unit disk lifted
+  // up, so that component is a uniform disk point's x: closed with the probability of the disk's
+  // segment beyond x = 1/2, (acos(1/2) − (1/2)·√(3/4)) / π, and A = 1 minus it.
+  const TexelSpace near = floor_texels(0.1, 0.1001, 2);
+  occlusion(wall, near, 0.2, 1024, &mean);
+  EXPECT_NEAR(mean, 1 - (std::acos(0.5) - 0.5 * std::sqrt(0.75)) / M_PI, 0.01);
+}
+
+}  // namespace
+}  // namespace sb
