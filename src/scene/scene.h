@@ -135,7 +135,7 @@ inline constexpr double kSpotBlend = 0.15;
 
 // The polygons a sky is baked as unless its light says otherwise (scene/sky.h): an icosahedron's
 // 20 faces split by flux up to this many (exact for a uniform sky at any number).
-inline constexpr int kSkyParts = 80;
+inline constexpr int kSkyParts = 128;
 
 struct LightDesc {
   std::string name;
