@@ -431,8 +431,9 @@ Expected<Scene> load_level_scene(const fs::path& file, bool need_lights) {
                              scene.warnings.size(), scene.warnings.front());
     return scene_error(file.string() +
                        ": holds no light shadowbake reads (KHR_lights_punctual point, spot or "
-                       "directional lights, or emissive meshes); add one, or bake it from a "
-                       "scene file that imports it and adds [[light]] tables" +
+                       "directional lights, or emissive meshes); add one, bake it from a "
+                       "scene file that imports it and adds [[light]] tables, or bake its "
+                       "ambient occlusion (--quantity ambient-occlusion)" +
                        left_out);
   }
   if (std::none_of(scene.objects.begin(), scene.objects.end(),

@@ -132,6 +132,35 @@ TEST_F(Cli, BakesFilesAndManifest) {
   EXPECT_NEAR(png->at(1, 1)[0], exr->at(1, 1)[0], 1.0 / 255 + 1e-6);
 }
 
+// Ambient occlusion from the command line: a scene without lights bakes with --quantity
+// ambient-occlusion (which picks its method), a light-method named beside it is refused, and
+// without it the scene's missing light is the error.
+TEST_F(Cli, AmbientOcclusionBakesAFileWithoutLights) {
+  const std::string unlit = scene().substr(0, scene().find("\n[[light]]"));
+  write("scene.toml", unlit);
+  const std::string s = (dir_ / "scene.toml").string();
+  const CliRun ok = run("bake " + s + " -o " + (dir_ / "out").string() +
+                        " --quantity ambient-occlusion --ao-distance 5 -q");
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  const auto manifest = sb::read_manifest(dir_ / "out");
+  ASSERT_TRUE(manifest) << manifest.error().message;
+  EXPECT_EQ(manifest->receivers[0].method, "ambient-occlusion");
+  EXPECT_EQ(manifest->receivers[0].quantity, sb::Quantity::ambient_occlusion);
+  auto exr = sb::read_image(dir_ / "out" / "floor.exr");
+  ASSERT_TRUE(exr);
+  EXPECT_LT(exr->at(16, 16)[0], 0.8f);  // under the blocker
+  EXPECT_GT(exr->at(1, 1)[0], exr->at(16, 16)[0]);
+  const CliRun mixed = run("bake " + s + " -o " + (dir_ / "mixed").string() +
+                           " --quantity ambient-occlusion --method reference");
+  EXPECT_NE(mixed.code, 0);
+  EXPECT_NE(mixed.err.find("do not go together"), std::string::npos) << mixed.err;
+  EXPECT_FALSE(fs::exists(dir_ / "mixed" / "floor.exr"));
+  const CliRun unlit_visibility = run("bake " + s + " -o " + (dir_ / "vis").string());
+  EXPECT_NE(unlit_visibility.code, 0);
+  EXPECT_NE(unlit_visibility.err.find("no light"), std::string::npos) << unlit_visibility.err;
+  EXPECT_EQ(std::count(unlit_visibility.err.begin(), unlit_visibility.err.end(), '\n'), 1);
+}
+
 TEST_F(Cli, ShardsMergeIntoWhatOneBakeWrites) {
   // The floor and the blocker both receive, so that two shards each get one.
   write("scene.toml", replaced(scene("method = \"reference\"\n"), "receiver = false\n", ""));

@@ -237,6 +237,15 @@ TEST(Sky, SceneFileReadsASkyAndRejectsWhatDoesNotApply) {
   EXPECT_GT(lights->size(), 110u);
   EXPECT_EQ(output_count(*lights), 1u);
   EXPECT_NE((*lights)[0].sky(), nullptr);
+  // A map with a negative radiance is refused when the lights are made, naming light and file.
+  auto negative = *gradient_map(32, 16);
+  negative.at(3, 3)[1] = -1;
+  ASSERT_TRUE(write_image(dir / "sky.exr", negative, PixelFormat::float32));
+  auto refused_map = make_lights(scene->lights, dir / "scene.toml");
+  ASSERT_FALSE(refused_map);
+  EXPECT_NE(refused_map.error().message.find("light 'sky': map:"), std::string::npos)
+      << refused_map.error().message;
+  EXPECT_NE(refused_map.error().message.find("sky.exr"), std::string::npos);
   for (const std::string bad : {"power = 3\n", "parts = 3\n", "map = \"none.exr\"\n",
                                 "strength = -1\n", "position = [0, 0, 1]\n"}) {
     auto refused = write(bad);
