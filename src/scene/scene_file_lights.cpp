@@ -88,15 +88,21 @@ Expected<LightDesc> read_sun(TableReader& r, LightDesc light) {
 }
 
 // A sky: `color` and `strength` (its radiance, W/m²/sr, as Blender's Background), an optional
-// equirectangular `map` and its `rotation_deg` about +Z, and the `parts` it is baked as
+// equirectangular `map` and its `rotation_deg` about the zenith `up` (+Z; a glTF level's is
+// +Y), and the `parts` it is baked as
 // (scene/sky.h); placed around the scene by the bake.
 Expected<LightDesc> read_sky(TableReader& r, const std::filesystem::path& file, LightDesc light) {
-  for (const char* key : {"position", "normal", "up", "size", "radius", "power", "texture",
-                          "direction", "angle_deg", "irradiance", "cone_deg", "blend"})
+  for (const char* key : {"position", "normal", "size", "radius", "power", "texture", "direction",
+                          "angle_deg", "irradiance", "cone_deg", "blend"})
     r.forbid(key,
              "does not apply to a sky, which is given by 'color', 'strength', 'map', "
-             "'rotation_deg' and 'parts'");
+             "'rotation_deg', 'up' and 'parts'");
   light.shape = LightShape::sky;
+  light.up = Vec3::UnitZ();  // a scene file's zenith; a glTF level's is +Y
+  if (auto v = r.vec3("up", "3 finite numbers, not all zero", is_finite)) {
+    if (v->isZero(0)) r.fail_got("up", "3 finite numbers, not all zero");
+    light.up = v->normalized();
+  }
   const std::string_view color_requirement = "3 finite numbers >= 0, not all zero";
   if (auto v =
           r.vec3("color", color_requirement, [](double x) { return std::isfinite(x) && x >= 0; })) {

@@ -51,8 +51,20 @@ struct Patch {
 
 }  // namespace
 
-Sky::Sky(const Vec3& radiance, std::shared_ptr<const Image> map, double rotation)
-    : radiance_(radiance), map_(std::move(map)), rotation_(rotation) {
+Mat3 sky_frame(const Vec3& up) {
+  const Vec3 z = up.normalized();
+  Vec3 x = Vec3::UnitX() - Vec3::UnitX().dot(z) * z;
+  if (x.norm() < 1e-6) x = Vec3::UnitY() - Vec3::UnitY().dot(z) * z;
+  x.normalize();
+  Mat3 frame;
+  frame.row(0) = x;
+  frame.row(1) = z.cross(x);
+  frame.row(2) = z;
+  return frame;
+}
+
+Sky::Sky(const Vec3& radiance, std::shared_ptr<const Image> map, double rotation, const Vec3& up)
+    : radiance_(radiance), map_(std::move(map)), rotation_(rotation), frame_(sky_frame(up)) {
   if (!map_) return;
   const int w = map_->width, h = map_->height;
   pixel_probability_.assign(std::size_t(w) * std::size_t(h), 0.0);
@@ -94,8 +106,9 @@ void Sky::pixel_of(const Vec3& d, int* x, int* y) const {
   // Cycles' equirectangular mapping (direction_to_equirectangular) of the direction the map is
   // looked up at, d turned by the rotation about +Z: u = 1/2 − atan2(y, x) / 2π (+X at the
   // image's middle column), v = 1/2 + elevation / π; row 0 is v = 1 (the zenith).
+  const Vec3 m = frame_ * d;  // in the map's axes
   const double c = std::cos(rotation_), s = std::sin(rotation_);
-  const Vec3 r(c * d.x() - s * d.y(), s * d.x() + c * d.y(), d.z());
+  const Vec3 r(c * m.x() - s * m.y(), s * m.x() + c * m.y(), m.z());
   const double u = 0.5 - std::atan2(r.y(), r.x()) / (2 * pi);
   const double v = std::atan2(r.z(), std::hypot(r.x(), r.y())) / pi + 0.5;
   *x = std::clamp(int(std::floor(u * map_->width)), 0, map_->width - 1);
@@ -107,7 +120,8 @@ Vec3 Sky::direction_at(double u, double v) const {
   const Vec3 r(std::cos(phi) * std::cos(elevation), std::sin(phi) * std::cos(elevation),
                std::sin(elevation));
   const double c = std::cos(rotation_), s = std::sin(rotation_);
-  return Vec3(c * r.x() + s * r.y(), -s * r.x() + c * r.y(), r.z());  // turned back
+  const Vec3 m(c * r.x() + s * r.y(), -s * r.x() + c * r.y(), r.z());  // turned back
+  return frame_.transpose() * m;                                       // in the scene's axes
 }
 
 Vec3 Sky::radiance(const Vec3& d) const {
@@ -151,7 +165,8 @@ double Sky::pdf(const Vec3& d) const {
   pixel_of(d, &x, &y);
   // A pixel's probability spread over its solid angle, (2π / w)·(π / h)·cos(elevation) per unit
   // of (u, v) area: at the point itself, so that the density is exact within the pixel.
-  const double cos_elevation = std::sqrt(std::max(0.0, 1 - d.z() * d.z()));
+  const double z = (frame_ * d).z();  // the sine of the elevation, in the map's axes
+  const double cos_elevation = std::sqrt(std::max(0.0, 1 - z * z));
   const double omega = 2 * pi / map_->width * pi / map_->height * std::max(cos_elevation, 1e-9);
   return pixel_probability_[std::size_t(y) * std::size_t(map_->width) + std::size_t(x)] / omega;
 }
@@ -260,7 +275,8 @@ Expected<std::shared_ptr<const Sky>> make_sky(const LightDesc& desc,
                                               const std::filesystem::path& scene_file) {
   const Vec3 radiance = desc.color * desc.sky_strength;
   const double rotation = desc.sky_rotation_deg * pi / 180;
-  if (desc.texture.empty()) return std::make_shared<const Sky>(radiance, nullptr, rotation);
+  if (desc.texture.empty())
+    return std::make_shared<const Sky>(radiance, nullptr, rotation, desc.up);
   const std::string where =
       scene_file.string() + ":" + std::to_string(desc.line) + ": light '" + desc.name + "': map: ";
   auto image = read_image(desc.texture, /*linearise=*/true);
@@ -272,7 +288,7 @@ Expected<std::shared_ptr<const Sky>> make_sky(const LightDesc& desc,
       return scene_error(where + desc.texture.string() +
                          ": holds a negative or non-finite value; a sky's radiance is >= 0");
   return std::make_shared<const Sky>(radiance, std::make_shared<const Image>(std::move(*image)),
-                                     rotation);
+                                     rotation, desc.up);
 }
 
 void place_sky(LightDesc& sky, const Bounds3& bounds) {

@@ -25,8 +25,10 @@ namespace sb {
 class Sky {
  public:
   // `radiance` per channel (W/m²/sr; colour · strength); `map` an equirectangular linear RGB
-  // image scaled by it, or null for a uniform sky; `rotation` radians about +Z.
-  Sky(const Vec3& radiance, std::shared_ptr<const Image> map, double rotation);
+  // image scaled by it, or null for a uniform sky; `rotation` radians about `up`, the scene's
+  // zenith (unit): the map's own Z (sky_frame).
+  Sky(const Vec3& radiance, std::shared_ptr<const Image> map, double rotation,
+      const Vec3& up = Vec3::UnitZ());
 
   bool uniform() const { return map_ == nullptr; }
   // Radiance arriving from unit direction `d` (where the light comes from), per channel: the
@@ -55,6 +57,8 @@ class Sky {
   Vec3 radiance_;
   std::shared_ptr<const Image> map_;
   double rotation_ = 0;
+  // The map's axes in the scene: X (its middle column), Y, Z (its top row), Z = `up`.
+  Mat3 frame_ = Mat3::Identity();
   // Sampling tables: the cumulative distribution over rows, then over columns within each row
   // (rows + 1 and rows × (columns + 1) entries), and each pixel's probability.
   std::vector<double> row_cdf_, column_cdf_, pixel_probability_;
@@ -65,6 +69,12 @@ class Sky {
 // image.
 Expected<std::shared_ptr<const Sky>> make_sky(const LightDesc& desc,
                                               const std::filesystem::path& scene_file);
+
+// The scene axes a sky's map lies along (rows of the matrix: the map's X, Y and Z): Z is `up`,
+// X is +X made perpendicular to it (+Y where up lies along X), Y = Z × X. With up = +Z it is
+// the identity; with up = +Y, a glTF level's zenith, X stays X and Y is −Z: the axes Blender's
+// glTF importer gives the file, so a map looks in shadowbake as in Blender.
+Mat3 sky_frame(const Vec3& up);
 
 // The distance at which the bake puts a sky's parts for a scene within `bounds` (a sun's,
 // sun_light.h).

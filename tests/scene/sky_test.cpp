@@ -28,6 +28,7 @@ LightDesc sky_desc(int parts) {
   d.shape = LightShape::sky;
   d.sky_parts = parts;
   d.radius = 1e4;
+  d.up = Vec3::UnitZ();
   return d;
 }
 
@@ -146,6 +147,31 @@ TEST(Sky, MapPartsKeepItsIrradianceAndSplitWhereItIsBright) {
   EXPECT_LT(with_sun, 32 * pixel);
 }
 
+// A glTF level's zenith is +Y: the map's top row is then +Y and its middle column +X, and a
+// direction (x, y, z) of the level is looked up where Blender's import, (x, −z, y), puts it.
+TEST(Sky, UpTurnsTheMapOntoTheScenesZenith) {
+  const int w = 64, h = 32;
+  auto map = std::make_shared<Image>(w, h, 3, 0.0f);
+  for (int x = 0; x < w; ++x) map->at(x, 0)[0] = 1;  // the zenith row
+  map->at(w / 2, h / 2 - 1)[1] = 1;  // just above the horizon at the middle column (+X)
+  map->at(w / 4, h / 2 - 1)[2] = 1;  // a quarter to the left: Blender's +Y
+  const Sky y_up(Vec3::Ones(), map, 0, Vec3::UnitY());
+  EXPECT_EQ(y_up.radiance(Vec3(0, 1, 0)).x(), 1.0);
+  EXPECT_EQ(y_up.radiance(Vec3(1, 0.01, 0).normalized()).y(), 1.0);
+  EXPECT_EQ(y_up.radiance(Vec3(0, 0.01, -1).normalized()).z(), 1.0);  // glTF −Z is Blender +Y
+  const Sky z_up(Vec3::Ones(), map, 0);
+  EXPECT_EQ(z_up.radiance(Vec3(0, 1, 0.01).normalized()).z(), 1.0);
+  double density = 0;
+  EXPECT_GT(y_up.sample(Vec2(0.5, 0.0001), &density).y(), 0.99);  // the top row's samples
+  // The density is the map's in its own axes: the same at a direction and at its image.
+  const Sky turned(Vec3::Ones(), gradient_map(w, h), 0.3, Vec3(0.2, 1, -0.3).normalized());
+  const Sky plain(Vec3::Ones(), gradient_map(w, h), 0.3);
+  const Mat3 frame = sky_frame(Vec3(0.2, 1, -0.3).normalized());
+  for (const Vec3& d : {Vec3(0.3, 0.4, 0.866).normalized(), Vec3(-0.7, 0.1, 0.2).normalized()})
+    EXPECT_NEAR(turned.pdf(frame.transpose() * d), plain.pdf(d), 1e-9 * plain.pdf(d));
+  EXPECT_TRUE(sky_frame(Vec3::UnitZ()).isIdentity(1e-15));
+}
+
 TEST(Sky, MapSamplingDensityIsConsistent) {
   const int w = 64, h = 32;
   const Sky sky(Vec3::Ones(), gradient_map(w, h), 0.4);
@@ -224,13 +250,14 @@ TEST(Sky, SceneFileReadsASkyAndRejectsWhatDoesNotApply) {
   };
   auto scene = write(
       "color = [0.5, 0.6, 1]\nstrength = 2\nmap = \"sky.exr\"\nrotation_deg = 90\n"
-      "parts = 120\n");
+      "parts = 120\nup = [0, 2, 0]\n");
   ASSERT_TRUE(scene) << scene.error().message;
   const LightDesc& sky = scene->lights[0];
   EXPECT_EQ(sky.shape, LightShape::sky);
   EXPECT_EQ(sky.sky_strength, 2);
   EXPECT_EQ(sky.sky_rotation_deg, 90);
   EXPECT_EQ(sky.sky_parts, 120);
+  EXPECT_EQ(sky.up, Vec3(0, 1, 0));
   EXPECT_EQ(sky.texture, dir / "sky.exr");
   auto lights = make_lights(scene->lights, dir / "scene.toml");
   ASSERT_TRUE(lights) << lights.error().message;

@@ -3,6 +3,7 @@ cross-check of `shadowbake bake LEVEL.glb --per-light` (docs/methods.md, "Levels
 
     blender -b --factory-startup -P tests/tools/cycles_level_bake.py -- LEVEL.glb --out DIR \
         [--res 256] [--samples 256] [--receivers floor,table] [--lights bulb,ceiling_panel]
+        [--sky MAP.exr --sky-strength S]
 
 The file is imported by Blender's own glTF importer, which is not shadowbake's reader: its lamps
 (KHR_lights_punctual) stay lamps, made points (shadow_soft_size 0, as shadowbake reads them) and
@@ -39,6 +40,9 @@ ap.add_argument("--res", type=int, default=256)
 ap.add_argument("--samples", type=int, default=256)
 ap.add_argument("--receivers")
 ap.add_argument("--lights")
+ap.add_argument("--sky", help="an equirectangular map: the world's Environment Texture, baked as "
+                "the light 'sky' (a scene file's shape = \"sky\" light)")
+ap.add_argument("--sky-strength", type=float, default=1.0)
 args = ap.parse_args(sys.argv[sys.argv.index("--") + 1:])
 
 bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -106,6 +110,18 @@ for emitter in emitters.values():
     emitter.visible_shadow = False
     front_only(emitter)
 all_lights = dict(lamps, **emitters)
+# A sky: the world's Environment Texture, as Cycles maps it (the mapping shadowbake follows).
+sky_world = None
+if args.sky:
+    sky_world = bpy.data.worlds.new("sky")
+    sky_world.use_nodes = True
+    nodes = sky_world.node_tree.nodes
+    environment = nodes.new("ShaderNodeTexEnvironment")
+    environment.image = bpy.data.images.load(os.path.abspath(args.sky))
+    environment.image.colorspace_settings.name = "Linear"
+    sky_world.node_tree.links.new(environment.outputs["Color"], nodes["Background"].inputs["Color"])
+    nodes["Background"].inputs["Strength"].default_value = args.sky_strength
+    all_lights["sky"] = sky_world
 lights = all_lights
 if args.receivers:
     receivers = {n: receivers[n] for n in args.receivers.split(",")}
@@ -164,15 +180,22 @@ for name, receiver in receivers.items():
     bpy.context.view_layer.objects.active = receiver
     for light_name, light in lights.items():
         for other in all_lights.values():
-            other.hide_render = other is not light
+            if other is not sky_world:
+                other.hide_render = other is not light
+        scene.world = sky_world if light is sky_world else None
         start = time.time()
         shadowed = bake_direct(image)
-        casting = {o.name: o.visible_shadow for o in scene.objects}
+        # Unshadowed: no object casts shadows, and none stops the rays Cycles draws by the
+        # receiver's BSDF either (multiple importance sampling counts those too: for a sky, a
+        # large share of H0).
+        casting = {o.name: (o.visible_shadow, o.visible_diffuse) for o in scene.objects}
         for o in scene.objects:
             o.visible_shadow = False
+            if o is not receiver and o.type == "MESH" and o.name not in emitters:
+                o.visible_diffuse = False  # (a light's own diffuse visibility is its light)
         unshadowed = bake_direct(image)
         for o in scene.objects:
-            o.visible_shadow = casting[o.name]
+            o.visible_shadow, o.visible_diffuse = casting[o.name]
         print(f"BAKE_SECONDS {name} {light_name} {time.time() - start:.2f}", flush=True)
         h, h0 = shadowed[:, :, :3], unshadowed[:, :, :3]
         pixels = numpy.ones((args.res, args.res, 4))
