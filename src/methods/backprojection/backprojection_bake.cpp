@@ -11,6 +11,7 @@
 #include "methods/backprojection/backprojection_bake.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -523,13 +524,24 @@ MixedImages bake_backprojection(const TexelSpace& space, const BackprojectionInp
       continue;
     }
     const LightField field = backprojection_light(space, in, l);
-    for (std::size_t t = 0; t < space.texels.size(); ++t) {
-      const TexelRoute route = field.route[t];
-      if (route == TexelRoute::none) continue;
-      mix.set(l, t, Vec3::Constant(double(field.visibility[t])));
-      ++counts[route];
-      if (route == TexelRoute::traced) counts.rays += in.light_rows * LightRows::kCells / 2;
-    }
+    // Distinct texels in parallel (LightMix::set allows it), each range counting its routes.
+    tbb::combinable<RouteCounts> local;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, space.texels.size(), 1 << 14),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        RouteCounts& c = local.local();
+                        for (std::size_t t = range.begin(); t != range.end(); ++t) {
+                          const TexelRoute route = field.route[t];
+                          if (route == TexelRoute::none) continue;
+                          mix.set(l, t, Vec3::Constant(double(field.visibility[t])));
+                          ++c[route];
+                          if (route == TexelRoute::traced)
+                            c.rays += in.light_rows * LightRows::kCells / 2;
+                        }
+                      });
+    local.combine_each([&](const RouteCounts& c) {
+      for (std::size_t r = 0; r < c.pairs.size(); ++r) counts.pairs[r] += c.pairs[r];
+      counts.rays += c.rays;
+    });
   }
   if (routes) *routes = counts;
   return mix.finish();

@@ -279,7 +279,13 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
       box_hi = box_hi.cwiseMax(poly.v[k]);
     }
     const double gap = gap_to(box_lo, box_hi);
-    found(add_blocker(poly.v, poly.count, poly.normal, gap), gap, poly.triangle);
+    covers = false;
+    const bool reaches = add_blocker(poly.v, poly.count, poly.normal, gap);
+    // One polygon, clear of the origin, covering the whole light: its umbra, convex as a convex
+    // solid's is (a tree crown's facet over a texel in the sun's shadow), so refinement may
+    // interpolate between samples in it.
+    if (covers && gap >= light_offset) out.umbra = poly.triangle;
+    found(reaches, gap, poly.triangle);
   }
 
   // Convex solids by their silhouettes: seen from the origin, the edges between a face that

@@ -113,7 +113,8 @@ struct PenumbraSample {
   // hide some of the light from it (metres; infinity for none): how narrow a penumbra near it
   // can be (texel_refinement.cpp). From the rays' nearest hit on the traced route.
   double nearest_blocker = 0;
-  // The key of a convex solid that hides all of the light by itself (its umbra), or kNoUmbra.
+  // The key of a convex solid, or of one polygon, that hides all of the light by itself (its
+  // umbra), or kNoUmbra.
   static constexpr std::uint32_t kNoUmbra = 0xffffffffu;
   std::uint32_t umbra = kNoUmbra;
 };

@@ -147,8 +147,9 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
         if (tx.normal.dot(centre_normal) < settings.normal_cos) return false;
         box.extend(p);
       }
-    // In the umbra of one convex solid at all five samples: so is every point between them (a
-    // convex blocker's umbra under a convex light is convex), whatever the distance.
+    // In the umbra of one convex solid (or one polygon) at all five samples: so is every point
+    // between them (a convex blocker's umbra under a convex light is convex), whatever the
+    // distance.
     const std::uint32_t umbra = sample_at(std::size_t(at[0])).umbra;
     bool one_umbra = umbra != none.umbra;
     for (int k = 1; k < 5; ++k)

@@ -60,7 +60,8 @@ struct PairSample {
   // False where the blockers were not listed (a shaft traced past the estimator's budget):
   // then the distance bound is all the refinement has to go on.
   bool listed = true;
-  // A convex solid that hides all of the light by itself, or PenumbraSample::kNoUmbra.
+  // A convex solid or one polygon that hides all of the light by itself, or
+  // PenumbraSample::kNoUmbra.
   std::uint32_t umbra = 0xffffffffu;
 };
 

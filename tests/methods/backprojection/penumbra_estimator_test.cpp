@@ -145,6 +145,34 @@ TEST(PenumbraEstimator, UnblockedIsOneAndCoveredIsZeroExactly) {
   EXPECT_FALSE(estimator.visibility(Vec3(0, 0, 3), n, Vec3(0, 0, 3), Blockers{}).contributes);
 }
 
+// A single polygon that hides the whole light by itself is the sample's umbra (refinement may
+// interpolate between samples in one umbra: a convex blocker's is convex); two that hide it only
+// together are not.
+TEST(PenumbraEstimator, OnePolygonCoveringTheLightIsAnUmbra) {
+  const Light light(rectangle_light());
+  const PenumbraEstimator estimator(light, 32, 1e-4);
+  const Vec3 n(0, 0, 1);
+  // The light's centre (0.1, −0.2, 2) seen from y = (0.1, −0.2, 0) through z = 1: the cone's
+  // section there is the light's rectangle halved, 0.6 × 0.3 about (0.1, −0.2).
+  const Vec3 y(0.1, -0.2, 0);
+  const std::vector<Triangle3> one = {Triangle3{Vec3(-3, -3, 1), Vec3(3, -3, 1), Vec3(0, 3, 1)}};
+  const PenumbraSample covered = estimator.visibility(y, n, y, polygons(one));
+  EXPECT_EQ(covered.visibility, 0.0);
+  EXPECT_EQ(covered.umbra, 0u);
+  // A square split along a line through the cone's axis: each half hides half the light.
+  const std::vector<Triangle3> halves = {
+      Triangle3{Vec3(-2.9, -3.2, 1), Vec3(3.1, -3.2, 1), Vec3(3.1, 2.8, 1)},
+      Triangle3{Vec3(-2.9, -3.2, 1), Vec3(3.1, 2.8, 1), Vec3(-2.9, 2.8, 1)}};
+  const PenumbraSample together = estimator.visibility(y, n, y, polygons(halves));
+  EXPECT_EQ(together.visibility, 0.0);
+  EXPECT_EQ(together.umbra, PenumbraSample::kNoUmbra);
+  // Part of the light hidden: no umbra.
+  const std::vector<Triangle3> part = {Triangle3{Vec3(0.1, -3, 1), Vec3(3, -3, 1), Vec3(3, 3, 1)}};
+  const PenumbraSample partly = estimator.visibility(y, n, y, polygons(part));
+  EXPECT_GT(partly.visibility, 0.0);
+  EXPECT_EQ(partly.umbra, PenumbraSample::kNoUmbra);
+}
+
 // The bake's 32 rows, and 64 (rows are the estimator's one approximation that matters: its error
 // falls about threefold per doubling).
 TEST(PenumbraEstimator, MatchesTheExactOracleOnRandomTriangles) {
