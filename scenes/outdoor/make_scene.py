@@ -85,11 +85,19 @@ def render_sky(path):
     scene.render.image_settings.color_mode = "RGB"
     scene.render.image_settings.exr_codec = "ZIP"
     scene.view_settings.view_transform = "Standard"
-    scene.render.filepath = path
+    # Rendered to a scratch file, then written again from its pixels alone: Cycles puts its
+    # render times in the file's header, which would change its bytes on every run.
+    scratch = path + ".render.exr"
+    scene.render.filepath = scratch
     bpy.ops.render.render(write_still=True)
-    image = bpy.data.images.load(path)
+    image = bpy.data.images.load(scratch)
     w, h = image.size
     pixels = list(image.pixels)
+    clean = bpy.data.images.new("sky", w, h, float_buffer=True)
+    clean.colorspace_settings.name = "Non-Color"
+    clean.pixels[:] = pixels
+    clean.save_render(path, scene=scene)  # half float, ZIP, as the render settings say
+    os.remove(scratch)
     best, best_i = -1.0, 0
     for i in range(w * h):
         lum = 0.2126 * pixels[4 * i] + 0.7152 * pixels[4 * i + 1] + 0.0722 * pixels[4 * i + 2]
@@ -178,7 +186,7 @@ def build():
     for obj in objects:
         obj.data.materials.clear()
         obj.data.materials.append(stone)
-        ba.lightmap_uvs_smart(obj, gap=0.004 if obj is ground else 0.01)
+        ba.lightmap_uvs_smart(obj, gap=0.004 if obj is ground else 0.02)
 
     # The panel under the arcade roof, facing down, and the disc lamp over the post.
     bpy.ops.mesh.primitive_plane_add(size=1.0, location=(0.0, 7.0, 3.15), rotation=(math.pi, 0.0, 0.0))
