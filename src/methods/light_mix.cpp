@@ -10,7 +10,12 @@ LightMix::LightMix(const TexelSpace& space, const std::vector<Light>& lights, Qu
                    Order order, KeepPerLight keep)
     : space_(space), lights_(lights), quantity_(quantity), keep_(keep) {
   out_.image = Image(space.width, space.height, 3, 0.0f);
-  if (order == Order::light_major) {
+  // One light's visibility, set light by light: its V is the texel's value wherever it reaches
+  // (H0·V / H0), so set() writes it straight into the image and nothing waits for finish() (a
+  // 4096² receiver's per-light buffer alone would be 260 MB).
+  direct_ = order == Order::light_major && lights.size() == 1 && quantity == Quantity::visibility &&
+            !keep.any();
+  if (order == Order::light_major && !direct_) {
     set_values_.assign(lights.size(), std::vector<Vec3f>(space.texels.size(), Vec3f::Zero()));
     set_flags_.assign(lights.size(), std::vector<std::uint8_t>(space.texels.size(), 0));
   }
@@ -86,27 +91,18 @@ void LightMix::write(std::size_t texel, const Sum& sum) {
 }
 
 void LightMix::set(std::size_t light, std::size_t texel, const Vec3& v) {
+  if (direct_) {
+    const Texel& tx = space_.texels[texel];
+    float* px = out_.image.at(tx.x, tx.y);
+    for (int c = 0; c < 3; ++c) px[c] = lights_[0].exitance()[c] > 0 ? float(v[c]) : 0.0f;
+    return;
+  }
   set_values_[light][texel] = v.cast<float>();
   set_flags_[light][texel] = 1;
 }
 
 MixedImages LightMix::finish() {
-  // One light's visibility is its own V wherever it reaches: H0·V / H0, without the closed form
-  // per texel (a light-major method sets only the pairs the light reaches).
-  if (!set_values_.empty() && lights_.size() == 1 && quantity_ == Quantity::visibility &&
-      !keep_.any()) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, space_.texels.size(), 4096),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-                        for (std::size_t t = range.begin(); t != range.end(); ++t) {
-                          if (!set_flags_[0][t]) continue;
-                          const Texel& tx = space_.texels[t];
-                          float* px = out_.image.at(tx.x, tx.y);
-                          for (int c = 0; c < 3; ++c)
-                            px[c] = lights_[0].exitance()[c] > 0 ? set_values_[0][t][c] : 0.0f;
-                        }
-                      });
-    return std::move(out_);
-  }
+  if (direct_) return std::move(out_);  // set() wrote every value
   if (!set_values_.empty()) {
     // Texels are independent: the closed forms of every light at every texel, on all threads.
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, space_.texels.size(), 1024),

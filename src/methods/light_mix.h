@@ -71,6 +71,7 @@ class LightMix {
   Quantity quantity_;
   KeepPerLight keep_;
   MixedImages out_;
+  bool direct_ = false;  // one light's visibility, light-major: set() writes the image itself
   // Light-major methods' values until finish(): per light, V per texel and whether it was set;
   // empty for texel-major ones.
   std::vector<std::vector<Vec3f>> set_values_;
