@@ -43,30 +43,60 @@ TileShafts tile_shafts(const TexelSpace& space, const ShaftCuller& culler, const
   std::vector<Bounds3>& boxes = tiles.origins;
   boxes.assign(count, Bounds3());
   tiles.reached.assign(space.texels.size(), 0);
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, space.texels.size(), 4096), [&](const auto& r) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-          const Texel& t = space.texels[i];
-          tiles.reached[i] = light.reaches(t.position.cast<double>(), t.normal.cast<double>());
-        }
-      });
-  for (std::size_t i = 0; i < space.texels.size(); ++i)
-    if (tiles.reached[i])
-      boxes[tiles.tile_of(space.texels[i].x, space.texels[i].y)].extend(
-          ray_origin(space.texels[i], offset));
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 8), [&](const auto& r) {
-    for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      if (boxes[i].empty()) continue;
-      std::vector<std::uint32_t>& list = tiles.candidates[i];
-      if (!culler.tile_candidates(boxes[i], light, max, list)) {
-        tiles.kind[i] = TileShafts::Kind::clear;
-      } else if (list.empty()) {
-        tiles.kind[i] = TileShafts::Kind::all;
-      } else {
-        tiles.kind[i] = TileShafts::Kind::listed;
-        std::sort(list.begin(), list.end());
-      }
+  // Bands of kGroup tile rows in parallel, each in one pass over its texels (a 4096² receiver's
+  // texels are a gigabyte: a pass is memory-bound): texels are in row-major order, so a band's
+  // are the run from its first pixel row's first texel to the next band's.
+  constexpr int g = TileShafts::kGroup;
+  const auto row_start = [&](int y) {
+    return std::size_t(std::lower_bound(space.texels.begin(), space.texels.end(), y,
+                                        [](const Texel& t, int row) { return t.y < row; }) -
+                       space.texels.begin());
+  };
+  const auto test = [&](std::size_t i) {
+    std::vector<std::uint32_t>& list = tiles.candidates[i];
+    if (!culler.tile_candidates(boxes[i], light, max, list)) {
+      tiles.kind[i] = TileShafts::Kind::clear;
+    } else if (list.empty()) {
+      tiles.kind[i] = TileShafts::Kind::all;
+    } else {
+      tiles.kind[i] = TileShafts::Kind::listed;
+      std::sort(list.begin(), list.end());
     }
+  };
+  tbb::parallel_for(tbb::blocked_range<int>(0, (tiles.tiles_y + g - 1) / g), [&](const auto& r) {
+    const int ty0 = r.begin() * g, ty1 = std::min(r.end() * g, tiles.tiles_y);
+    for (std::size_t i = row_start(ty0 * k); i < row_start(ty1 * k); ++i) {
+      const Texel& t = space.texels[i];
+      tiles.reached[i] = light.reaches(t.position.cast<double>(), t.normal.cast<double>());
+      if (tiles.reached[i]) boxes[tiles.tile_of(t.x, t.y)].extend(ray_origin(t, offset));
+    }
+    // A group of g × g tiles whose joint box's shaft is clear is clear throughout (each tile's
+    // shaft lies inside it); otherwise its tiles are tested one by one.
+    thread_local std::vector<std::uint32_t> group_list;
+    for (int gy = ty0; gy < ty1; gy += g)
+      for (int gx = 0; gx < tiles.tiles_x; gx += g) {
+        const int x1 = std::min(gx + g, tiles.tiles_x), y1 = std::min(gy + g, ty1);
+        Bounds3 joint;
+        int filled = 0;
+        for (int ty = gy; ty < y1; ++ty)
+          for (int tx = gx; tx < x1; ++tx) {
+            const Bounds3& b = boxes[std::size_t(ty) * std::size_t(tiles.tiles_x) + tx];
+            if (b.empty()) continue;
+            joint.extend(b);
+            ++filled;
+          }
+        if (filled == 0) continue;
+        const bool clear = filled > 1 && !culler.tile_candidates(joint, light, max, group_list);
+        for (int ty = gy; ty < y1; ++ty)
+          for (int tx = gx; tx < x1; ++tx) {
+            const std::size_t i = std::size_t(ty) * std::size_t(tiles.tiles_x) + tx;
+            if (boxes[i].empty()) continue;
+            if (clear)
+              tiles.kind[i] = TileShafts::Kind::clear;
+            else
+              test(i);
+          }
+      }
   });
   return tiles;
 }

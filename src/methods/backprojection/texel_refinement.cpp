@@ -47,9 +47,14 @@ TexelGrid::TexelGrid(const TexelSpace& space)
     : width(space.width),
       height(space.height),
       at(std::size_t(space.width) * std::size_t(space.height), -1) {
-  for (std::size_t t = 0; t < space.texels.size(); ++t)
-    at[std::size_t(space.texels[t].y) * std::size_t(width) + std::size_t(space.texels[t].x)] =
-        std::int32_t(t);
+  // Each texel its own pixel: distinct writes.
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, space.texels.size(), 1 << 14),
+      [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t t = r.begin(); t != r.end(); ++t)
+          at[std::size_t(space.texels[t].y) * std::size_t(width) + std::size_t(space.texels[t].x)] =
+              std::int32_t(t);
+      });
 }
 
 LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const TileShafts& tiles,
@@ -64,14 +69,21 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
   // texel's: what the cells' checks read beyond V.
   std::vector<PairSample> samples;
   std::vector<std::int32_t> sample_of(n, -1);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& r) {
-    for (std::size_t t = r.begin(); t != r.end(); ++t) {
-      const Texel& tx = space.texels[t];
-      if (reached[t] && tiles.kind[tiles.tile_of(tx.x, tx.y)] == TileShafts::Kind::clear) {
-        field.route[t] = TexelRoute::clear;
-        state[t] = kValued;
+  // The clear tiles' texels, found through the grid (the texel records are many times larger).
+  tbb::parallel_for(tbb::blocked_range<int>(0, tiles.tiles_y), [&](const auto& r) {
+    for (int ty = r.begin(); ty != r.end(); ++ty)
+      for (int tx = 0; tx < tiles.tiles_x; ++tx) {
+        if (tiles.kind[std::size_t(ty) * std::size_t(tiles.tiles_x) + std::size_t(tx)] !=
+            TileShafts::Kind::clear)
+          continue;
+        for (int y = ty * TileShafts::kTile; y < (ty + 1) * TileShafts::kTile; ++y)
+          for (int x = tx * TileShafts::kTile; x < (tx + 1) * TileShafts::kTile; ++x) {
+            const std::int32_t t = grid.texel(x, y);
+            if (t < 0 || !reached[std::size_t(t)]) continue;
+            field.route[std::size_t(t)] = TexelRoute::clear;
+            state[std::size_t(t)] = kValued;
+          }
       }
-    }
   });
 
   const auto evaluate_all = [&](const std::vector<std::size_t>& queue) {

@@ -32,6 +32,8 @@ struct TexelGrid {
 // light: what the refinement's cells start from.
 struct TileShafts {
   static constexpr int kTile = 8;
+  // Tiles are first tested kGroup × kGroup together: one clear group clears them all.
+  static constexpr int kGroup = 4;
   enum class Kind : std::uint8_t {
     empty,   // no covered texel the light reaches
     clear,   // nothing can block the light from any of its texels
