@@ -80,6 +80,10 @@ struct BakeArgs {
   bool no_trace = false;
   bool no_convolve = false;
   bool no_seams = false;
+  std::optional<std::string> preset;  // "preview" or "final"
+  // Incremental bakes (pipeline/bake_cache.h).
+  bool force = false, no_cache = false;
+  std::vector<std::string> only, lights;
 };
 
 // --explain: per receiver its stage times, the method's figures and what the method says of its
@@ -92,6 +96,25 @@ void print_explanation(const sb::BakeResult& result) {
     for (const auto& [key, value] : r.report.stats) fmt::print("    {} = {:.4g}\n", key, value);
     fmt::print("{}", r.report.explain);
   }
+}
+
+// --preset: "final" bakes the scene as it says; "preview" a faithful look in seconds (docs/cli.md,
+// "Presets"): a quarter of the texels per side (at least 16), the lightmaps alone (no per-light
+// images or shadow masks), rays at 16 samples or fewer (at a sixteenth of the texels the
+// reference's rays are faster than any estimator's per-light set-up: measured on the hall
+// level), no seams pass. Options given beside it override it.
+void apply_preset(const std::string& preset, sb::BakeSettings& settings,
+                  sb::OutputSettings& output) {
+  if (preset != "preview") return;
+  if (settings.texels_per_metre > 0)
+    settings.texels_per_metre /= 4;
+  else
+    settings.resolution = std::max(16, settings.resolution / 4);
+  if (settings.quantity != sb::Quantity::ambient_occlusion) settings.method = "reference";
+  settings.samples = std::min(settings.samples, 16);
+  settings.seams = false;
+  output.per_light = false;
+  output.shadowmask = false;
 }
 
 // Bakes one scene into `out_dir` (a shard's part of it, with --shard); the exit code.
@@ -110,6 +133,7 @@ int bake_scene(const BakeArgs& args, const std::string& scene_file, const std::s
   auto scene = sb::load_scene(scene_file, !ambient_occlusion);
   if (!scene) return fail(scene.error());
   auto& settings = scene->bake;
+  if (args.preset) apply_preset(*args.preset, settings, scene->output);
   if (args.method) settings.method = *args.method;
   if (args.quantity) {
     settings.quantity = *args.quantity == "irradiance"          ? sb::Quantity::irradiance
@@ -163,6 +187,13 @@ int bake_scene(const BakeArgs& args, const std::string& scene_file, const std::s
   sb::BakeOptions options;
   options.threads = args.threads;
   options.shard = shard;
+  // A bake keeps each receiver's result for the next into this folder, and takes what it can
+  // from the last; a shard's receivers go to its merge instead.
+  options.keys = !args.no_cache && !shard;
+  if (options.keys) options.reuse_from = out_dir;
+  options.force = args.force;
+  options.only = args.only;
+  options.relight = args.lights;
   if (show_progress) options.progress = [&bar](double f) { bar.update(f); };
 
   auto result = sb::bake(*scene, options);
@@ -275,7 +306,7 @@ Runner add_bake_command(CLI::App& app) {
     double ao_distance = 10;
     std::string max_memory;
     double texels_per_metre = 0;
-    std::string encoding, shard, balance;
+    std::string encoding, shard, balance, preset;
     int atlas_size = 0, atlas_padding = 0;
   };
   auto o = std::make_shared<Options>();
@@ -359,6 +390,30 @@ Runner add_bake_command(CLI::App& app) {
   bake->add_flag("--no-seams", o->args.no_seams,
                  "leave the texels along UV seams as baked; only measure the seams (overrides "
                  "[bake] seams)");
+  bake->add_option("--preset", o->preset,
+                   "preview: a quarter of the texels per side, rays at 16 samples or fewer, the "
+                   "lightmaps alone, no seams pass; final: the scene's settings (options given "
+                   "beside it override it)")
+      ->check(CLI::IsMember({"preview", "final"}));
+  bake->add_flag("--force", o->args.force,
+                 "bake every receiver, even those the folder's earlier bake holds unchanged")
+      ->excludes("--shard");
+  bake->add_option("--only", o->args.only,
+                   "bake these receivers; the others are taken from the folder's earlier bake "
+                   "where it has them, changed or not")
+      ->excludes("--force")
+      ->excludes("--shard");
+  bake->add_option("--lights", o->args.lights,
+                   "bake the receivers these lights may reach; the others are taken from the "
+                   "folder's earlier bake where it has them, changed or not")
+      ->excludes("--force")
+      ->excludes("--shard");
+  bake->add_flag("--no-cache", o->args.no_cache,
+                 "neither take receivers from the folder's earlier bake nor keep this bake's "
+                 "for the next (.shadowbake-cache)")
+      ->excludes("--force")
+      ->excludes("--only")
+      ->excludes("--lights");
   bake->add_flag("--explain", o->args.explain,
                  "print, per light and receiver, the convolution's direction, planes, error "
                  "metric, image sizes and stage times");
@@ -369,6 +424,7 @@ Runner add_bake_command(CLI::App& app) {
     if (*resolution_opt) o->args.resolution = o->resolution;
     if (*density_opt) o->args.texels_per_metre = o->texels_per_metre;
     if (!o->shard.empty()) o->args.shard = o->shard;
+    if (!o->preset.empty()) o->args.preset = o->preset;
     if (o->balance == "count") o->args.balance = sb::ShardBalance::count;
     if (*encoding_opt) o->args.encoding = o->encoding;
     if (*atlas_opt) o->args.atlas_size = o->atlas_size;

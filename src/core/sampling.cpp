@@ -7,6 +7,12 @@
 
 namespace sb {
 
+std::uint64_t name_stream(std::string_view name) {
+  std::uint64_t stream = 0xcbf29ce484222325ull;
+  for (const unsigned char c : name) stream = (stream ^ c) * 0x100000001b3ull;
+  return stream;
+}
+
 std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t a, std::uint64_t b) {
   Rng mix(seed ^ 0x5851F42D4C957F2Dull);
   std::uint64_t s = mix.next_u64() ^ a;

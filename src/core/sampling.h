@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string_view>
 #include <vector>
 
 #include "core/geometry.h"
@@ -33,6 +34,10 @@ class Rng {
 
 // A seed for one stream, mixed from several keys.
 std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t a, std::uint64_t b = 0);
+
+// A light's or receiver's stream key from its name (FNV-1a over its bytes): stable across runs,
+// builds and platforms, and the same whatever else the scene holds or in what order.
+std::uint64_t name_stream(std::string_view name);
 
 // Fills `out` with `count` jittered stratified points in [0,1)²: the unit square is cut into
 // nx × ny cells (nx = ceil(√count), ny = ceil(count / nx)), one jittered point per cell; when

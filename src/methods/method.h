@@ -68,7 +68,7 @@ struct ReceiverInput {
   const TexelSpace* space = nullptr;
   const Mesh* mesh = nullptr;
   const ObjectDesc* object = nullptr;
-  std::uint64_t stream = 0;  // the receiver's index in the scene: its own random streams
+  std::uint64_t stream = 0;  // the receiver's name's key (name_stream): its own random streams
 };
 
 // What a method says about one receiver beyond its values, as data the pipeline passes on.

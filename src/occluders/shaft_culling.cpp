@@ -542,6 +542,8 @@ const BlockerSolid& ShaftCuller::solid_of_key(std::uint32_t key) const {
 
 std::size_t ShaftCuller::triangle_count() const { return impl_->tris.size(); }
 
+int ShaftCuller::mesh_of(std::uint32_t triangle) const { return impl_->tris[triangle].mesh; }
+
 int ShaftCuller::neighbour(std::uint32_t triangle, int edge) const {
   return impl_->tris[triangle].across[std::size_t(edge)];
 }

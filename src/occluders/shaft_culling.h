@@ -83,6 +83,8 @@ class ShaftCuller {
   // the other way round, or -1 (a border, or more than two triangles on it).
   int neighbour(std::uint32_t triangle, int edge) const;
   std::size_t triangle_count() const;
+  // The index, among the blockers it was built from, of the mesh a triangle is of.
+  int mesh_of(std::uint32_t triangle) const;
   // The closed solid a triangle belongs to (blocker_solids.h), or null.
   const BlockerSolid* solid(std::uint32_t triangle) const;
   // What a triangle counts as where blockers are listed: its convex solid (kSolidKey | its

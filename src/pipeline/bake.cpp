@@ -14,6 +14,7 @@
 #include <optional>
 #include <thread>
 
+#include "core/sampling.h"
 #include "core/stopwatch.h"
 #include "lightmaps/shadowmask.h"
 #include "methods/convolution/fft_convolution.h"
@@ -22,6 +23,7 @@
 #include "occluders/clusters.h"
 #include "occluders/ray_scene.h"
 #include "occluders/shaft_culling.h"
+#include "pipeline/bake_cache.h"
 #include "pipeline/memory_budget.h"
 #include "scene/lights.h"
 #include "scene/mesh.h"
@@ -304,8 +306,92 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   if (needs.shafts) shafts.emplace(blockers);
   result.load_seconds = seconds_since(load_start);
 
-  // The bake proper, timed from here: texel space, the method, dilation, seams.
+  // The bake proper, timed from here: the receivers' keys, texel space, the method, dilation,
+  // seams.
   const auto bake_start = std::chrono::steady_clock::now();
+  // Incremental bakes: each receiver's key, and the receivers an earlier bake's cache holds
+  // unchanged (or that --only leaves as they were).
+  std::vector<std::optional<ReceiverBake>> reused(receivers.size());
+  std::vector<ReceiverKey> keys(receivers.size());
+  std::vector<std::string> reasons(receivers.size());
+  if (options.keys) {
+    for (const std::string& name : options.only) {
+      bool found = false;
+      for (std::size_t i : all_receivers) found = found || scene.objects[i].name == name;
+      if (!found)
+        return scene_error(scene.file.string() + ": --only " + name +
+                           ": no receiver has that name");
+    }
+    std::optional<ShaftCuller> own_culler;
+    const ShaftCuller* culler = shafts ? &*shafts : nullptr;
+    if (!culler && !ambient_occlusion && method_is_local(scene.bake.method)) {
+      own_culler.emplace(blockers);
+      culler = &*own_culler;
+    }
+    KeyInputs key_inputs;
+    key_inputs.scene = &scene;
+    key_inputs.meshes = &meshes;
+    key_inputs.lights = &lights;
+    key_inputs.blockers = &blockers;
+    key_inputs.culler = culler;
+    key_inputs.keep_per_light = options.keep_per_light;
+    key_inputs.keep_per_light.values |= scene.output.per_light;
+    key_inputs.keep_per_light.visibility |= scene.output.shadowmask;
+    std::vector<int> relit;  // the scene lights --lights names
+    for (const std::string& name : options.relight) {
+      int found = -1;
+      for (std::size_t l = 0; l < scene.lights.size(); ++l)
+        if (scene.lights[l].name == name) found = int(l);
+      if (found < 0)
+        return scene_error(scene.file.string() + ": --lights " + name + ": no light has that name");
+      relit.push_back(found);
+    }
+    std::vector<std::vector<int>> reaching;
+    auto computed = receiver_keys(key_inputs, receivers, my_sides, &reaching);
+    if (!computed) return computed.error();
+    keys = std::move(*computed);
+    for (std::size_t r = 0; r < receivers.size(); ++r) {
+      const std::string& name = scene.objects[receivers[r]].name;
+      const bool named =
+          std::find(options.only.begin(), options.only.end(), name) != options.only.end();
+      std::string lit_by;
+      for (int l : relit)
+        if (std::find(reaching[r].begin(), reaching[r].end(), l) != reaching[r].end())
+          lit_by = scene.lights[std::size_t(l)].name;
+      if (options.force) {
+        reasons[r] = "--force";
+      } else if (!lit_by.empty()) {
+        reasons[r] = "may be reached by --lights " + lit_by;
+      } else if (named) {
+        reasons[r] = "named by --only";
+      } else if (options.reuse_from.empty()) {
+        reasons[r] = "no earlier bake to take it from";
+      } else if (const auto entry = find_cached(options.reuse_from, name); !entry) {
+        reasons[r] = "no earlier bake of it";
+      } else {
+        const std::string change = key_change(entry->key, keys[r]);
+        const bool restricted = !options.only.empty() || !options.relight.empty();
+        if (!change.empty() && !restricted) {
+          reasons[r] = "changed: " + change;
+          continue;
+        }
+        auto loaded = read_cached(*entry);
+        if (!loaded) {
+          reasons[r] = "its earlier bake is unreadable (" + loaded.error().message + ")";
+          continue;
+        }
+        reasons[r] =
+            change.empty()
+                ? "nothing that may reach it changed"
+                : "left as it was: not named by --only or --lights (changed: " + change + ")";
+        loaded->key = change.empty() ? keys[r] : entry->key;
+        loaded->reuse = "reused";
+        loaded->reuse_why = reasons[r];
+        reused[r] = std::move(*loaded);
+      }
+    }
+  }
+
   std::vector<TexelSpace> spaces;
   std::vector<double> raster_seconds;
   std::int64_t total_texels = 0;
@@ -317,21 +403,32 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     const ObjectDesc& obj = scene.objects[i];
     const auto start = std::chrono::steady_clock::now();
     const int res = my_sides[r];
-    spaces.push_back(rasterise_texels(meshes[i], res, res));
-    raster_seconds.push_back(seconds_since(start));
-    total_texels += std::int64_t(spaces.back().texels.size());
-    layouts.push_back(check_uv_layout(meshes[i], spaces.back(), scene.bake.margin));
-    // Which lights reach any of its texels (for the warning about lights that reach nothing).
-    reached[r].assign(scene.lights.size(), 0);
-    for (std::size_t l = 0; !ambient_occlusion && l < lights.size(); ++l) {
-      std::uint8_t& reaches = reached[r][std::size_t(lights[l].output())];
-      for (const Texel& t : spaces.back().texels) {
-        if (reaches) break;  // this light, or another part of its mesh light
-        reaches = lights[l].reaches(t.position.cast<double>(), t.normal.cast<double>());
+    std::int64_t covered = 0;
+    if (reused[r]) {  // taken from the cache: nothing to rasterise, its layout as it was
+      spaces.emplace_back();
+      raster_seconds.push_back(0);
+      layouts.push_back(reused[r]->uv);
+      reached[r] = reused[r]->lights_reached;
+      covered = reused[r]->covered_texels;
+    } else {
+      spaces.push_back(rasterise_texels(meshes[i], res, res));
+      raster_seconds.push_back(seconds_since(start));
+      covered = std::int64_t(spaces.back().texels.size());
+      layouts.push_back(check_uv_layout(meshes[i], spaces.back(), scene.bake.margin));
+      // Which lights reach any of its texels (for the warning about lights that reach nothing).
+      reached[r].assign(scene.lights.size(), 0);
+      for (std::size_t l = 0; !ambient_occlusion && l < lights.size(); ++l) {
+        std::uint8_t& reaches = reached[r][std::size_t(lights[l].output())];
+        for (const Texel& t : spaces.back().texels) {
+          if (reaches) break;  // this light, or another part of its mesh light
+          reaches = lights[l].reaches(t.position.cast<double>(), t.normal.cast<double>());
+        }
       }
     }
+    total_texels += covered;
+    // Its warnings say where it is in the scene file as it is now (a reused one's too).
     const std::string where = object_location(scene.file, obj) + ": ";
-    if (spaces.back().texels.empty()) {
+    if (covered == 0) {
       const UvLayoutReport& uv = layouts.back();
       const std::string problem = fmt::format(
           "its lightmap UVs (channel {}) cover no texel at {}² (UV area {:.3g}, of which {:.3g} "
@@ -371,9 +468,21 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   if (!method) return method.error();
 
   for (std::size_t r = 0; r < receivers.size(); ++r) {
+    if (reused[r]) {
+      texels_done += reused[r]->covered_texels;
+      reused[r]->object = receivers[r];
+      reused[r]->uv_warnings = std::move(uv_warnings[r]);
+      result.receivers.push_back(std::move(*reused[r]));
+      continue;
+    }
     const auto start = std::chrono::steady_clock::now();
     const ObjectDesc& obj = scene.objects[receivers[r]];
     ReceiverBake out;
+    if (options.keys) {
+      out.key = keys[r];
+      out.reuse = "baked";
+      out.reuse_why = reasons[r];
+    }
     out.object = receivers[r];
     out.uv_warnings = std::move(uv_warnings[r]);
     out.lights_reached = std::move(reached[r]);
@@ -384,7 +493,8 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     input.space = &spaces[r];
     input.mesh = &meshes[receivers[r]];
     input.object = &obj;
-    input.stream = receivers[r];
+    // Keyed by its name: adding or removing other objects leaves its samples as they were.
+    input.stream = name_stream(obj.name);
     const std::int64_t done_before = texels_done.load();
     auto baked = (*method)->bake(input);
     if (!baked) return baked.error();

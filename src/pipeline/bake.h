@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -33,6 +34,12 @@ struct ShardSpec {
   ShardBalance balance = ShardBalance::cost;
 };
 
+// A receiver's key for incremental bakes (pipeline/bake_cache.h): four hashes, 32 hex digits each.
+struct ReceiverKey {
+  std::string settings, receiver, lights, blockers;
+  bool operator==(const ReceiverKey&) const = default;
+};
+
 struct BakeOptions {
   int threads = 0;  // 0: all cores
   // Called from worker threads with the fraction of the bake done, in [0, 1]; may be empty.
@@ -43,6 +50,19 @@ struct BakeOptions {
   // Bake only this shard's receivers, and leave what needs every receiver (shadow-mask channels,
   // the warnings about lights that reach nothing) to the merge (pipeline/shards.h).
   std::optional<ShardSpec> shard;
+  // Incremental bakes (pipeline/bake_cache.h): compute each receiver's key (for the cache the
+  // bake's outputs keep), and take a receiver from the cache of `reuse_from` (an output folder;
+  // empty: none) where its key is unchanged, unless `force`. A receiver `only` names is always
+  // baked; when `only` is not empty, the others are taken from the cache when there, changed or
+  // not (said in the manifest), and baked when not. A receiver one of the `relight` lights may
+  // reach is baked too.
+  bool keys = false;
+  std::filesystem::path reuse_from;
+  bool force = false;
+  std::vector<std::string> only;
+  // Scene lights whose receivers are baked whatever their keys say (those each may reach); as
+  // with `only`, the others are then taken from the cache when there, changed or not.
+  std::vector<std::string> relight;
 };
 
 struct ReceiverBake {
@@ -71,6 +91,10 @@ struct ReceiverBake {
   std::int64_t rays = 0;                     // shadow rays the method traced for it
   std::vector<std::string> uv_warnings;      // its UV layout's (and a black lightmap's) warnings
   std::vector<std::uint8_t> lights_reached;  // per light: 1 where it reaches a texel of it
+  // Incremental bakes (BakeOptions::keys): its key; whether it was taken from the cache
+  // ("reused") or baked ("baked"; empty without keys), and why.
+  ReceiverKey key;
+  std::string reuse, reuse_why;
 };
 
 struct BakeResult {

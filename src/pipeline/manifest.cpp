@@ -19,9 +19,9 @@ using json = nlohmann::ordered_json;
 // The receiver keys the schema names; any other key is one of the method's own entries.
 const std::set<std::string, std::less<>>& receiver_schema_keys() {
   static const std::set<std::string, std::less<>> keys = {
-      "name",   "files",    "atlas",       "uv_channel",     "resolution",
-      "method", "quantity", "samples",     "covered_texels", "uv_layout",
-      "seams",  "seconds",  "method_stats"};
+      "name",         "files",   "atlas",          "uv_channel", "resolution", "method",
+      "quantity",     "samples", "covered_texels", "uv_layout",  "seams",      "seconds",
+      "method_stats", "bake"};
   return keys;
 }
 
@@ -264,6 +264,7 @@ json receiver_to_json(const ManifestReceiver& r) {
         {"visible_after", r.seams.visible_after}}},
       {"seconds", r.seconds},
   });
+  if (r.bake) out["bake"] = {{"reused", r.bake->reused}, {"why", r.bake->why}};
   if (!r.method_stats.empty()) {
     json& stats = out["method_stats"] = json::object();
     for (const auto& [key, value] : r.method_stats) stats[key] = value;
@@ -346,6 +347,12 @@ void read_receiver(const json& entry, const std::string& where, const std::strin
     seam_fields.read("largest_difference_after", r.seams.largest_difference_after);
     seam_fields.read("visible_before", r.seams.visible_before);
     seam_fields.read("visible_after", r.seams.visible_after);
+  }
+  if (const json* reuse = entry.contains("bake") ? fields.object("bake") : nullptr) {
+    FieldReader reuse_fields(*reuse, where, fields.path_of("bake."), status);
+    ManifestReceiver::Reuse& b = r.bake.emplace();
+    reuse_fields.read("reused", b.reused);
+    reuse_fields.read("why", b.why);
   }
   fields.read("seconds", r.seconds);
   if (status && entry.contains("method_stats")) {

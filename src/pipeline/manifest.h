@@ -96,6 +96,13 @@ struct ManifestReceiver {
   ManifestUvLayout uv_layout;
   ManifestSeams seams;
   double seconds = 0;
+  // Incremental bakes: whether it was taken from the earlier bake's cache, and why it was or
+  // was not (pipeline/bake_cache.h); absent for a shard's or a merge's receivers.
+  struct Reuse {
+    bool reused = false;
+    std::string why;
+  };
+  std::optional<Reuse> bake;
   MethodStats method_stats;  // written only when there are some
   // The method's own entries (MethodReport::manifest), written after method_stats in their
   // order; on reading, every key the schema does not name. They must not reuse a schema key.

@@ -18,6 +18,7 @@
 #include "lightmaps/encodings.h"
 #include "lightmaps/gltf_export.h"
 #include "lightmaps/shadowmask.h"
+#include "pipeline/bake_cache.h"
 #include "pipeline/manifest.h"
 
 namespace sb {
@@ -202,6 +203,7 @@ ManifestReceiver describe_receiver(const ReceiverBake& r, const BakeSettings& ef
                  .visible_before = r.seams.before.visible,
                  .visible_after = r.seams.after.visible};
   entry.seconds = r.seconds;
+  if (!r.reuse.empty()) entry.bake = ManifestReceiver::Reuse{r.reuse == "reused", r.reuse_why};
   entry.method_stats = r.report.stats;
   entry.method_entries = r.report.manifest;
   return entry;
@@ -450,7 +452,18 @@ Status write_outputs(OutputFolder& folder, const Scene& scene, const BakeSetting
           write_text_file(folder.staged(kManifestFile), manifest_to_json(manifest).dump(2) + "\n");
       !s)
     return s;
-  return folder.publish(names);
+  // Incremental bakes: every receiver's raw result, for the next bake into this folder.
+  std::vector<std::string> cache;
+  if (!result.receivers.empty() && !result.receivers[0].reuse.empty()) {
+    auto staged = stage_cache(folder, result);
+    if (!staged) return staged.error();
+    cache = std::move(*staged);
+  }
+  std::vector<std::string> all = names;
+  all.insert(all.end(), cache.begin(), cache.end());
+  if (Status s = folder.publish(all); !s) return s;
+  if (!cache.empty()) prune_cache(folder.dir(), cache);
+  return Ok{};
 }
 
 }  // namespace sb

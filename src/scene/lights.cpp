@@ -23,6 +23,7 @@
 #include <numbers>
 
 #include "core/image_io.h"
+#include "core/sampling.h"
 #include "scene/sky.h"
 
 namespace sb {
@@ -177,9 +178,7 @@ Light::Light(const LightDesc& desc, std::shared_ptr<const Image> texture, int ou
     up_ = (desc_.up - desc_.up.dot(desc_.normal) * desc_.normal).normalized();
     right_ = up_.cross(desc_.normal).normalized();
   }
-  // FNV-1a over the name's bytes: stable across runs, builds and platforms.
-  stream_ = 0xcbf29ce484222325ull;
-  for (const unsigned char c : desc_.name) stream_ = (stream_ ^ c) * 0x100000001b3ull;
+  stream_ = name_stream(desc_.name);
   exitance_ = desc_.color * (desc_.power / area());
   if (texture_) exitance_ = exitance_.cwiseProduct(texture_mean(*texture_));
 }

@@ -99,8 +99,11 @@ TEST_F(Cli, BakesFilesAndManifest) {
   write("scene.toml", scene());
   const CliRun r = run("bake " + (dir_ / "scene.toml").string() + " -o " + (dir_ / "out").string());
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(listing(dir_ / "out"), (std::vector<std::string>{"floor.coverage.png", "floor.exr",
-                                                             "floor.png", "manifest.json"}));
+  // The lightmap, its preview and coverage, the manifest, and the cache the next bake into the
+  // folder takes unchanged receivers from (incremental bakes).
+  EXPECT_EQ(listing(dir_ / "out"),
+            (std::vector<std::string>{".shadowbake-cache", "floor.coverage.png", "floor.exr",
+                                      "floor.png", "manifest.json"}));
   const auto manifest = sb::read_manifest(dir_ / "out");
   ASSERT_TRUE(manifest) << manifest.error().message;
   ASSERT_EQ(manifest->receivers.size(), 1u);
@@ -231,6 +234,68 @@ TEST_F(Cli, BatchBakesEachSceneIntoItsOwnFolder) {
   EXPECT_EQ(second->quantity, sb::Quantity::irradiance);
 }
 
+TEST_F(Cli, RebakesTakeUnchangedReceiversFromTheFolder) {
+  write("scene.toml", scene());
+  const std::string bake = "bake " + (dir_ / "scene.toml").string() + " -o ";
+  ASSERT_EQ(run(bake + (dir_ / "out").string()).code, 0);
+  const std::string first = slurp(dir_ / "out" / "floor.exr");
+  // Unchanged: taken from the cache, the same bytes, and the manifest says so.
+  CliRun r = run(bake + (dir_ / "out").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(slurp(dir_ / "out" / "floor.exr"), first);
+  auto manifest = sb::read_manifest(dir_ / "out");
+  ASSERT_TRUE(manifest) << manifest.error().message;
+  ASSERT_TRUE(manifest->receivers[0].bake);
+  EXPECT_TRUE(manifest->receivers[0].bake->reused);
+  EXPECT_EQ(manifest->receivers[0].seconds, 0);
+  // --force bakes it again, to the same bytes.
+  r = run(bake + (dir_ / "out").string() + " --force");
+  ASSERT_EQ(r.code, 0) << r.err;
+  manifest = sb::read_manifest(dir_ / "out");
+  ASSERT_TRUE(manifest) << manifest.error().message;
+  EXPECT_FALSE(manifest->receivers[0].bake->reused);
+  EXPECT_EQ(manifest->receivers[0].bake->why, "--force");
+  EXPECT_EQ(slurp(dir_ / "out" / "floor.exr"), first);
+  // --no-cache keeps no cache; --only names a receiver that must exist.
+  r = run(bake + (dir_ / "plain").string() + " --no-cache");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "plain" / ".shadowbake-cache"));
+  r = run(bake + (dir_ / "out").string() + " --only nothing");
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("--only nothing: no receiver has that name"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(dir_ / "out" / "floor.exr"), first);
+}
+
+TEST_F(Cli, PreviewPresetBakesASixteenthOfTheTexelsByRaysAndOptionsOverrideIt) {
+  std::string text = scene();
+  text.replace(text.find("resolution = 32\nsamples = 16"), 28,
+               "resolution = 128\nsamples = 64\nmethod = \"backprojection\"");
+  write("scene.toml", text);
+  const std::string bake = "bake " + (dir_ / "scene.toml").string() + " -o ";
+  CliRun r = run(bake + (dir_ / "preview").string() + " --preset preview --per-light");
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto manifest = sb::read_manifest(dir_ / "preview");
+  ASSERT_TRUE(manifest) << manifest.error().message;
+  EXPECT_EQ(manifest->resolution, 32);
+  EXPECT_EQ(manifest->method, "reference");
+  EXPECT_EQ(manifest->samples, 16);
+  EXPECT_FALSE(manifest->receivers[0].seams.stitched);
+  EXPECT_TRUE(manifest->output.per_light);  // asked for beside the preset
+  r = run(bake + (dir_ / "preview2").string() + " --preset preview --resolution 64 --samples 4");
+  ASSERT_EQ(r.code, 0) << r.err;
+  manifest = sb::read_manifest(dir_ / "preview2");
+  ASSERT_TRUE(manifest) << manifest.error().message;
+  EXPECT_EQ(manifest->resolution, 64);
+  EXPECT_EQ(manifest->samples, 4);
+  r = run(bake + (dir_ / "final").string() + " --preset final");
+  ASSERT_EQ(r.code, 0) << r.err;
+  manifest = sb::read_manifest(dir_ / "final");
+  ASSERT_TRUE(manifest) << manifest.error().message;
+  EXPECT_EQ(manifest->resolution, 128);
+  EXPECT_EQ(manifest->method, "backprojection");
+  EXPECT_EQ(run(bake + (dir_ / "x").string() + " --preset draft").code, 2);
+}
+
 TEST_F(Cli, OutputFlagsWriteAtlasesMasksPerLightImagesAndGltf) {
   write("scene.toml", scene());
   const fs::path out = dir_ / "out";
@@ -238,9 +303,10 @@ TEST_F(Cli, OutputFlagsWriteAtlasesMasksPerLightImagesAndGltf) {
                        " --method reference --texels-per-metre 12 --atlas 256 --atlas-padding 3 "
                        "--shadowmask --per-light --gltf --encoding png");
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(listing(out), (std::vector<std::string>{
-                              "lightmap_0.coverage.png", "lightmap_0.panel.png", "lightmap_0.png",
-                              "lightmap_0.shadowmask.png", "manifest.json", "scene.glb"}));
+  EXPECT_EQ(listing(out),
+            (std::vector<std::string>{".shadowbake-cache", "lightmap_0.coverage.png",
+                                      "lightmap_0.panel.png", "lightmap_0.png",
+                                      "lightmap_0.shadowmask.png", "manifest.json", "scene.glb"}));
   const auto manifest = sb::read_manifest(out);
   ASSERT_TRUE(manifest) << manifest.error().message;
   EXPECT_EQ(manifest->texels_per_metre, 12.0);

@@ -1,0 +1,346 @@
+// Incremental bakes' keys and cache (bake_cache.h).
+#include "pipeline/bake_cache.h"
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+#include <xxhash.h>
+
+#include <algorithm>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <set>
+
+#include "occluders/shaft_culling.h"
+#include "pipeline/settings_json.h"
+#include "pipeline/shard_files.h"
+
+namespace sb {
+
+namespace fs = std::filesystem;
+using json = nlohmann::ordered_json;
+
+namespace {
+
+// A receiver's shafts are tested from the boxes of its parts in a grid of this many cells a side.
+constexpr int kCells = 4;
+
+// An XXH3-128 hash fed field by field; each variable-length field is preceded by its length.
+class Hash {
+ public:
+  Hash() : state_(XXH3_createState()) { XXH3_128bits_reset(state_); }
+  ~Hash() { XXH3_freeState(state_); }
+  Hash(const Hash&) = delete;
+  Hash& operator=(const Hash&) = delete;
+
+  void bytes(const void* data, std::size_t size) { XXH3_128bits_update(state_, data, size); }
+  void text(const std::string& s) {
+    number(double(s.size()));
+    bytes(s.data(), s.size());
+  }
+  void number(double v) { bytes(&v, sizeof v); }
+  void vec(const Vec3& v) {
+    for (int k = 0; k < 3; ++k) number(v[k]);
+  }
+  std::string hex() const {
+    const XXH128_hash_t h = XXH3_128bits_digest(state_);
+    return fmt::format("{:016x}{:016x}", h.high64, h.low64);
+  }
+
+ private:
+  XXH3_state_t* state_;
+};
+
+// A mesh as the bake reads it.
+std::string mesh_hash(const Mesh& m) {
+  Hash h;
+  h.text(m.name);
+  const TriMesh& mesh = m.mesh;
+  h.number(double(mesh.n_vertices()));
+  for (const auto v : mesh.vertices()) {
+    const auto& p = mesh.point(v);
+    h.bytes(p.data(), sizeof(p[0]) * 3);
+    if (mesh.has_vertex_normals()) {
+      const auto& n = mesh.normal(v);
+      h.bytes(n.data(), sizeof(n[0]) * 3);
+    }
+    if (mesh.has_vertex_texcoords2D()) {
+      const auto& t = mesh.texcoord2D(v);
+      h.bytes(t.data(), sizeof(t[0]) * 2);
+    }
+  }
+  h.number(double(mesh.n_faces()));
+  for (const auto f : mesh.faces())
+    for (const auto v : mesh.fv_range(f)) {
+      const int index = v.idx();
+      h.bytes(&index, sizeof index);
+    }
+  h.number(m.has_uv ? 1 : 0);
+  h.number(double(m.texture_uv.size()));
+  for (const Vec2& t : m.texture_uv) h.bytes(t.data(), sizeof(double) * 2);
+  return h.hex();
+}
+
+// A file's bytes, for a light's texture.
+Expected<std::string> file_hash(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return input_error(path.string() + ": cannot read the light's texture");
+  Hash h;
+  std::vector<char> buffer(1 << 16);
+  while (in.read(buffer.data(), std::streamsize(buffer.size())) || in.gcount() > 0)
+    h.bytes(buffer.data(), std::size_t(in.gcount()));
+  return h.hex();
+}
+
+// Whether light may reach a point of box: a one-sided planar light cannot reach what lies
+// wholly behind its plane; any other light may.
+bool may_reach(const Light& light, const Bounds3& box) {
+  switch (light.shape()) {
+    case LightShape::rectangle:
+    case LightShape::disk:
+    case LightShape::polygon:
+      break;
+    default:
+      return true;
+  }
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 p((c & 1 ? box.hi : box.lo).x(), (c & 2 ? box.hi : box.lo).y(),
+                 (c & 4 ? box.hi : box.lo).z());
+    if (light.normal().dot(p - light.centre()) > 0) return true;
+  }
+  return false;
+}
+
+Bounds3 mesh_bounds(const Mesh& m) {
+  Bounds3 box;
+  for (const auto v : m.mesh.vertices()) {
+    const auto& p = m.mesh.point(v);
+    box.extend(Vec3(p[0], p[1], p[2]));
+  }
+  return box;
+}
+
+bool overlap(const Bounds3& a, const Bounds3& b) {
+  return !a.empty() && !b.empty() && (a.lo.array() <= b.hi.array()).all() &&
+         (b.lo.array() <= a.hi.array()).all();
+}
+
+// The cache's two files for a receiver, relative to the output folder.
+std::string metadata_name(const std::string& receiver) {
+  return (fs::path(kCacheFolder) / (receiver + ".json")).generic_string();
+}
+std::string data_name(const std::string& receiver) {
+  return (fs::path(kCacheFolder) / (receiver + ".bin")).generic_string();
+}
+
+json key_json(const ReceiverKey& k) {
+  return {{"settings", k.settings},
+          {"receiver", k.receiver},
+          {"lights", k.lights},
+          {"blockers", k.blockers}};
+}
+
+}  // namespace
+
+bool method_is_local(const std::string& method) {
+  return method == "backprojection" || method == "reference" || method == "ambient-occlusion";
+}
+
+Expected<std::vector<ReceiverKey>> receiver_keys(const KeyInputs& in,
+                                                 const std::vector<std::size_t>& objects,
+                                                 const std::vector<int>& sides,
+                                                 std::vector<std::vector<int>>* reaching) {
+  const Scene& scene = *in.scene;
+  const std::vector<Light>& lights = *in.lights;
+  const std::vector<const Mesh*>& blockers = *in.blockers;
+  const bool ambient_occlusion = scene.bake.quantity == Quantity::ambient_occlusion;
+  const bool local = method_is_local(scene.bake.method);
+
+  std::string settings;
+  {
+    Hash h;
+    h.text(SHADOWBAKE_VERSION);
+    h.text(settings_to_json(scene.bake, scene.output).dump());
+    h.number(in.keep_per_light.values ? 1 : 0);
+    h.number(in.keep_per_light.visibility ? 1 : 0);
+    h.number(double(scene.lights.size()));
+    settings = h.hex();
+  }
+  // Each light's and blocker's own hash, once.
+  std::vector<std::string> light_hashes(lights.size());
+  std::map<fs::path, std::string> textures;
+  for (std::size_t l = 0; l < lights.size(); ++l) {
+    const LightDesc& d = lights[l].desc();
+    Hash h;
+    h.number(double(l));
+    h.number(double(lights[l].output()));
+    h.text(d.name);
+    h.number(double(int(d.shape)));
+    h.vec(d.position), h.vec(d.normal), h.vec(d.up);
+    h.number(d.width), h.number(d.height), h.number(d.radius);
+    h.vec(d.color), h.number(d.power);
+    h.number(d.shadowmask_range);
+    h.vec(d.spot_axis), h.number(d.spot_inner), h.number(d.spot_outer);
+    h.number(d.sun_angle_deg);
+    h.number(double(d.corners.size()));
+    for (const Vec3& c : d.corners) h.vec(c);
+    h.number(d.sky_strength), h.number(d.sky_rotation_deg), h.number(double(d.sky_parts));
+    h.text(d.texture.string());
+    if (!d.texture.empty()) {
+      auto found = textures.find(d.texture);
+      if (found == textures.end()) {
+        auto bytes = file_hash(d.texture);
+        if (!bytes) return bytes.error();
+        found = textures.emplace(d.texture, *bytes).first;
+      }
+      h.text(found->second);
+    }
+    light_hashes[l] = h.hex();
+  }
+  std::vector<std::string> blocker_hashes(blockers.size());
+  std::vector<Bounds3> blocker_boxes(blockers.size());
+  tbb::parallel_for(std::size_t(0), blockers.size(), [&](std::size_t b) {
+    blocker_hashes[b] = mesh_hash(*blockers[b]);
+    blocker_boxes[b] = mesh_bounds(*blockers[b]);
+  });
+
+  std::vector<ReceiverKey> keys(objects.size());
+  if (reaching) reaching->assign(objects.size(), {});
+  // Receivers in parallel: each key is its own.
+  tbb::parallel_for(std::size_t(0), objects.size(), [&](std::size_t r) {
+    const std::size_t object = objects[r];
+    const Mesh& mesh = (*in.meshes)[object];
+    const ObjectDesc& obj = scene.objects[object];
+    ReceiverKey& key = keys[r];
+    key.settings = settings;
+    {
+      Hash h;
+      h.text(obj.name);  // its sampling stream's key, too
+      h.number(double(sides[r]));
+      h.number(double(obj.uv_channel));
+      h.number(obj.auto_uv ? 1 : 0);
+      h.text(mesh_hash(mesh));
+      key.receiver = h.hex();
+    }
+    // Its box, grown for the shadow origins lifted off the surface (texel_space.h), and the
+    // boxes of its triangles in each cell of a kCells³ grid over it (by centroid), grown alike:
+    // a floor's far end has shafts of its own.
+    Bounds3 box = mesh_bounds(mesh);
+    const Vec3 grow = Vec3::Constant(1e-3 + 1e-2 * box.diagonal());
+    std::vector<Bounds3> parts(std::size_t(kCells * kCells * kCells));
+    const Vec3 extent = (box.hi - box.lo).cwiseMax(Vec3::Constant(1e-12));
+    for (const auto f : mesh.mesh.faces()) {
+      Bounds3 tri;
+      for (const auto v : mesh.mesh.fv_range(f)) {
+        const auto& p = mesh.mesh.point(v);
+        tri.extend(Vec3(p[0], p[1], p[2]));
+      }
+      const Vec3 at = ((tri.centre() - box.lo).cwiseQuotient(extent) * kCells).cwiseMax(0.0);
+      const auto cell = [&](int k) { return std::min(int(at[k]), kCells - 1); };
+      parts[std::size_t((cell(2) * kCells + cell(1)) * kCells + cell(0))].extend(tri);
+    }
+    parts.erase(
+        std::remove_if(parts.begin(), parts.end(), [](const Bounds3& b) { return b.empty(); }),
+        parts.end());
+    for (Bounds3& b : parts) b.lo -= grow, b.hi += grow;
+    box.lo -= grow, box.hi += grow;
+    std::vector<std::uint8_t> blocker_in(blockers.size(), local ? 0 : 1);
+    Hash lights_hash;
+    if (!ambient_occlusion) {
+      std::vector<std::uint32_t> candidates;
+      for (std::size_t l = 0; l < lights.size(); ++l) {
+        if (!may_reach(lights[l], box)) continue;
+        lights_hash.text(light_hashes[l]);
+        if (reaching) (*reaching)[r].push_back(lights[l].output());
+        if (!local) continue;
+        for (const Bounds3& part : parts) {
+          // Too many to list (or no culler): every blocker may be in the shafts.
+          if (in.culler == nullptr ||
+              (in.culler->tile_candidates(part, lights[l], std::size_t(1) << 22, candidates) &&
+               candidates.empty())) {
+            std::fill(blocker_in.begin(), blocker_in.end(), 1);
+            break;
+          }
+          for (std::uint32_t t : candidates) blocker_in[std::size_t(in.culler->mesh_of(t))] = 1;
+        }
+      }
+    } else if (local) {
+      Bounds3 reach = box;
+      reach.lo -= Vec3::Constant(scene.bake.ao_distance);
+      reach.hi += Vec3::Constant(scene.bake.ao_distance);
+      for (std::size_t b = 0; b < blockers.size(); ++b)
+        blocker_in[b] = overlap(reach, blocker_boxes[b]);
+    }
+    key.lights = lights_hash.hex();
+    Hash blockers_hash;
+    for (std::size_t b = 0; b < blockers.size(); ++b)
+      if (blocker_in[b]) blockers_hash.text(blocker_hashes[b]);
+    key.blockers = blockers_hash.hex();
+  });
+  return keys;
+}
+
+std::string key_change(const ReceiverKey& before, const ReceiverKey& now) {
+  std::vector<std::string> parts;
+  if (before.settings != now.settings) parts.push_back("the settings");
+  if (before.receiver != now.receiver) parts.push_back("its mesh or lightmap");
+  if (before.lights != now.lights) parts.push_back("the lights that may reach it");
+  if (before.blockers != now.blockers) parts.push_back("the blockers in its shafts");
+  return fmt::format("{}", fmt::join(parts, ", "));
+}
+
+std::optional<CachedReceiver> find_cached(const fs::path& output_dir, const std::string& name) {
+  CachedReceiver entry;
+  entry.metadata = output_dir / metadata_name(name);
+  entry.data = output_dir / data_name(name);
+  std::ifstream in(entry.metadata);
+  if (!in) return std::nullopt;
+  const json j = json::parse(in, nullptr, false);
+  if (j.is_discarded() || !j.contains("key") || !j["key"].is_object()) return std::nullopt;
+  const json& k = j["key"];
+  for (const char* part : {"settings", "receiver", "lights", "blockers"})
+    if (!k.contains(part) || !k[part].is_string()) return std::nullopt;
+  entry.key = {k["settings"], k["receiver"], k["lights"], k["blockers"]};
+  return entry;
+}
+
+Expected<ReceiverBake> read_cached(const CachedReceiver& entry) {
+  std::ifstream in(entry.metadata);
+  const json j = json::parse(in, nullptr, false);
+  if (j.is_discarded() || !j.contains("receiver"))
+    return input_error(entry.metadata.string() + ": not a shadowbake cache entry");
+  auto r = read_receiver(j["receiver"], entry.data, entry.metadata.string());
+  if (!r) return r.error();
+  r->key = entry.key;
+  return r;
+}
+
+Expected<std::vector<std::string>> stage_cache(OutputFolder& folder, const BakeResult& result) {
+  std::vector<std::string> names;
+  for (const ReceiverBake& r : result.receivers) {
+    const std::string data = receiver_data(r);
+    json metadata = receiver_metadata(r);
+    metadata["checksum"] = data_checksum(data);
+    const json entry = {{"key", key_json(r.key)}, {"receiver", metadata}};
+    if (Status s = write_text_file(folder.staged(data_name(r.name)), data); !s) return s.error();
+    if (Status s = write_text_file(folder.staged(metadata_name(r.name)), entry.dump(1) + "\n"); !s)
+      return s.error();
+    names.push_back(data_name(r.name));
+    names.push_back(metadata_name(r.name));
+  }
+  return names;
+}
+
+void prune_cache(const fs::path& output_dir, const std::vector<std::string>& kept) {
+  const std::set<std::string> keep(kept.begin(), kept.end());
+  std::error_code error;
+  const fs::path dir = output_dir / kCacheFolder;
+  std::vector<fs::path> stale;
+  for (const auto& e : fs::directory_iterator(dir, error)) {
+    const std::string name = (fs::path(kCacheFolder) / e.path().filename()).generic_string();
+    if (e.is_regular_file(error) && !keep.count(name)) stale.push_back(e.path());
+  }
+  for (const fs::path& p : stale) fs::remove(p, error);
+}
+
+}  // namespace sb
