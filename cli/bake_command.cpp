@@ -2,6 +2,7 @@
 #include <fmt/core.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cctype>
 #include <chrono>
@@ -13,6 +14,9 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
+#include <utility>
+#include <vector>
 
 #include "commands.h"
 #include "pipeline/bake.h"
@@ -84,6 +88,7 @@ struct BakeArgs {
   // Incremental bakes (pipeline/bake_cache.h).
   bool force = false, no_cache = false;
   std::vector<std::string> only, lights;
+  bool watch = false;
 };
 
 // --explain: per receiver its stage times, the method's figures and what the method says of its
@@ -213,9 +218,11 @@ int bake_scene(const BakeArgs& args, const std::string& scene_file, const std::s
   if (args.explain) print_explanation(*result);
 
   if (!args.quiet) {
+    std::size_t reused = 0;
     for (const auto& r : result->receivers) {
-      fmt::print("  {:<16} {}² ({} texels covered, {:.2f} s)\n", r.name, r.image.width,
-                 r.covered_texels, r.seconds);
+      reused += r.reuse == "reused";
+      fmt::print("  {:<16} {}² ({} texels covered, {})\n", r.name, r.image.width, r.covered_texels,
+                 r.reuse == "reused" ? "reused" : fmt::format("{:.2f} s", r.seconds));
     }
     const std::string size = settings.texels_per_metre > 0
                                  ? fmt::format("{:.4g} texels per metre", settings.texels_per_metre)
@@ -224,11 +231,12 @@ int bake_scene(const BakeArgs& args, const std::string& scene_file, const std::s
         result->atlas ? fmt::format(", {} atlas(es)", result->atlas->sizes.size()) : "";
     const std::string what = shard ? fmt::format("shard {}/{}: ", shard->index, shard->count) : "";
     fmt::print(
-        "{}baked {} receiver(s) with '{}' at {}{} into {}/ ({}): load {:.2f} s, bake "
+        "{}baked {} receiver(s){} with '{}' at {}{} into {}/ ({}): load {:.2f} s, bake "
         "{:.2f} s, write {:.2f} s, total {:.2f} s\n",
-        what, result->receivers.size(), settings.method, size, atlases, out_dir,
-        shard ? sb::kShardFile : "manifest.json", result->load_seconds, result->bake_seconds,
-        write_seconds, total_seconds);
+        what, result->receivers.size(),
+        reused ? fmt::format(" ({} taken unchanged from the earlier bake)", reused) : "",
+        settings.method, size, atlases, out_dir, shard ? sb::kShardFile : "manifest.json",
+        result->load_seconds, result->bake_seconds, write_seconds, total_seconds);
   }
   return ok;
 }
@@ -268,6 +276,58 @@ std::string batch_folder(const std::string& out_dir, const std::string& file) {
 // One scene into its folder, or a batch, each scene into its own folder under OUT: the library
 // is loaded once for all. A scene that fails does not stop the others; the exit code is the
 // first failure's.
+// --watch: the files a bake of `scene_file` reads — the scene file, its objects' meshes (a
+// level's file for its objects) and its lights' images — with their times and sizes; a scene
+// that does not load is watched by its own file alone.
+using FileStamps =
+    std::vector<std::pair<std::filesystem::path, std::pair<std::int64_t, std::int64_t>>>;
+FileStamps watched_files(const std::string& scene_file) {
+  std::vector<std::filesystem::path> files = {scene_file};
+  if (auto scene = sb::load_scene(scene_file, false)) {
+    for (const auto& o : scene->objects) files.push_back(o.mesh);
+    for (const auto& l : scene->lights)
+      if (!l.texture.empty()) files.push_back(l.texture);
+  }
+  std::sort(files.begin(), files.end());
+  files.erase(std::unique(files.begin(), files.end()), files.end());
+  FileStamps stamps;
+  for (const auto& f : files) {
+    std::error_code error;
+    const auto time = std::filesystem::last_write_time(f, error);
+    const auto size = std::filesystem::file_size(f, error);
+    stamps.push_back({f,
+                      {error ? -1 : std::int64_t(time.time_since_epoch().count()),
+                       error ? -1 : std::int64_t(size)}});
+  }
+  return stamps;
+}
+
+// Bakes the scene, then again each time one of the files it reads changes (incrementally: the
+// folder's cache keeps what did not change), until interrupted (SIGINT, SIGTERM). A failed bake
+// prints its error and is retried at the next change.
+[[noreturn]] void watch_scene(const BakeArgs& args, const std::string& scene_file) {
+  constexpr auto kPoll = std::chrono::milliseconds(250);
+  for (;;) {
+    bake_scene(args, scene_file, args.out_dir);
+    reraise_pending_interrupt();
+    const FileStamps before = watched_files(scene_file);
+    if (!args.quiet)
+      fmt::print("watching {} file(s) of {}; Ctrl-C stops\n", before.size(), scene_file);
+    std::fflush(stdout);
+    FileStamps now = before;
+    while (now == before) {
+      std::this_thread::sleep_for(kPoll);
+      now = watched_files(scene_file);
+    }
+    // Editors and exporters write in steps: wait until the files hold still for one poll.
+    for (FileStamps next = watched_files(scene_file); next != now;
+         next = watched_files(scene_file)) {
+      now = std::move(next);
+      std::this_thread::sleep_for(kPoll);
+    }
+  }
+}
+
 int run_bake(const BakeArgs& args) {
   std::vector<std::string> scenes = args.scenes;
   if (!args.list.empty()) {
@@ -276,6 +336,11 @@ int run_bake(const BakeArgs& args) {
     scenes.insert(scenes.end(), listed->begin(), listed->end());
   }
   if (scenes.empty()) return fail(sb::scene_error("bake: no scene given (a file, or --list FILE)"));
+  if (args.watch) {
+    if (scenes.size() != 1 || !args.list.empty())
+      return fail(sb::scene_error("bake --watch: one scene file, not a batch"));
+    watch_scene(args, scenes[0]);
+  }
   if (scenes.size() == 1 && args.list.empty()) return bake_scene(args, scenes[0], args.out_dir);
   int first_failure = ok, failed = 0;
   const auto start = std::chrono::steady_clock::now();
@@ -407,6 +472,10 @@ Runner add_bake_command(CLI::App& app) {
                    "bake the receivers these lights may reach; the others are taken from the "
                    "folder's earlier bake where it has them, changed or not")
       ->excludes("--force")
+      ->excludes("--shard");
+  bake->add_flag("--watch", o->args.watch,
+                 "bake, then bake again (incrementally) whenever the scene file, a mesh or a "
+                 "light's image changes, until interrupted")
       ->excludes("--shard");
   bake->add_flag("--no-cache", o->args.no_cache,
                  "neither take receivers from the folder's earlier bake nor keep this bake's "

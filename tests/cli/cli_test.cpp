@@ -3,9 +3,11 @@
 // with no partial output left behind.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -294,6 +296,41 @@ TEST_F(Cli, PreviewPresetBakesASixteenthOfTheTexelsByRaysAndOptionsOverrideIt) {
   EXPECT_EQ(manifest->resolution, 128);
   EXPECT_EQ(manifest->method, "backprojection");
   EXPECT_EQ(run(bake + (dir_ / "x").string() + " --preset draft").code, 2);
+}
+
+TEST_F(Cli, WatchRebakesWhenTheSceneChanges) {
+  write("scene.toml", scene());
+  const fs::path out = dir_ / "out", pid = dir_ / "watch.pid";
+  // In the background, its pid kept to stop it.
+  const std::string cmd = "sh -c '" + std::string(SB_CLI) + " bake " +
+                          (dir_ / "scene.toml").string() + " -o " + out.string() +
+                          " --watch --quiet >/dev/null 2>&1 & echo $! >" + pid.string() + "'";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  const auto wait_for = [](const std::function<bool()>& done) {
+    for (int i = 0; i < 600 && !done(); ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    return done();
+  };
+  const auto manifest_text = [&] { return slurp(out / "manifest.json"); };
+  EXPECT_TRUE(wait_for([&] { return !manifest_text().empty(); }));
+  const std::string first = manifest_text();
+  // A brighter light: the watcher bakes again (the floor, which it reaches).
+  std::string text = scene();
+  text.replace(text.find("power = 100.0"), 13, "power = 250.0");
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));  // a new modification time
+  write("scene.toml", text);
+  const bool rebaked = wait_for([&] {
+    const std::string now = manifest_text();
+    return !now.empty() && now != first;
+  });
+  const std::string kill = "kill $(cat " + pid.string() + ")";
+  EXPECT_EQ(std::system(kill.c_str()), 0);
+  ASSERT_TRUE(rebaked);
+  const auto manifest = sb::read_manifest(out);
+  ASSERT_TRUE(manifest) << manifest.error().message;
+  ASSERT_TRUE(manifest->receivers[0].bake);
+  EXPECT_FALSE(manifest->receivers[0].bake->reused);
+  EXPECT_EQ(manifest->receivers[0].bake->why, "changed: the lights that may reach it");
 }
 
 TEST_F(Cli, OutputFlagsWriteAtlasesMasksPerLightImagesAndGltf) {
