@@ -315,13 +315,6 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   std::vector<ReceiverKey> keys(receivers.size());
   std::vector<std::string> reasons(receivers.size());
   if (options.keys) {
-    for (const std::string& name : options.only) {
-      bool found = false;
-      for (std::size_t i : all_receivers) found = found || scene.objects[i].name == name;
-      if (!found)
-        return scene_error(scene.file.string() + ": --only " + name +
-                           ": no receiver has that name");
-    }
     std::optional<ShaftCuller> own_culler;
     const ShaftCuller* culler = shafts ? &*shafts : nullptr;
     if (!culler && !ambient_occlusion && method_is_local(scene.bake.method)) {
@@ -337,58 +330,15 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     key_inputs.keep_per_light = options.keep_per_light;
     key_inputs.keep_per_light.values |= scene.output.per_light;
     key_inputs.keep_per_light.visibility |= scene.output.shadowmask;
-    std::vector<int> relit;  // the scene lights --lights names
-    for (const std::string& name : options.relight) {
-      int found = -1;
-      for (std::size_t l = 0; l < scene.lights.size(); ++l)
-        if (scene.lights[l].name == name) found = int(l);
-      if (found < 0)
-        return scene_error(scene.file.string() + ": --lights " + name + ": no light has that name");
-      relit.push_back(found);
-    }
     std::vector<std::vector<int>> reaching;
     auto computed = receiver_keys(key_inputs, receivers, my_sides, &reaching);
     if (!computed) return computed.error();
     keys = std::move(*computed);
+    auto decided = decide_reuse(scene, receivers, keys, reaching, options);
+    if (!decided) return decided.error();
     for (std::size_t r = 0; r < receivers.size(); ++r) {
-      const std::string& name = scene.objects[receivers[r]].name;
-      const bool named =
-          std::find(options.only.begin(), options.only.end(), name) != options.only.end();
-      std::string lit_by;
-      for (int l : relit)
-        if (std::find(reaching[r].begin(), reaching[r].end(), l) != reaching[r].end())
-          lit_by = scene.lights[std::size_t(l)].name;
-      if (options.force) {
-        reasons[r] = "--force";
-      } else if (!lit_by.empty()) {
-        reasons[r] = "may be reached by --lights " + lit_by;
-      } else if (named) {
-        reasons[r] = "named by --only";
-      } else if (options.reuse_from.empty()) {
-        reasons[r] = "no earlier bake to take it from";
-      } else if (const auto entry = find_cached(options.reuse_from, name); !entry) {
-        reasons[r] = "no earlier bake of it";
-      } else {
-        const std::string change = key_change(entry->key, keys[r]);
-        const bool restricted = !options.only.empty() || !options.relight.empty();
-        if (!change.empty() && !restricted) {
-          reasons[r] = "changed: " + change;
-          continue;
-        }
-        auto loaded = read_cached(*entry);
-        if (!loaded) {
-          reasons[r] = "its earlier bake is unreadable (" + loaded.error().message + ")";
-          continue;
-        }
-        reasons[r] =
-            change.empty()
-                ? "nothing that may reach it changed"
-                : "left as it was: not named by --only or --lights (changed: " + change + ")";
-        loaded->key = change.empty() ? keys[r] : entry->key;
-        loaded->reuse = "reused";
-        loaded->reuse_why = reasons[r];
-        reused[r] = std::move(*loaded);
-      }
+      reused[r] = std::move((*decided)[r].reused);
+      reasons[r] = std::move((*decided)[r].why);
     }
   }
 

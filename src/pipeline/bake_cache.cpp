@@ -315,9 +315,67 @@ Expected<ReceiverBake> read_cached(const CachedReceiver& entry) {
   return r;
 }
 
+Expected<std::vector<ReuseDecision>> decide_reuse(const Scene& scene,
+                                                  const std::vector<std::size_t>& receivers,
+                                                  const std::vector<ReceiverKey>& keys,
+                                                  const std::vector<std::vector<int>>& reaching,
+                                                  const BakeOptions& options) {
+  for (const std::string& name : options.only) {
+    bool found = false;
+    for (const ObjectDesc& o : scene.objects) found = found || (o.receiver && o.name == name);
+    if (!found)
+      return scene_error(scene.file.string() + ": --only " + name + ": no receiver has that name");
+  }
+  std::vector<int> relit;  // the scene lights --lights names
+  for (const std::string& name : options.relight) {
+    int found = -1;
+    for (std::size_t l = 0; l < scene.lights.size(); ++l)
+      if (scene.lights[l].name == name) found = int(l);
+    if (found < 0)
+      return scene_error(scene.file.string() + ": --lights " + name + ": no light has that name");
+    relit.push_back(found);
+  }
+  const bool restricted = !options.only.empty() || !options.relight.empty();
+  std::vector<ReuseDecision> out(receivers.size());
+  for (std::size_t r = 0; r < receivers.size(); ++r) {
+    const std::string& name = scene.objects[receivers[r]].name;
+    std::string& why = out[r].why;
+    std::string lit_by;
+    for (int l : relit)
+      if (std::find(reaching[r].begin(), reaching[r].end(), l) != reaching[r].end())
+        lit_by = scene.lights[std::size_t(l)].name;
+    if (options.force) {
+      why = "--force";
+    } else if (!lit_by.empty()) {
+      why = "may be reached by --lights " + lit_by;
+    } else if (std::find(options.only.begin(), options.only.end(), name) != options.only.end()) {
+      why = "named by --only";
+    } else if (options.reuse_from.empty()) {
+      why = "no earlier bake to take it from";
+    } else if (const auto entry = find_cached(options.reuse_from, name); !entry) {
+      why = "no earlier bake of it";
+    } else if (const std::string change = key_change(entry->key, keys[r]);
+               !change.empty() && !restricted) {
+      why = "changed: " + change;
+    } else if (auto loaded = read_cached(*entry); !loaded) {
+      why = "its earlier bake is unreadable (" + loaded.error().message + ")";
+    } else {
+      why = change.empty()
+                ? "nothing that may reach it changed"
+                : "left as it was: not named by --only or --lights (changed: " + change + ")";
+      loaded->key = change.empty() ? keys[r] : entry->key;
+      loaded->reuse = "reused";
+      loaded->reuse_why = why;
+      out[r].reused = std::move(*loaded);
+    }
+  }
+  return out;
+}
+
 Expected<std::vector<std::string>> stage_cache(OutputFolder& folder, const BakeResult& result) {
   std::vector<std::string> names;
   for (const ReceiverBake& r : result.receivers) {
+    if (r.reuse != "baked") continue;  // a reused one's entry stands as it was
     const std::string data = receiver_data(r);
     json metadata = receiver_metadata(r);
     metadata["checksum"] = data_checksum(data);
@@ -331,8 +389,12 @@ Expected<std::vector<std::string>> stage_cache(OutputFolder& folder, const BakeR
   return names;
 }
 
-void prune_cache(const fs::path& output_dir, const std::vector<std::string>& kept) {
-  const std::set<std::string> keep(kept.begin(), kept.end());
+void prune_cache(const fs::path& output_dir, const BakeResult& result) {
+  std::set<std::string> keep;
+  for (const ReceiverBake& r : result.receivers) {
+    keep.insert(data_name(r.name));
+    keep.insert(metadata_name(r.name));
+  }
   std::error_code error;
   const fs::path dir = output_dir / kCacheFolder;
   std::vector<fs::path> stale;

@@ -76,13 +76,28 @@ std::optional<CachedReceiver> find_cached(const std::filesystem::path& output_di
 // The result it holds; errors (damaged data) name the file.
 Expected<ReceiverBake> read_cached(const CachedReceiver& entry);
 
-// Stages every receiver of `result` into `folder`'s cache; the names (relative to the folder)
-// to publish with the bake's other files.
+// Per receiver (`receivers`, object indices, with their `keys` and the scene lights `reaching`
+// each): its result when options.reuse_from's cache gives it (its key unchanged; or, with
+// options.only or options.relight, any entry it has unless it is named or lit), and why it is
+// taken or baked, as the manifest says it. Errors: a name in options.only that is no receiver's,
+// one in options.relight that is no light's.
+struct ReuseDecision {
+  std::optional<ReceiverBake> reused;
+  std::string why;
+};
+Expected<std::vector<ReuseDecision>> decide_reuse(const Scene& scene,
+                                                  const std::vector<std::size_t>& receivers,
+                                                  const std::vector<ReceiverKey>& keys,
+                                                  const std::vector<std::vector<int>>& reaching,
+                                                  const BakeOptions& options);
+
+// Stages the receivers of `result` that were baked into `folder`'s cache (a reused one's entry
+// is already there, unchanged); the names (relative to the folder) to publish with the bake's
+// other files.
 Expected<std::vector<std::string>> stage_cache(OutputFolder& folder, const BakeResult& result);
 
-// After publishing: removes the cache's files that `kept` (names as stage_cache gives) does not
-// list (receivers no longer in the scene). Failures are ignored: a stale entry is never read for
-// a receiver of another key.
-void prune_cache(const std::filesystem::path& output_dir, const std::vector<std::string>& kept);
+// After publishing: removes the cache's files of receivers `result` does not hold (no longer in
+// the scene). Failures are ignored: a stale entry is never read for a receiver of another key.
+void prune_cache(const std::filesystem::path& output_dir, const BakeResult& result);
 
 }  // namespace sb

@@ -453,16 +453,15 @@ Status write_outputs(OutputFolder& folder, const Scene& scene, const BakeSetting
       !s)
     return s;
   // Incremental bakes: every receiver's raw result, for the next bake into this folder.
-  std::vector<std::string> cache;
-  if (!result.receivers.empty() && !result.receivers[0].reuse.empty()) {
+  const bool keep_cache = !result.receivers.empty() && !result.receivers[0].reuse.empty();
+  std::vector<std::string> all = names;
+  if (keep_cache) {
     auto staged = stage_cache(folder, result);
     if (!staged) return staged.error();
-    cache = std::move(*staged);
+    all.insert(all.end(), staged->begin(), staged->end());
   }
-  std::vector<std::string> all = names;
-  all.insert(all.end(), cache.begin(), cache.end());
   if (Status s = folder.publish(all); !s) return s;
-  if (!cache.empty()) prune_cache(folder.dir(), cache);
+  if (keep_cache) prune_cache(folder.dir(), result);
   return Ok{};
 }
 
