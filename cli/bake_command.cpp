@@ -68,6 +68,7 @@ struct BakeArgs {
   std::string out_dir;
   std::optional<std::string> shard;  // "K/N" or "auto/N"
   sb::ShardBalance balance = sb::ShardBalance::cost;
+  bool shard_tiles = true;  // --shard-tiles auto (off: false)
   std::optional<std::string> method, quantity;
   std::optional<int> resolution, samples;
   std::optional<double> texels_per_metre;
@@ -130,6 +131,7 @@ int bake_scene(const BakeArgs& args, const std::string& scene_file, const std::s
     auto spec = sb::parse_shard(*args.shard);
     if (!spec) return fail(spec.error());
     spec->balance = args.balance;
+    spec->tiles = args.shard_tiles;
     shard = *spec;
   }
   // Ambient occlusion asked for here needs no light in the file.
@@ -219,9 +221,14 @@ int bake_scene(const BakeArgs& args, const std::string& scene_file, const std::s
 
   if (!args.quiet) {
     std::size_t reused = 0;
+    const bool tiles = std::any_of(result->receivers.begin(), result->receivers.end(),
+                                   [](const sb::ReceiverBake& r) { return bool(r.tile); });
     for (const auto& r : result->receivers) {
       reused += r.reuse == "reused";
-      fmt::print("  {:<16} {}² ({} texels covered, {})\n", r.name, r.image.width, r.covered_texels,
+      const std::string rows =
+          r.tile ? fmt::format(", rows {} to {}", r.tile->begin, r.tile->end - 1) : "";
+      fmt::print("  {:<16} {}²{} ({} texels covered, {})\n", r.name, r.image.width, rows,
+                 r.covered_texels,
                  r.reuse == "reused" ? "reused" : fmt::format("{:.2f} s", r.seconds));
     }
     const std::string size = settings.texels_per_metre > 0
@@ -231,9 +238,9 @@ int bake_scene(const BakeArgs& args, const std::string& scene_file, const std::s
         result->atlas ? fmt::format(", {} atlas(es)", result->atlas->sizes.size()) : "";
     const std::string what = shard ? fmt::format("shard {}/{}: ", shard->index, shard->count) : "";
     fmt::print(
-        "{}baked {} receiver(s){} with '{}' at {}{} into {}/ ({}): load {:.2f} s, bake "
+        "{}baked {} {}{} with '{}' at {}{} into {}/ ({}): load {:.2f} s, bake "
         "{:.2f} s, write {:.2f} s, total {:.2f} s\n",
-        what, result->receivers.size(),
+        what, result->receivers.size(), tiles ? "receiver(s) or tile(s)" : "receiver(s)",
         reused ? fmt::format(" ({} taken unchanged from the earlier bake)", reused) : "",
         settings.method, size, atlases, out_dir, shard ? sb::kShardFile : "manifest.json",
         result->load_seconds, result->bake_seconds, write_seconds, total_seconds);
@@ -371,7 +378,7 @@ Runner add_bake_command(CLI::App& app) {
     double ao_distance = 10;
     std::string max_memory;
     double texels_per_metre = 0;
-    std::string encoding, shard, balance, preset;
+    std::string encoding, shard, balance, preset, shard_tiles;
     int atlas_size = 0, atlas_padding = 0;
   };
   auto o = std::make_shared<Options>();
@@ -388,6 +395,10 @@ Runner add_bake_command(CLI::App& app) {
   bake->add_option("--shard-balance", o->balance,
                    "how receivers are dealt to shards: cost (default) or count (round robin)")
       ->check(CLI::IsMember({"cost", "count"}));
+  bake->add_option("--shard-tiles", o->shard_tiles,
+                   "auto (default): a receiver dearer than a shard's share is split into tiles "
+                   "of rows, for methods that allow it; off: receivers stay whole")
+      ->check(CLI::IsMember({"auto", "off"}));
   auto* method_opt =
       bake->add_option("--method", o->method, "bake method (overrides [bake] method)")
           ->check(CLI::IsMember(sb::known_methods()));
@@ -495,6 +506,7 @@ Runner add_bake_command(CLI::App& app) {
     if (!o->shard.empty()) o->args.shard = o->shard;
     if (!o->preset.empty()) o->args.preset = o->preset;
     if (o->balance == "count") o->args.balance = sb::ShardBalance::count;
+    o->args.shard_tiles = o->shard_tiles != "off";
     if (*encoding_opt) o->args.encoding = o->encoding;
     if (*atlas_opt) o->args.atlas_size = o->atlas_size;
     if (*padding_opt) o->args.atlas_padding = o->atlas_padding;

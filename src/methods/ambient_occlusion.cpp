@@ -89,7 +89,9 @@ MethodEntry ambient_occlusion_method() {
           nullptr,
           [](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {
             return std::unique_ptr<Method>(std::make_unique<AmbientOcclusionMethod>(context));
-          }};
+          },
+          /*tile_halo=*/0,  // each texel's rays are its own
+          nullptr};
 }
 
 }  // namespace sb

@@ -51,11 +51,15 @@ std::vector<MemoryItem> shadow_map_memory(const Scene& scene, double texels) {
 MethodEntry baseline_entry(std::string name, std::vector<std::string> settings, bool rays,
                            BaselineMethod::Bake bake,
                            std::function<std::vector<MemoryItem>(const Scene&, double)> memory) {
-  return {std::move(name), std::move(settings),
-          [rays](const BakeSettings&) { return MethodNeeds{.rays = rays}; }, std::move(memory),
+  return {std::move(name),
+          std::move(settings),
+          [rays](const BakeSettings&) { return MethodNeeds{.rays = rays}; },
+          std::move(memory),
           [bake](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {
             return std::unique_ptr<Method>(std::make_unique<BaselineMethod>(context, bake));
-          }};
+          },
+          /*tile_halo=*/-1,  // shadow maps and clusters fitted to the whole receiver
+          nullptr};
 }
 
 }  // namespace

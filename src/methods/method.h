@@ -82,6 +82,10 @@ struct MethodReport {
   // The method's own records, for its tests and benchmarks (the convolution's: a
   // std::vector<PairReport>, per light part and frustum); the pipeline passes them on unread.
   std::any details;
+  // Counts over the kept texels that `stats` and `explain` derive from (MethodEntry::summarise),
+  // for a method whose receivers can be baked in tiles: the join adds its tiles' and derives the
+  // whole receiver's figures from the sums, as its bake in one piece would.
+  std::vector<std::pair<std::string, std::int64_t>> tallies;
 };
 
 struct MethodResult {
@@ -98,6 +102,9 @@ class Method {
   virtual Expected<MethodResult> bake(const ReceiverInput& receiver) = 0;
 };
 
+// A tile of a receiver (pipeline/tiles.h) starts and ends on a multiple of this many rows.
+inline constexpr int kTileRows = 32;
+
 struct MethodEntry {
   std::string name;
   // The [bake] keys it reads beyond those of every bake (resolution, method, quantity, margin,
@@ -110,6 +117,13 @@ struct MethodEntry {
   std::function<std::vector<MemoryItem>(const Scene&, double texels)> memory;
   // Checks the settings (errors name the scene file and [bake]) and makes the method.
   std::function<Expected<std::unique_ptr<Method>>(const BakeContext&)> make;
+  // Tiles (pipeline/tiles.h): the rows of texels beyond a tile's own that its bake must hold for
+  // its own texels' values to be those of a bake of the whole receiver (a texel's value depends on
+  // no texel further away); -1: its receivers cannot be split (a texel's value depends on the
+  // whole receiver: a convolution's images, a shadow map fitted to the receiver).
+  int tile_halo = -1;
+  // Fills a report's stats and explain from its tallies; empty: the method reports no stats.
+  std::function<void(MethodReport&)> summarise;
 };
 
 // Every method of this build, in the order docs/methods.md lists them.

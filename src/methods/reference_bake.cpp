@@ -103,7 +103,9 @@ MethodEntry reference_method() {
           nullptr,
           [](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {
             return std::unique_ptr<Method>(std::make_unique<ReferenceMethod>(context));
-          }};
+          },
+          /*tile_halo=*/0,  // each texel's rays are its own
+          nullptr};
 }
 
 }  // namespace sb

@@ -25,12 +25,10 @@
 #include "occluders/shaft_culling.h"
 #include "pipeline/bake_cache.h"
 #include "pipeline/memory_budget.h"
+#include "pipeline/receiver_stages.h"
+#include "pipeline/tiles.h"
 #include "scene/lights.h"
 #include "scene/mesh.h"
-#include "scene/mesh_reader.h"
-#include "scene/sky.h"
-#include "scene/sun_light.h"
-#include "texels/auto_uv.h"
 #include "texels/lightmap_sizes.h"
 #include "texels/texel_space.h"
 
@@ -38,150 +36,10 @@ namespace sb {
 
 namespace {
 
-// Every object's mesh, in scene order; skipped degenerate triangles become warnings. A mesh file
-// may be a quarter of the memory budget, and its reader may use half of it: Assimp's scene and
-// the working mesh take several times the file's size. A file that several objects share (a
-// level's nodes) is read once and kept until its last object is built. A receiver with
-// uv = "auto" gets its lightmap UVs here, packed for the side it will have.
-Expected<std::vector<Mesh>> load_meshes(const Scene& scene, std::vector<std::string>* warnings) {
-  std::vector<Mesh> meshes;
-  meshes.reserve(scene.objects.size());
-  ImportLimits limits;
-  limits.max_file_bytes = memory_budget(scene.bake) / 4;
-  limits.max_memory = memory_budget(scene.bake) / 2;
-  std::map<std::filesystem::path, std::size_t> users;
-  for (const auto& obj : scene.objects) ++users[obj.mesh];
-  std::map<std::filesystem::path, std::shared_ptr<const RawMeshFile>> read;
-  for (const auto& obj : scene.objects) {
-    std::shared_ptr<const RawMeshFile>& file = read[obj.mesh];
-    if (!file) {
-      auto raw = read_object_file(obj, scene.file, limits);
-      if (!raw) return raw.error();
-      file = std::move(*raw);
-    }
-    auto mesh = build_object_mesh(obj, *file, scene.file);
-    if (--users[obj.mesh] == 0) read.erase(obj.mesh);
-    if (!mesh) return mesh.error();
-    if (mesh->skipped_degenerate > 0 && warnings) {
-      warnings->push_back(object_location(scene.file, obj) + ": skipped " +
-                          std::to_string(mesh->skipped_degenerate) +
-                          " degenerate (zero-area) triangles");
-    }
-    if (obj.auto_uv && obj.receiver) {
-      AutoUvTarget target;
-      target.margin = scene.bake.margin;
-      target.max_side = largest_lightmap_side(scene);
-      if (scene.bake.texels_per_metre > 0)
-        target.texels_per_metre = scene.bake.texels_per_metre * obj.lightmap_scale;
-      else
-        target.side = std::min(scene.bake.resolution, target.max_side);
-      if (auto made = generate_lightmap_uvs(*mesh, target); !made)
-        return scene_error(object_location(scene.file, obj) + ": " + made.error().message);
-    }
-    meshes.push_back(std::move(*mesh));
-  }
-  return meshes;
-}
-
-std::vector<const Mesh*> blocker_meshes(const Scene& scene, const std::vector<Mesh>& meshes) {
-  std::vector<const Mesh*> blockers;
-  for (std::size_t i = 0; i < meshes.size(); ++i)
-    if (scene.objects[i].blocker) blockers.push_back(&meshes[i]);
-  return blockers;
-}
-
-// The scene's lights with every sun and sky placed for the meshes' bounds (sun_light.h, sky.h).
-std::vector<LightDesc> placed_lights(const Scene& scene, const std::vector<Mesh>& meshes) {
-  std::vector<LightDesc> lights = scene.lights;
-  const auto at_infinity = [](const LightDesc& l) {
-    return l.sun_angle_deg > 0 || l.shape == LightShape::sky;
-  };
-  if (std::none_of(lights.begin(), lights.end(), at_infinity)) return lights;
-  Bounds3 bounds;
-  for (const Mesh& m : meshes)
-    for (const auto& v : m.mesh.vertices()) {
-      const auto& p = m.mesh.point(v);
-      bounds.extend(Vec3(p[0], p[1], p[2]));
-    }
-  if (bounds.empty()) return lights;
-  for (LightDesc& l : lights) {
-    if (l.sun_angle_deg > 0) place_sun(l, bounds);
-    if (l.shape == LightShape::sky) place_sky(l, bounds);
-  }
-  return lights;
-}
-
-// The covered texels whose value means nothing, for the seams' stitching (texels/seams.h): in a
-// visibility, those none of `lights` reaches (V = H / H0 with H0 = 0, written 0). None for an
-// irradiance, which is 0 there in truth.
-std::vector<std::uint8_t> arbitrary_texels(bool visibility, const TexelSpace& space,
-                                           const std::vector<const Light*>& lights) {
-  std::vector<std::uint8_t> arbitrary;
-  if (!visibility) return arbitrary;
-  arbitrary.assign(space.covered.size(), 0);
-  for (const Texel& t : space.texels) {
-    const Vec3 y = t.position.cast<double>(), n = t.normal.cast<double>();
-    const bool reached =
-        std::any_of(lights.begin(), lights.end(), [&](const Light* l) { return l->reaches(y, n); });
-    arbitrary[std::size_t(t.y) * std::size_t(space.width) + std::size_t(t.x)] = !reached;
-  }
-  return arbitrary;
-}
-
-// A receiver's images with their arbitrary texels, for stitch_seams: the value image (every
-// light), then each light's value and visibility images (that light alone), so that a light's
-// image is stitched as a bake of that light alone would stitch it.
-std::vector<SeamImage> seam_images(const Scene& scene, ReceiverBake& out, const TexelSpace& space,
-                                   const std::vector<Light>& lights) {
-  const bool visibility = scene.bake.quantity == Quantity::visibility;
-  std::vector<const Light*> all;
-  for (const Light& l : lights) all.push_back(&l);
-  std::vector<SeamImage> images = {{&out.image, arbitrary_texels(visibility, space, all)}};
-  // The lights a scene light is made of: itself, or a mesh light's triangles.
-  const auto parts = [&](std::size_t output) {
-    std::vector<const Light*> of;
-    for (const Light& l : lights)
-      if (std::size_t(l.output()) == output) of.push_back(&l);
-    return of;
-  };
-  for (std::size_t l = 0; l < out.per_light.size(); ++l)
-    images.push_back({&out.per_light[l], arbitrary_texels(visibility, space, parts(l))});
-  for (std::size_t l = 0; l < out.per_light_visibility.size(); ++l)
-    images.push_back({&out.per_light_visibility[l], arbitrary_texels(true, space, parts(l))});
-  return images;
-}
-
-// What a seam's lookup difference is measured against (SeamReport): 1 for a visibility, the
-// image's largest value for an irradiance (1 where it is black).
-double seam_scale(const Scene& scene, const Image& image) {
-  if (scene.bake.quantity != Quantity::irradiance || image.pixels.empty()) return 1.0;
-  const float largest = *std::max_element(image.pixels.begin(), image.pixels.end());
-  return largest > 0 ? double(largest) : 1.0;
-}
-
 std::unique_ptr<tbb::global_control> limit_threads(const BakeOptions& options) {
   if (options.threads <= 0) return nullptr;
   return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                std::size_t(options.threads));
-}
-
-// A receiver's estimated cost for sharding: the (texel, light) pairs a method shades, what every
-// method's time grows with. Per triangle, the texels its UVs cover (its UV area times side²)
-// times the lights that reach its centroid, plus a tenth of a light for the work every texel
-// takes whatever the lights (texel space, dilation, writing).
-double receiver_cost(const Mesh& mesh, int side, const std::vector<Light>& lights) {
-  double pairs = 0;
-  for (auto f : mesh.mesh.faces()) {
-    const Triangle t = triangle(mesh.mesh, f);
-    const Vec2 a = t.uv[1] - t.uv[0], b = t.uv[2] - t.uv[0];
-    const double uv_area = 0.5 * std::abs(a.x() * b.y() - a.y() * b.x());
-    const Vec3 centroid = (t.p[0] + t.p[1] + t.p[2]) / 3.0;
-    const Vec3 normal = (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]).normalized();
-    double reached = 0.1;
-    for (const Light& light : lights) reached += light.reaches(centroid, normal) ? 1.0 : 0.0;
-    pairs += uv_area * reached;
-  }
-  return double(side) * double(side) * pairs;
 }
 
 // The [bake] keys every bake reads, whatever its method.
@@ -261,23 +119,28 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
   auto lights_or = make_lights(placed_lights(scene, meshes), scene.file);
   if (!lights_or) return lights_or.error();
   const std::vector<Light>& lights = *lights_or;
-  // The receivers this bake does: all, or its shard's (as object indices, and their sides).
+  // What this bake does: every receiver, or its shard's receivers and tiles (tiles.h), as
+  // object indices, their sides and, for a tile, its rows.
   std::vector<std::size_t> all_receivers;
   for (std::size_t i = 0; i < meshes.size(); ++i)
     if (scene.objects[i].receiver) all_receivers.push_back(i);
-  std::vector<std::size_t> mine(all_receivers.size());  // indices into all_receivers
-  for (std::size_t r = 0; r < mine.size(); ++r) mine[r] = r;
+  std::vector<ShardUnit> units;
   if (options.shard) {
-    std::vector<double> costs;
+    std::vector<std::vector<double>> costs;
     for (std::size_t r = 0; r < all_receivers.size(); ++r)
-      costs.push_back(receiver_cost(meshes[all_receivers[r]], sides[r], lights));
-    mine = shard_receivers(costs, *options.shard);
+      costs.push_back(row_block_costs(meshes[all_receivers[r]], sides[r], lights));
+    units =
+        shard_units(costs, sides, options.shard->tiles && entry->tile_halo >= 0, *options.shard);
+  } else {
+    for (std::size_t r = 0; r < all_receivers.size(); ++r) units.push_back({r, std::nullopt});
   }
   std::vector<std::size_t> receivers;
   std::vector<int> my_sides;
-  for (std::size_t r : mine) {
-    receivers.push_back(all_receivers[r]);
-    my_sides.push_back(sides[r]);
+  std::vector<std::optional<RowRange>> tiles;
+  for (const ShardUnit& u : units) {
+    receivers.push_back(all_receivers[u.receiver]);
+    my_sides.push_back(sides[u.receiver]);
+    tiles.push_back(u.rows);
   }
   if (estimate.empty()) {
     estimate = bake_memory_estimate(scene, my_sides);
@@ -360,39 +223,27 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
       layouts.push_back(reused[r]->uv);
       reached[r] = reused[r]->lights_reached;
       covered = reused[r]->covered_texels;
+    } else if (tiles[r]) {  // a tile: its rows and the halo its method needs; the rest at the join
+      spaces.push_back(
+          rasterise_texels(meshes[i], res, res, tile_window(*tiles[r], entry->tile_halo, res)));
+      spaces.back().kept = *tiles[r];
+      raster_seconds.push_back(seconds_since(start));
+      layouts.emplace_back();
+      covered = std::int64_t(spaces.back().texels.size());
+      total_texels += covered;
+      continue;
     } else {
       spaces.push_back(rasterise_texels(meshes[i], res, res));
       raster_seconds.push_back(seconds_since(start));
       covered = std::int64_t(spaces.back().texels.size());
       layouts.push_back(check_uv_layout(meshes[i], spaces.back(), scene.bake.margin));
       // Which lights reach any of its texels (for the warning about lights that reach nothing).
-      reached[r].assign(scene.lights.size(), 0);
-      for (std::size_t l = 0; !ambient_occlusion && l < lights.size(); ++l) {
-        std::uint8_t& reaches = reached[r][std::size_t(lights[l].output())];
-        for (const Texel& t : spaces.back().texels) {
-          if (reaches) break;  // this light, or another part of its mesh light
-          reaches = lights[l].reaches(t.position.cast<double>(), t.normal.cast<double>());
-        }
-      }
+      reached[r] = lights_reaching(scene, spaces.back(), lights);
     }
     total_texels += covered;
-    // Its warnings say where it is in the scene file as it is now (a reused one's too).
-    const std::string where = object_location(scene.file, obj) + ": ";
-    if (covered == 0) {
-      const UvLayoutReport& uv = layouts.back();
-      const std::string problem = fmt::format(
-          "its lightmap UVs (channel {}) cover no texel at {}² (UV area {:.3g}, of which {:.3g} "
-          "inside [0, 1])",
-          obj.uv_channel, res, uv.uv_area, uv.uv_area - uv.uv_area_outside);
-      if (!obj.allow_uncovered) {
-        return scene_error(where + problem +
-                           "; fix the UVs, set 'uv' to the lightmap channel, or set "
-                           "allow_uncovered = true");
-      }
-      uv_warnings[r].push_back(where + problem + "; its lightmap is black");
-    }
-    for (const std::string& w : uv_layout_warnings(layouts.back()))
-      uv_warnings[r].push_back(where + w);
+    auto warnings = layout_warnings(scene, obj, layouts.back(), covered, res);
+    if (!warnings) return warnings.error();
+    uv_warnings[r] = std::move(*warnings);
   }
 
   std::atomic<std::int64_t> texels_done{0};
@@ -454,30 +305,17 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options) {
     out.image = std::move(baked->images.image);
     out.per_light = std::move(baked->images.per_light);
     out.per_light_visibility = std::move(baked->images.per_light_visibility);
-    for (std::size_t l = 0; l < out.per_light_visibility.size(); ++l)
-      apply_shadowmask_range(out.per_light_visibility[l], scene.lights[l], spaces[r]);
     out.report = std::move(baked->report);
     out.rays = baked->rays;
     result.shadow_rays += baked->rays;
     out.seconds_method = seconds_since(start);
-    const auto dilate_start = std::chrono::steady_clock::now();
-    dilate(out.image, spaces[r].covered, scene.bake.margin);
-    for (Image& image : out.per_light) dilate(image, spaces[r].covered, scene.bake.margin);
-    for (Image& image : out.per_light_visibility)
-      dilate(image, spaces[r].covered, scene.bake.margin);
-    out.seconds_dilate = seconds_since(dilate_start);
-    const auto seams_start = std::chrono::steady_clock::now();
-    // The arbitrary-texel masks cost a reach test per texel and light: only for a mesh with seams.
-    if (const std::vector<SeamEdge> seams = find_seams(meshes[receivers[r]]); !seams.empty()) {
-      out.seams = stitch_seams(seams, spaces[r].covered, seam_images(scene, out, spaces[r], lights),
-                               seam_scale(scene, out.image), scene.bake.seams);
+    if (tiles[r]) {
+      crop_to_tile(out, spaces[r], *tiles[r]);  // dilation, seams and the rest at the join
+    } else {
+      out.uv = layouts[r];
+      finish_receiver(scene, meshes[receivers[r]], spaces[r], lights, out);
     }
-    out.seconds_seams = seconds_since(seams_start);
-    out.covered_texels = std::int64_t(spaces[r].texels.size());
-    out.uv = layouts[r];
-    out.covered = spaces[r].covered;
-    if (scene.output.gltf)
-      out.gltf_mesh = std::make_shared<const GltfMesh>(gltf_mesh(meshes[receivers[r]]));
+    spaces[r] = TexelSpace();  // its memory back before the next receiver's
     out.seconds = raster_seconds[r] + seconds_since(start);
     result.receivers.push_back(std::move(out));
   }

@@ -19,6 +19,7 @@
 #include "scene/scene.h"
 #include "texels/atlas_packing.h"
 #include "texels/seams.h"
+#include "texels/texel_space.h"
 #include "texels/uv_checks.h"
 
 namespace sb {
@@ -32,6 +33,9 @@ enum class ShardBalance {
 struct ShardSpec {
   int index = 0, count = 1;
   ShardBalance balance = ShardBalance::cost;
+  // Whether a receiver that costs more than a shard's share may be split into tiles of rows
+  // (pipeline/tiles.h), for a method that allows it (MethodEntry::tile_halo).
+  bool tiles = true;
 };
 
 // A receiver's key for incremental bakes (pipeline/bake_cache.h): four hashes, 32 hex digits each.
@@ -69,6 +73,10 @@ struct ReceiverBake {
   std::size_t object = 0;  // its index among the scene's objects
   std::string name;
   int uv_channel = 0;
+  // A tile's bake (pipeline/tiles.h): its rows of the side × side lightmap, which its images and
+  // coverage hold alone, undilated; its layout, seams, reached lights and glTF mesh are left to
+  // the join. None: the whole receiver.
+  std::optional<RowRange> tile;
   Image image;  // RGB, the receiver's side² (resolution, or its texels_per_metre size), dilated
   std::vector<std::uint8_t> covered;  // width × height: 1 where a triangle covers the texel
   std::int64_t covered_texels = 0;
@@ -125,9 +133,8 @@ Expected<BakeResult> bake(const Scene& scene, const BakeOptions& options = {});
 // `whole`: false for a shard alone, whose warnings leave out what only all receivers tell.
 void finish_bake(const Scene& scene, BakeResult& result, bool whole = true);
 
-// The receivers a shard bakes (indices among the scene's receivers, in scene order): `costs`
-// per receiver dealt to `spec.count` shards as spec.balance says. The same costs give the same
-// shards.
+// The items a shard bakes (indices into `costs`, in order): `costs` per item (a receiver, or a
+// tile) dealt to `spec.count` shards as spec.balance says. The same costs give the same shards.
 std::vector<std::size_t> shard_receivers(const std::vector<double>& costs, const ShardSpec& spec);
 
 // The convolution method's plan for every receiver (describe_plan's text, in scene order),

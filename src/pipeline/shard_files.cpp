@@ -18,7 +18,8 @@ using json = nlohmann::ordered_json;
 
 constexpr std::uint32_t kReceiverMagic = 0x52535342;  // "SBSR"
 constexpr std::uint32_t kMeshMagic = 0x4D535342;      // "SBSM"
-constexpr std::uint32_t kVersion = 3;  // 2: receivers' seams; 3: UV stretch, density spread
+// 2: receivers' seams; 3: UV stretch, density spread; 4: tiles, the method's tallies.
+constexpr std::uint32_t kVersion = 4;
 // A lightmap side no bake makes (resolution ≤ 16384), so that a damaged header cannot make the
 // reader allocate terabytes.
 constexpr std::uint64_t kMaxSide = 16384;
@@ -115,17 +116,21 @@ std::string data_checksum(const std::string& bytes) {
   return fmt::format("{:016x}", XXH3_64bits(bytes.data(), bytes.size()));
 }
 
-std::string receiver_data_file(std::size_t object) {
-  return fmt::format("receiver_{}.bin", object);
+std::string receiver_data_file(std::size_t object, std::optional<RowRange> tile) {
+  return tile ? fmt::format("receiver_{}_rows_{}.bin", object, tile->begin)
+              : fmt::format("receiver_{}.bin", object);
 }
 
 json receiver_metadata(const ReceiverBake& r) {
   json stats = json::array();
   for (const auto& [key, value] : r.report.stats) stats.push_back({key, value});
+  json tallies = json::array();
+  for (const auto& [key, value] : r.report.tallies) tallies.push_back({key, value});
   return {{"object", r.object},
           {"name", r.name},
           {"uv_channel", r.uv_channel},
           {"side", r.image.width},
+          {"tile", r.tile ? json::array({r.tile->begin, r.tile->end}) : json()},
           {"covered_texels", r.covered_texels},
           {"uv_layout",
            {{"covered_texels", r.uv.covered_texels},
@@ -147,6 +152,7 @@ json receiver_metadata(const ReceiverBake& r) {
           {"uv_warnings", r.uv_warnings},
           {"lights_reached", r.lights_reached},
           {"method_stats", stats},
+          {"method_tallies", tallies},
           {"method_entries", r.report.manifest},
           {"explain", r.report.explain},
           {"method_warnings", r.report.warnings},
@@ -180,6 +186,8 @@ Expected<ReceiverBake> read_receiver(const json& meta, const std::filesystem::pa
     r.name = meta.at("name").get<std::string>();
     r.uv_channel = meta.at("uv_channel").get<int>();
     side = meta.at("side").get<int>();
+    if (const json& tile = meta.at("tile"); !tile.is_null())
+      r.tile = RowRange{tile.at(0).get<int>(), tile.at(1).get<int>()};
     r.covered_texels = meta.at("covered_texels").get<std::int64_t>();
     const json& uv = meta.at("uv_layout");
     r.uv.covered_texels = uv.at("covered_texels").get<std::int64_t>();
@@ -203,6 +211,9 @@ Expected<ReceiverBake> read_receiver(const json& meta, const std::filesystem::pa
     r.lights_reached = meta.at("lights_reached").get<std::vector<std::uint8_t>>();
     for (const json& stat : meta.at("method_stats"))
       r.report.stats.emplace_back(stat.at(0).get<std::string>(), stat.at(1).get<double>());
+    for (const json& tally : meta.at("method_tallies"))
+      r.report.tallies.emplace_back(tally.at(0).get<std::string>(),
+                                    tally.at(1).get<std::int64_t>());
     r.report.manifest = meta.at("method_entries");
     r.report.explain = meta.at("explain").get<std::string>();
     r.report.warnings = meta.at("method_warnings").get<std::vector<std::string>>();
@@ -212,24 +223,27 @@ Expected<ReceiverBake> read_receiver(const json& meta, const std::filesystem::pa
   } catch (const json::exception& e) {
     return damaged(where, std::string("a receiver's entry: ") + e.what());
   }
-  if (side <= 0 || std::uint64_t(side) > kMaxSide || per_light > 4096 || visibility > 4096)
+  if (side <= 0 || std::uint64_t(side) > kMaxSide || per_light > 4096 || visibility > 4096 ||
+      (r.tile && (r.tile->begin < 0 || r.tile->end <= r.tile->begin || r.tile->end > side)))
     return damaged(where, "receiver '" + r.name + "' has impossible sizes");
+  // A tile's images hold its rows alone.
+  const int rows = r.tile ? r.tile->end - r.tile->begin : side;
   auto bytes = read_bytes(data);
   if (!bytes) return bytes.error();
   if (data_checksum(*bytes) != meta.value("checksum", ""))
     return damaged(data.string(), "its checksum is not the one " + where + " gives");
   Unpacker in(std::move(*bytes));
   const std::uint32_t magic = in.u32(), version = in.u32(), width = in.u32(), height = in.u32();
-  if (magic != kReceiverMagic || version != kVersion || int(width) != side || int(height) != side)
+  if (magic != kReceiverMagic || version != kVersion || int(width) != side || int(height) != rows)
     return damaged(data.string(), "not receiver '" + r.name + "'s data");
-  const std::size_t texels = std::size_t(side) * std::size_t(side);
-  r.image = Image(side, side, 3);
+  const std::size_t texels = std::size_t(side) * std::size_t(rows);
+  r.image = Image(side, rows, 3);
   in.take(r.image.pixels.data(), r.image.pixels.size());
   r.covered.resize(texels);
   in.take(r.covered.data(), r.covered.size());
-  r.per_light.assign(per_light, Image(side, side, 3));
+  r.per_light.assign(per_light, Image(side, rows, 3));
   for (Image& image : r.per_light) in.take(image.pixels.data(), image.pixels.size());
-  r.per_light_visibility.assign(visibility, Image(side, side, 2));
+  r.per_light_visibility.assign(visibility, Image(side, rows, 2));
   for (Image& image : r.per_light_visibility) in.take(image.pixels.data(), image.pixels.size());
   if (mesh) r.gltf_mesh = std::make_shared<const GltfMesh>(take_mesh(in));
   if (!in.at_end()) return damaged(data.string(), "its size does not match its header");

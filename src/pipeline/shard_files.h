@@ -1,14 +1,16 @@
-// A shard's receivers on disk (shards.h): per receiver its metadata as JSON (in shard.json) and
-// its arrays in one binary file, receiver_<object>.bin: a header (magic "SBSR", version, sizes)
-// then the image (float RGB), the coverage (bytes, padded to 4), the per-light images and
-// visibility (float), and the glTF mesh's arrays, in this machine's byte order (a shard and its
-// merge run on one cluster). Reading checks every size against the header and the file.
+// A shard's receivers on disk (shards.h): per receiver (or tile of one, pipeline/tiles.h) its
+// metadata as JSON (in shard.json) and its arrays in one binary file, receiver_<object>.bin (a
+// tile's: receiver_<object>_rows_<first row>.bin): a header (magic "SBSR", version, sizes) then
+// the image (float RGB; a tile's rows alone), the coverage (bytes, padded to 4), the per-light
+// images and visibility (float), and the glTF mesh's arrays, in this machine's byte order (a shard
+// and its merge run on one cluster). Reading checks every size against the header and the file.
 #pragma once
 
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "core/error.h"
@@ -16,8 +18,8 @@
 
 namespace sb {
 
-// The name of receiver (object index) `object`'s binary file.
-std::string receiver_data_file(std::size_t object);
+// The name of receiver (object index) `object`'s binary file, or of its tile's.
+std::string receiver_data_file(std::size_t object, std::optional<RowRange> tile = std::nullopt);
 
 // The receiver's metadata: everything but its arrays and timings.
 nlohmann::ordered_json receiver_metadata(const ReceiverBake& r);

@@ -16,6 +16,7 @@
 
 #include "pipeline/settings_json.h"
 #include "pipeline/shard_files.h"
+#include "pipeline/tiles.h"
 #include "texels/atlas_packing.h"
 
 namespace sb {
@@ -131,7 +132,8 @@ Expected<ShardSpec> parse_shard(const std::string& text) {
 
 std::vector<std::string> shard_output_names(const BakeResult& result) {
   std::vector<std::string> names;
-  for (const ReceiverBake& r : result.receivers) names.push_back(receiver_data_file(r.object));
+  for (const ReceiverBake& r : result.receivers)
+    names.push_back(receiver_data_file(r.object, r.tile));
   for (std::size_t b = 0; b < result.gltf_blockers.size(); ++b)
     names.push_back(fmt::format("{}{}.bin", kBlockerMeshPrefix, b));
   names.push_back(kShardTimingsFile);
@@ -146,17 +148,19 @@ Status write_shard(OutputFolder& folder, const Scene& scene, const ShardSpec& sp
   const std::vector<std::string> names = shard_output_names(result);
   if (Status s = folder.check_targets(names); !s) return s;
   std::error_code ec;
-  json description = {
-      {"shadowbake_shard", SHADOWBAKE_VERSION},
-      {"hash", *hash},
-      {"scene", scene.file.string()},
-      {"scene_path", fs::absolute(scene.file, ec).lexically_normal().string()},
-      {"shard",
-       {{"index", spec.index}, {"count", spec.count}, {"balance", to_string(spec.balance)}}},
-      {"settings", settings_to_json(scene.bake, scene.output)},
-      {"setup_warnings", result.setup_warnings},
-      {"receivers", json::array()},
-      {"gltf_blockers", json::array()}};
+  json description = {{"shadowbake_shard", SHADOWBAKE_VERSION},
+                      {"hash", *hash},
+                      {"scene", scene.file.string()},
+                      {"scene_path", fs::absolute(scene.file, ec).lexically_normal().string()},
+                      {"shard",
+                       {{"index", spec.index},
+                        {"count", spec.count},
+                        {"balance", to_string(spec.balance)},
+                        {"tiles", spec.tiles}}},
+                      {"settings", settings_to_json(scene.bake, scene.output)},
+                      {"setup_warnings", result.setup_warnings},
+                      {"receivers", json::array()},
+                      {"gltf_blockers", json::array()}};
   json timings = {{"load_seconds", result.load_seconds},
                   {"bake_seconds", result.bake_seconds},
                   {"receivers", json::object()}};
@@ -165,12 +169,13 @@ Status write_shard(OutputFolder& folder, const Scene& scene, const ShardSpec& sp
     json metadata = receiver_metadata(r);
     metadata["checksum"] = data_checksum(data);
     description["receivers"].push_back(std::move(metadata));
-    timings["receivers"][r.name] = {{"seconds", r.seconds},
-                                    {"texels", r.seconds_texels},
-                                    {"method", r.seconds_method},
-                                    {"dilate", r.seconds_dilate},
-                                    {"seams", r.seconds_seams}};
-    if (Status s = write_text_file(folder.staged(receiver_data_file(r.object)), data); !s) return s;
+    timings["receivers"][receiver_data_file(r.object, r.tile)] = {{"seconds", r.seconds},
+                                                                  {"texels", r.seconds_texels},
+                                                                  {"method", r.seconds_method},
+                                                                  {"dilate", r.seconds_dilate},
+                                                                  {"seams", r.seconds_seams}};
+    if (Status s = write_text_file(folder.staged(receiver_data_file(r.object, r.tile)), data); !s)
+      return s;
   }
   for (std::size_t b = 0; b < result.gltf_blockers.size(); ++b) {
     const std::string file = fmt::format("{}{}.bin", kBlockerMeshPrefix, b);
@@ -215,14 +220,17 @@ Expected<MergedBake> merge_shards(const std::vector<fs::path>& folders,
     return s.description.value(key, json()) == first.description.value(key, json());
   };
   const auto same_split = [&](const ShardRead& s) {
-    return s.count == first.count && s.description["shard"].value("balance", "") ==
-                                         first.description["shard"].value("balance", "");
+    return s.count == first.count &&
+           s.description["shard"].value("balance", "") ==
+               first.description["shard"].value("balance", "") &&
+           s.description["shard"].value("tiles", true) ==
+               first.description["shard"].value("tiles", true);
   };
   for (const ShardRead& s : shards) {
     const char* what = !same(s, "shadowbake_shard") ? "another shadowbake version"
                        : !same(s, "hash")           ? "another scene, meshes or settings"
-                       : !same_split(s)             ? "another split (shard count or balance)"
-                                                    : nullptr;
+                       : !same_split(s) ? "another split (shard count, balance or tiles)"
+                                        : nullptr;
     if (what)
       return input_error(fmt::format("{}: a shard of {} than {} (scene hash {} against {})",
                                      s.folder.string(), what, first.folder.string(),
@@ -274,9 +282,10 @@ Expected<MergedBake> merge_shards(const std::vector<fs::path>& folders,
                       path, *hash, d.value("hash", "")));
   }
 
-  // Every receiver once, in scene order.
+  // Every receiver once, in scene order; a receiver baked in tiles once its tiles are joined.
   BakeResult& result = merged.result;
   std::map<std::size_t, ReceiverBake> receivers;
+  std::map<std::size_t, std::vector<ReceiverBake>> tiled;
   for (const ShardRead* s : by_index) {
     const std::string where = (s->folder / kShardFile).string();
     // Timings are not checked: a shard's time is what it is, and the merged manifest sums them.
@@ -286,10 +295,15 @@ Expected<MergedBake> merge_shards(const std::vector<fs::path>& folders,
       result.bake_seconds += timings->value("bake_seconds", 0.0);
     }
     for (const json& meta : s->description.at("receivers")) {
-      auto r = read_receiver(meta, s->folder / receiver_data_file(meta.value("object", 0)), where);
+      std::optional<RowRange> tile;
+      if (const json rows = meta.value("tile", json());
+          rows.is_array() && rows.size() == 2 && rows[0].is_number_integer())
+        tile = RowRange{rows[0].get<int>(), rows[1].get<int>()};
+      const std::string file = receiver_data_file(meta.value("object", 0), tile);
+      auto r = read_receiver(meta, s->folder / file, where);
       if (!r) return r.error();
-      if (timings && timings->contains("receivers") && (*timings)["receivers"].contains(r->name)) {
-        const json& t = (*timings)["receivers"][r->name];
+      if (timings && timings->contains("receivers") && (*timings)["receivers"].contains(file)) {
+        const json& t = (*timings)["receivers"][file];
         r->seconds = t.value("seconds", 0.0);
         r->seconds_texels = t.value("texels", 0.0);
         r->seconds_method = t.value("method", 0.0);
@@ -300,8 +314,31 @@ Expected<MergedBake> merge_shards(const std::vector<fs::path>& folders,
       if (object >= merged.scene.objects.size() || !merged.scene.objects[object].receiver ||
           merged.scene.objects[object].name != r->name)
         return input_error(where + ": receiver '" + r->name + "' is not in the scene");
-      if (!receivers.emplace(object, std::move(*r)).second)
+      if (r->tile) {
+        tiled[object].push_back(std::move(*r));
+      } else if (!receivers.emplace(object, std::move(*r)).second) {
         return input_error(where + ": receiver '" + r->name + "' is in two shards");
+      }
+    }
+  }
+  {
+    std::vector<std::vector<ReceiverBake>> lists;
+    for (auto& [object, tiles] : tiled) {
+      if (receivers.count(object))
+        return input_error(fmt::format("receiver '{}' is both whole and in tiles in the shards",
+                                       tiles.front().name));
+      lists.push_back(std::move(tiles));
+    }
+    Scene as_read = merged.scene;
+    as_read.file = path;  // where its meshes lie
+    auto joined = join_tiles(as_read, std::move(lists), "merge");
+    if (!joined) return joined.error();
+    for (ReceiverBake& r : *joined) {
+      // Its warnings name the scene as the shards did.
+      for (std::string& w : r.uv_warnings)
+        if (w.rfind(path, 0) == 0) w = as_given + w.substr(path.size());
+      const std::size_t object = r.object;
+      receivers.emplace(object, std::move(r));
     }
   }
   for (std::size_t i = 0; i < merged.scene.objects.size(); ++i) {

@@ -3,7 +3,10 @@
 // rasterise_texels (uv_rasterizer.cpp); grown into the margin by dilate (dilation.cpp).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <limits>
+#include <utility>
 #include <vector>
 
 #include "core/geometry.h"
@@ -26,6 +29,13 @@ struct Texel {
   int face = -1;  // index of the covering triangle
 };
 
+// Rows [begin, end) of a lightmap.
+struct RowRange {
+  int begin = 0, end = std::numeric_limits<int>::max();
+  bool contains(int y) const { return y >= begin && y < end; }
+  bool operator==(const RowRange&) const = default;
+};
+
 struct TexelSpace {
   int width = 0, height = 0;
   std::vector<Texel> texels;          // covered texels, in row-major order
@@ -33,13 +43,30 @@ struct TexelSpace {
   // Texels whose centre two UV triangles claim (inside one, inside or on the other): charts that
   // overlap in the lightmap, so one surface point stands for two (check_uv_layout reports it).
   std::int64_t overlapping_texels = 0;
+  // A tile's texel space (pipeline/tiles.h) holds some rows only: the tile's own, `kept`, and a
+  // halo around them that its method needs to value them as a bake of every row would. Methods
+  // count the kept rows' texels alone (a tile's counts add up to the whole receiver's); the
+  // halo's values are dropped. A whole receiver's keeps every row.
+  RowRange kept;
 };
+
+// The kept rows' texels: indices [first, second) into space.texels (row-major).
+inline std::pair<std::size_t, std::size_t> kept_texels(const TexelSpace& space) {
+  const auto at = [&](int row) {
+    return std::size_t(std::lower_bound(space.texels.begin(), space.texels.end(), row,
+                                        [](const Texel& t, int y) { return t.y < y; }) -
+                       space.texels.begin());
+  };
+  return {at(space.kept.begin), at(space.kept.end)};
+}
 
 // Rasterises mesh's triangles in UV space at width × height. A texel whose centre lies inside a
 // triangle takes that point; a texel that a triangle touches but whose centre no triangle covers
 // (thin triangles, chart borders) takes the triangle's point nearest its centre (conservative
-// coverage), so thin geometry is never lost. UVs outside [0, 1] are clipped.
-TexelSpace rasterise_texels(const Mesh& mesh, int width, int height);
+// coverage), so thin geometry is never lost. UVs outside [0, 1] are clipped. With `rows`, only
+// those rows are rasterised (their texels are those a whole rasterisation gives them); `covered`
+// is still width × height.
+TexelSpace rasterise_texels(const Mesh& mesh, int width, int height, RowRange rows = {});
 
 // Grows image values outward from covered texels by `margin` texels: each ring of uncovered
 // texels takes the mean of its already-filled 8-neighbours, so bilinear filtering and mip-mapping

@@ -239,7 +239,7 @@ int face_of(std::int32_t code) { return code >= 0 ? code : -2 - code; }
 
 }  // namespace
 
-TexelSpace rasterise_texels(const Mesh& mesh, int width, int height) {
+TexelSpace rasterise_texels(const Mesh& mesh, int width, int height, RowRange rows) {
   assert(width > 0 && height > 0);
   TexelSpace space;
   if (width <= 0 || height <= 0) return space;
@@ -247,6 +247,9 @@ TexelSpace rasterise_texels(const Mesh& mesh, int width, int height) {
   space.height = height;
   const std::size_t texel_count = std::size_t(width) * std::size_t(height);
   space.covered.assign(texel_count, 0);
+  // The rows rasterised: all, or a tile's (rows are independent, so a row's texels are the same).
+  const int row0 = std::clamp(rows.begin, 0, height), row1 = std::clamp(rows.end, row0, height);
+  const int window = row1 - row0;
   if (!mesh.has_uv) return space;  // no lightmap UVs: nothing is covered
 
   // Footprints of the usable faces, in face order; surfaces indexed by face.
@@ -311,17 +314,18 @@ TexelSpace rasterise_texels(const Mesh& mesh, int width, int height) {
     }
   }
 
-  // Passes 1 and 2, row by row: the owner code of every texel, and covered texels per row.
-  std::vector<std::int32_t> owner(texel_count, kUncovered);
-  std::vector<std::size_t> row_count(std::size_t(height) + 1, 0);
+  // Passes 1 and 2, row by row: the owner code of every texel of the window, and covered texels
+  // per row (indexed from row0).
+  std::vector<std::int32_t> owner(std::size_t(window) * std::size_t(width), kUncovered);
+  std::vector<std::size_t> row_count(std::size_t(window) + 1, 0);
   std::atomic<std::int64_t> overlapping{0};
-  tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
+  tbb::parallel_for(tbb::blocked_range<int>(row0, row1), [&](const tbb::blocked_range<int>& rows) {
     std::vector<double> best_distance(static_cast<std::size_t>(width));
     std::vector<std::uint8_t> row_strict(static_cast<std::size_t>(width));
     std::vector<std::uint8_t> row_overlap(static_cast<std::size_t>(width));
     for (int y = rows.begin(); y != rows.end(); ++y) {
       std::fill(row_overlap.begin(), row_overlap.end(), 0);
-      std::int32_t* row_owner = &owner[std::size_t(y) * std::size_t(width)];
+      std::int32_t* row_owner = &owner[std::size_t(y - row0) * std::size_t(width)];
       const auto faces_begin = row_faces.begin() + std::ptrdiff_t(row_begin[std::size_t(y)]);
       const auto faces_end = row_faces.begin() + std::ptrdiff_t(row_begin[std::size_t(y) + 1]);
       const double centre_y = y + 0.5;
@@ -368,7 +372,7 @@ TexelSpace rasterise_texels(const Mesh& mesh, int width, int height) {
       }
       std::size_t count = 0;
       for (int x = 0; x < width; ++x) count += row_owner[x] != kUncovered;
-      row_count[std::size_t(y) + 1] = count;
+      row_count[std::size_t(y - row0) + 1] = count;
       std::int64_t overlaps = 0;
       for (const std::uint8_t o : row_overlap) overlaps += o;
       overlapping += overlaps;
@@ -378,19 +382,20 @@ TexelSpace rasterise_texels(const Mesh& mesh, int width, int height) {
   space.overlapping_texels = overlapping.load();
 
   // Offsets of each row's texels in the row-major output, then the texels themselves.
-  for (int y = 0; y < height; ++y) row_count[std::size_t(y) + 1] += row_count[std::size_t(y)];
-  space.texels.resize(row_count[std::size_t(height)]);
+  for (int y = 0; y < window; ++y) row_count[std::size_t(y) + 1] += row_count[std::size_t(y)];
+  space.texels.resize(row_count[std::size_t(window)]);
   std::vector<int> footprint_of_face(tri_mesh.n_faces(), -1);
   for (std::size_t i = 0; i < footprints.size(); ++i)
     footprint_of_face[std::size_t(footprints[i].face)] = int(i);
-  tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
+  tbb::parallel_for(tbb::blocked_range<int>(row0, row1), [&](const tbb::blocked_range<int>& rows) {
     for (int y = rows.begin(); y != rows.end(); ++y) {
-      Texel* out = space.texels.data() + row_count[std::size_t(y)];
+      Texel* out = space.texels.data() + row_count[std::size_t(y - row0)];
       const std::size_t row_offset = std::size_t(y) * std::size_t(width);
+      const std::size_t owner_offset = std::size_t(y - row0) * std::size_t(width);
       const double centre_y = y + 0.5;
       const double centre_v = 1.0 - centre_y / height;
       for (int x = 0; x < width; ++x) {
-        const std::int32_t code = owner[row_offset + std::size_t(x)];
+        const std::int32_t code = owner[owner_offset + std::size_t(x)];
         if (code == kUncovered) continue;
         const int face = face_of(code);
         const FaceFootprint& fp = footprints[std::size_t(footprint_of_face[std::size_t(face)])];

@@ -3,11 +3,13 @@
 # and slurmd (Debian's munge and slurm-wlm) with their state, sockets and logs in a scratch
 # folder and their own ports, submits a 4-task job array of shards and the merge with
 # deploy/slurm/submit.sh, waits for both, bakes the same scene in one process, and compares the
-# two bakes byte for byte (the manifest but for its timings). Stops the daemons whatever happens.
-# Needs root (slurmd runs jobs as their user) and the packages munge, slurm-wlm
-# (.ci/debian-packages). CTest: `ctest -L slurm` (Distributed.SlurmOneNodeCluster).
+# two bakes byte for byte (the manifest but for its timings). With TILES, a receiver must have
+# been split into that many tiles of rows (pipeline/tiles.h) across the shards. Stops the daemons
+# whatever happens. Needs root (slurmd runs jobs as their user) and the packages munge, slurm-wlm
+# (.ci/debian-packages). CTest: `ctest -L slurm` (Distributed.SlurmOneNodeCluster: the hall
+# level in 4 shards; Distributed.SlurmTiles4096: the courtyard's 4096² ground in 8 tiles).
 #
-#   tests/distributed/slurm_cluster_test.sh build/shadowbake [SCENE]
+#   tests/distributed/slurm_cluster_test.sh build/shadowbake [SCENE [SHARDS [TILES [OPTIONS...]]]]
 set -euo pipefail
 
 fail() {
@@ -18,8 +20,9 @@ fail() {
 root=$(cd "$(dirname "$0")/../.." && pwd)
 shadowbake=$(realpath "$1")
 scene=$(realpath "${2:-$root/scenes/hall/scene_level.toml}")
-bake_options=(--samples 8)
-shards=4
+shards=${3:-4}
+tiles=${4:-0}
+if [ $# -ge 5 ]; then bake_options=("${@:5}"); else bake_options=(--samples 8); fi
 [ "$(id -u)" -eq 0 ] || fail "needs root: slurmd starts each job as its user"
 for tool in munged slurmctld slurmd sbatch scontrol sinfo; do
   command -v "$tool" >/dev/null || fail "$tool not found (apt-get install munge slurm-wlm)"
@@ -115,9 +118,15 @@ done
 [[ $merge_state == *COMPLETED* ]] || fail "merge job $merge did not finish in 6 minutes ($merge_state)"
 echo "slurm_cluster_test: array and merge completed ($(elapsed))"
 ls "$scratch/out/merged.shards" | grep -c '^shard_' | grep -qx "$shards" || fail "not $shards shard folders"
+if [ "$tiles" -gt 0 ]; then
+  found=$(find "$scratch/out/merged.shards" -name 'receiver_*_rows_*.bin' | wc -l)
+  [ "$found" -eq "$tiles" ] || fail "$found tiles in the shards, not $tiles"
+  echo "slurm_cluster_test: the shards hold $found tiles of one receiver"
+fi
 
-# The same bake in one process, and the comparison.
-"$shadowbake" bake "$scene" -o "$scratch/out/single" -q "${bake_options[@]}" 2>/dev/null
+# The same bake in one process (without the incremental cache a merge does not write), and the
+# comparison.
+"$shadowbake" bake "$scene" -o "$scratch/out/single" -q --no-cache "${bake_options[@]}" 2>/dev/null
 /usr/bin/python3 - "$scratch/out/single" "$out" <<'PY'
 import json, os, sys
 a, b = sys.argv[1], sys.argv[2]

@@ -2,9 +2,11 @@
 // N = 1…8 shards, the merge writes what one bake of the whole scene writes, byte for byte (the
 // manifest but for its timings), per-light images, shadow masks, atlases and glTF included; a
 // rerun of a shard writes the same bytes; a missing, duplicated or foreign shard is a one-line
-// error; cost balancing deals uneven receivers better than round robin.
+// error; cost balancing deals uneven receivers better than round robin; receivers split into tiles
+// of rows merge to the single bake too.
 #include "pipeline/shards.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -17,6 +19,7 @@
 
 #include "pipeline/manifest.h"
 #include "pipeline/outputs.h"
+#include "pipeline/tiles.h"
 
 namespace sb {
 namespace {
@@ -226,6 +229,146 @@ TEST(Shards, MissingDuplicatedOrForeignShardsAreNamed) {
   EXPECT_NE(damaged.find("damaged shard data"), std::string::npos) << damaged;
   std::ofstream(data, std::ios::binary | std::ios::trunc) << original;
   EXPECT_TRUE(merge_shards({s0, s1, s2}));
+}
+
+// Tiles (pipeline/tiles.h): receivers dearer than a shard's share split into tiles of rows, for
+// each method that allows it, merge to the single bake byte for byte (seams, dilation, per-light
+// images, shadow masks and glTF included); some receiver must have been split.
+struct TiledCase {
+  std::string scene, method;
+};
+
+void PrintTo(const TiledCase& c, std::ostream* os) { *os << c.scene << " by " << c.method; }
+
+class TiledScenes : public ::testing::TestWithParam<TiledCase> {};
+
+TEST_P(TiledScenes, MergeToTheSingleBake) {
+  const TiledCase& c = GetParam();
+  std::string name = c.scene + "_" + c.method;
+  for (char& ch : name)
+    if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+  ShardsFixture f("tiles_" + name);
+  Scene scene = quick(c.scene);
+  scene.bake.resolution = 96;  // three blocks of rows: tiles of 32 and 64 rows
+  scene.bake.method = c.method;
+  if (c.method == "ambient-occlusion") {
+    scene.bake.quantity = Quantity::ambient_occlusion;
+    scene.output.per_light = scene.output.shadowmask = false;
+  }
+  f.bake_whole(scene, f.dir() / "whole");
+  int tiles = 0;
+  for (int n = 2; n <= 4; ++n) {
+    std::vector<fs::path> shards;
+    for (int k = 0; k < n; ++k) {
+      shards.push_back(f.dir() / ("shard_" + std::to_string(n) + "_" + std::to_string(k)));
+      f.bake_shard(scene, {k, n, ShardBalance::cost}, shards.back());
+      for (const auto& e : fs::directory_iterator(shards.back()))
+        tiles += e.path().filename().string().find("_rows_") != std::string::npos;
+    }
+    const fs::path merged = f.dir() / ("merged_" + std::to_string(n));
+    f.merge(shards, merged);
+    const std::vector<std::string> diff = differences(f.dir() / "whole", merged);
+    EXPECT_TRUE(diff.empty()) << name << ", N = " << n << ": " << diff.size()
+                              << " file(s) differ, first " << (diff.empty() ? "" : diff[0]);
+    for (const fs::path& s : shards) fs::remove_all(s);
+    fs::remove_all(merged);
+  }
+  EXPECT_GT(tiles, 0) << "no receiver was split";
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, TiledScenes,
+                         ::testing::Values(TiledCase{"room/scene.toml", "backprojection"},
+                                           TiledCase{"seams/scene.toml", "backprojection"},
+                                           TiledCase{"room/scene.toml", "reference"},
+                                           TiledCase{"seams/scene.toml", "ambient-occlusion"}),
+                         [](const auto& info) {
+                           std::string name = info.param.scene + "_" + info.param.method;
+                           for (char& c : name)
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           return name;
+                         });
+
+TEST(Tiles, AReceiverDearerThanAShareIsSplitIntoRowsThatCoverItOnce) {
+  // One 4096² receiver of uniform cost in 8 shards: a tile of 512 rows each.
+  const std::vector<std::vector<double>> one(1, std::vector<double>(128, 1.0));
+  for (int k = 0; k < 8; ++k) {
+    const std::vector<ShardUnit> units = shard_units(one, {4096}, true, {k, 8});
+    ASSERT_EQ(units.size(), 1u) << k;
+    ASSERT_TRUE(units[0].rows) << k;
+    EXPECT_EQ(units[0].rows->end - units[0].rows->begin, 512) << k;
+  }
+  // Without tiles, or with a method that cannot be split, it stays whole in one shard.
+  EXPECT_EQ(shard_units(one, {4096}, false, {0, 8}), (std::vector<ShardUnit>{{0, std::nullopt}}));
+  EXPECT_TRUE(shard_units(one, {4096}, false, {1, 8}).empty());
+  // A floor dearer than the rest, a wall, props: every receiver's rows once over the shards, the
+  // props whole, and the dearest shard within LPT's bound of a share.
+  std::vector<std::vector<double>> costs = {
+      std::vector<double>(64, 3.0), {5, 1, 2}, std::vector<double>(16, 2.0), {1}, {0.5, 0.5}};
+  costs[0][10] = 40;  // a dense corner
+  const std::vector<int> sides = {2048, 96, 512, 32, 50};
+  double total = 0;
+  for (const auto& blocks : costs)
+    for (double c : blocks) total += c;
+  for (int n = 2; n <= 6; ++n) {
+    std::vector<std::vector<int>> rows(costs.size());
+    double dearest = 0;
+    for (int k = 0; k < n; ++k) {
+      double load = 0;
+      for (const ShardUnit& u : shard_units(costs, sides, true, {k, n})) {
+        const RowRange r = u.rows.value_or(RowRange{0, sides[u.receiver]});
+        EXPECT_EQ(r.begin % kTileRows, 0);
+        for (int y = r.begin; y < r.end; ++y) rows[u.receiver].push_back(y);
+        for (int b = r.begin / kTileRows; b * kTileRows < r.end; ++b) load += costs[u.receiver][b];
+        if (u.receiver == 3 || u.receiver == 4) {
+          EXPECT_FALSE(u.rows) << "a prop was split";
+        }
+      }
+      dearest = std::max(dearest, load);
+    }
+    for (std::size_t r = 0; r < costs.size(); ++r) {
+      std::sort(rows[r].begin(), rows[r].end());
+      std::vector<int> all(std::size_t(sides[r]));
+      for (int y = 0; y < sides[r]; ++y) all[std::size_t(y)] = y;
+      EXPECT_EQ(rows[r], all) << "receiver " << r << ", N = " << n;
+    }
+    EXPECT_LE(dearest, 1.5 * total / n + 40) << n;
+  }
+}
+
+TEST(Tiles, AJoinWithRowsMissingOrTwiceIsAnError) {
+  ShardsFixture f("tile_errors");
+  Scene scene = quick("room/scene.toml");
+  scene.bake.resolution = 96;
+  std::vector<ReceiverBake> tiles;
+  for (int k = 0; k < 3; ++k) {
+    BakeOptions options;
+    options.shard = ShardSpec{k, 3};
+    auto result = bake(scene, options);
+    ASSERT_TRUE(result) << result.error().message;
+    for (ReceiverBake& r : result->receivers)
+      if (r.tile && r.name == "floor") tiles.push_back(std::move(r));
+  }
+  ASSERT_GE(tiles.size(), 2u);  // the floor costs more than a shard's share
+  std::sort(tiles.begin(), tiles.end(), [](const ReceiverBake& a, const ReceiverBake& b) {
+    return a.tile->begin < b.tile->begin;
+  });
+  auto joined = join_tiles(scene, {tiles}, "here");
+  ASSERT_TRUE(joined) << joined.error().message;
+  EXPECT_EQ(joined->at(0).image.height, 96);
+  const RowRange first = *tiles[0].tile, second = *tiles[1].tile;
+  std::vector<ReceiverBake> gap = tiles, twice = tiles, short_of = tiles;
+  gap.erase(gap.begin());
+  twice.push_back(tiles[1]);
+  short_of.pop_back();
+  EXPECT_EQ(join_tiles(scene, {gap}, "here").error().message,
+            fmt::format("here: receiver 'floor': its tiles leave rows {} to {} out (a shard is "
+                        "missing)",
+                        first.begin, first.end - 1));
+  EXPECT_EQ(join_tiles(scene, {twice}, "here").error().message,
+            fmt::format("here: receiver 'floor': its tiles overlap at row {}", second.begin));
+  EXPECT_EQ(join_tiles(scene, {short_of}, "here").error().message,
+            fmt::format("here: receiver 'floor': its tiles end at row {} of 96",
+                        short_of.back().tile->end));
 }
 
 TEST(ShardSpec, ParsesKOfNAndTakesAutoFromTheScheduler) {

@@ -5,7 +5,9 @@
    many at a time as there are cores, as Slurm runs an array on one node) plus their merge, wall
    time from the first start to the merged files;
 2. balance: each shard of an N-way split baked alone on all cores (as on N farm machines), by
-   cost (the default) and by count (round robin); the split's makespan is its slowest shard.
+   cost (the default: receivers dearer than a shard's share split into tiles of rows), by cost
+   with receivers kept whole (--shard-tiles off), and by count (round robin); the split's
+   makespan is its slowest shard.
 
 Medians of --repeat runs. Standard library only:
 
@@ -29,7 +31,7 @@ def run(cmd):
 
 def single(binary, scene, extra, out):
     start = time.perf_counter()
-    run([binary, "bake", scene, "-o", out, "-q", *extra])
+    run([binary, "bake", scene, "-o", out, "-q", "--no-cache", *extra])
     return time.perf_counter() - start
 
 
@@ -43,13 +45,20 @@ def sharded(binary, scene, extra, out, n, workers):
     return time.perf_counter() - start
 
 
-def shard_times(binary, scene, extra, out, n, balance):
+SPLITS = {  # name: the bake options that make it
+    "cost": ["--shard-balance", "cost"],
+    "whole": ["--shard-balance", "cost", "--shard-tiles", "off"],
+    "count": ["--shard-balance", "count", "--shard-tiles", "off"],
+}
+
+
+def shard_times(binary, scene, extra, out, n, split):
     """Each shard alone on all cores: wall seconds per shard."""
     times = []
     for k in range(n):
         start = time.perf_counter()
-        run([binary, "bake", scene, "--shard", f"{k}/{n}", "--shard-balance", balance, "-o",
-             f"{out}.{balance}_{n}_{k}", "-q", *extra])
+        run([binary, "bake", scene, "--shard", f"{k}/{n}", *SPLITS[split], "-o",
+             f"{out}.{split}_{n}_{k}", "-q", *extra])
         times.append(time.perf_counter() - start)
     return times
 
@@ -75,18 +84,19 @@ def main():
             t = statistics.median(sharded(binary, args.scene, extra, f"{scratch}/sh{n}_{i}", n, cores)
                                   for i in range(args.repeat))
             print(f"| {n} shards (1 thread each, {cores} at a time) + merge | {t:.2f} | {base / t:.2f} |")
-        print("\n| N | makespan by cost (s) | by count (s) | cost's gain | shard times by cost | by count |")
-        print("|---|---|---|---|---|---|")
+        print("\n| N | makespan by cost, tiles (s) | by cost, whole receivers (s) | by count (s) "
+              "| shard times: by cost, tiles | whole | by count |")
+        print("|---|---|---|---|---|---|---|")
         for n in (2, 4, 8):
             rows = {}
-            for balance in ("cost", "count"):
-                runs = [shard_times(binary, args.scene, extra, f"{scratch}/b{i}", n, balance)
+            for split in SPLITS:
+                runs = [shard_times(binary, args.scene, extra, f"{scratch}/b{i}", n, split)
                         for i in range(args.repeat)]
-                per_shard = [statistics.median(r[k] for r in runs) for k in range(n)]
-                rows[balance] = per_shard
-            c, r = max(rows["cost"]), max(rows["count"])
+                rows[split] = [statistics.median(r[k] for r in runs) for k in range(n)]
             fmt = lambda xs: " ".join(f"{x:.2f}" for x in xs)
-            print(f"| {n} | {c:.2f} | {r:.2f} | {r / c:.2f}× | {fmt(rows['cost'])} | {fmt(rows['count'])} |")
+            print(f"| {n} | {max(rows['cost']):.2f} | {max(rows['whole']):.2f} | "
+                  f"{max(rows['count']):.2f} | {fmt(rows['cost'])} | {fmt(rows['whole'])} | "
+                  f"{fmt(rows['count'])} |")
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
 

@@ -489,6 +489,8 @@ void bake_light_by_rays(const TexelSpace& space, const BackprojectionInputs& in,
   const Light& light = (*in.lights)[l];
   const double offset = in.rays->surface_offset();
   const TileShafts tiles = tile_shafts(space, *in.culler, light, offset, kTileCandidates);
+  // Counted: the kept rows' texels (a tile's halo is not).
+  const std::size_t kept0 = kept_texels(space).first, kept1 = kept_texels(space).second;
   std::atomic<std::int64_t> clear{0}, traced{0}, rays{0};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, space.texels.size(), 64),
                     [&](const auto& r) {
@@ -506,7 +508,7 @@ void bake_light_by_rays(const TexelSpace& space, const BackprojectionInputs& in,
                                                           ? &tiles.candidates[tile]
                                                           : nullptr)) {
                           mix.set(l, t, Vec3::Ones());
-                          ++local_clear;
+                          local_clear += t >= kept0 && t < kept1;
                           continue;
                         }
                         Vec3 v;
@@ -514,6 +516,7 @@ void bake_light_by_rays(const TexelSpace& space, const BackprojectionInputs& in,
                                                  space.width, batch, strata, &v))
                           continue;
                         mix.set(l, t, v);
+                        if (t < kept0 || t >= kept1) continue;
                         ++local_traced;
                         local_rays += batch.size();
                       }
@@ -548,6 +551,8 @@ MixedImages bake_backprojection(const TexelSpace& space, const BackprojectionInp
   const std::vector<Light>& lights = *in.lights;
   LightMix mix(space, lights, in.quantity, LightMix::Order::light_major, in.keep_per_light);
   RouteCounts counts;
+  // Counted: the kept rows' texels (a tile's halo is not).
+  const std::size_t kept0 = kept_texels(space).first, kept1 = kept_texels(space).second;
   for (std::size_t l = 0; l < lights.size(); ++l) {
     if (lights[l].textured() || lights[l].is_point()) {
       bake_light_by_rays(space, in, l, lights[l].is_point() ? 1 : in.samples, mix, counts);
@@ -563,6 +568,7 @@ MixedImages bake_backprojection(const TexelSpace& space, const BackprojectionInp
                           const TexelRoute route = field.route[t];
                           if (route == TexelRoute::none) continue;
                           mix.set(l, t, Vec3::Constant(double(field.visibility[t])));
+                          if (t < kept0 || t >= kept1) continue;
                           ++c[route];
                           if (route == TexelRoute::traced)
                             c.rays += in.light_rows * LightRows::kCells / 2;

@@ -14,6 +14,35 @@ namespace sb {
 
 namespace {
 
+// A texel's value depends on its tile of 8 × 8 texels and the tiles around it (their cells'
+// corners, texel_refinement.cpp), and a tile's shaft test on its group of kGroup × kGroup tiles:
+// a tile of rows, its borders on groups, holds a group of tile rows on each side.
+constexpr int kBackprojectionHalo = TileShafts::kTile * TileShafts::kGroup;
+static_assert(kTileRows % kBackprojectionHalo == 0, "tiles' borders must lie on tile groups");
+
+// Its stats and explain from its tallies: the share of (light, texel) pairs each route took, and
+// the rays per texel.
+void summarise_routes(MethodReport& report) {
+  const auto tally = [&](std::string_view name) {
+    for (const auto& [key, count] : report.tallies)
+      if (key == name) return count;
+    return std::int64_t(0);
+  };
+  std::int64_t reached = 0;
+  for (TexelRoute r : kTexelRoutes) reached += tally(to_string(r));
+  const double all = std::max<double>(1.0, double(reached));
+  report.stats.clear();
+  std::string explain = fmt::format("{} (light, texel) pairs the lights reach:", reached);
+  for (TexelRoute r : kTexelRoutes) {
+    const double share = double(tally(to_string(r))) / all;
+    report.stats.emplace_back(std::string(to_string(r)) + "_fraction", share);
+    explain += fmt::format(" {} {:.1f} %", to_string(r), 100.0 * share);
+  }
+  report.stats.emplace_back("rays_per_texel",
+                            double(tally("rays")) / std::max<double>(1.0, double(tally("texels"))));
+  report.explain = explain + "\n";
+}
+
 class BackprojectionMethod final : public Method {
  public:
   explicit BackprojectionMethod(const BakeContext& context) : context_(context) {}
@@ -37,18 +66,12 @@ class BackprojectionMethod final : public Method {
     MethodResult result;
     result.images = bake_backprojection(*receiver.space, in, &routes);
     result.rays = routes.rays;
-    MethodReport& report = result.report;
-    const double all = std::max<double>(1.0, double(routes.reached()));
-    std::string explain =
-        fmt::format("{} (light, texel) pairs the lights reach:", routes.reached());
-    for (TexelRoute r : kTexelRoutes) {
-      report.stats.emplace_back(std::string(to_string(r)) + "_fraction", double(routes[r]) / all);
-      explain += fmt::format(" {} {:.1f} %", to_string(r), 100.0 * double(routes[r]) / all);
-    }
-    report.stats.emplace_back(
-        "rays_per_texel",
-        double(routes.rays) / std::max<double>(1.0, double(receiver.space->texels.size())));
-    report.explain = explain + "\n";
+    for (TexelRoute r : kTexelRoutes)
+      result.report.tallies.emplace_back(std::string(to_string(r)), routes[r]);
+    result.report.tallies.emplace_back("rays", routes.rays);
+    const auto [first, last] = kept_texels(*receiver.space);
+    result.report.tallies.emplace_back("texels", std::int64_t(last - first));
+    summarise_routes(result.report);
     return result;
   }
 
@@ -65,7 +88,9 @@ MethodEntry backprojection_method() {
           nullptr,
           [](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {
             return std::unique_ptr<Method>(std::make_unique<BackprojectionMethod>(context));
-          }};
+          },
+          kBackprojectionHalo,
+          summarise_routes};
 }
 
 }  // namespace sb

@@ -22,7 +22,11 @@
 // Inside a cell that passes, V is interpolated linearly over the four triangles the centre makes
 // with the cell's sides, so it is exact at all five samples and continuous across cells. Texels
 // of a cell that fails at S = 2 are each evaluated. Every decision depends on exact values and
-// the geometry alone, so the result is the same for any thread count and from run to run.
+// the geometry alone, so the result is the same for any thread count and from run to run; and a
+// cell's checks read all the texels it owns, whether or not a neighbour's samples valued some of
+// them already, so its decisions depend on its own samples and texels alone: a texel's value
+// depends on its tile and the tiles above, left and below it (their cells' corners), which is what
+// lets a tile of rows be baked apart from the rest (pipeline/tiles.h).
 #include "methods/backprojection/texel_refinement.h"
 
 #include <tbb/blocked_range.h>
@@ -150,7 +154,7 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
     for (int y = c.y0; y < c.y0 + s; ++y)
       for (int x = c.x0; x < c.x0 + s; ++x) {
         const std::int32_t t = grid.texel(x, y);
-        if (t < 0 || !reached[std::size_t(t)] || state[std::size_t(t)] == kValued) continue;
+        if (t < 0 || !reached[std::size_t(t)]) continue;
         const Texel& tx = space.texels[std::size_t(t)];
         const double u = double(x - c.x0) / s, w = double(y - c.y0) / s;
         const Vec3 bilinear = (1 - w) * ((1 - u) * p00 + u * p10) + w * ((1 - u) * p01 + u * p11);
@@ -194,8 +198,7 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
     for (int y = c.y0; y < c.y0 + s; ++y)
       for (int x = c.x0; x < c.x0 + s; ++x) {
         const std::int32_t t = grid.texel(x, y);
-        if (t >= 0 && reached[std::size_t(t)] && state[std::size_t(t)] != kValued)
-          inside.push_back(std::size_t(t));
+        if (t >= 0 && reached[std::size_t(t)]) inside.push_back(std::size_t(t));
       }
     return !source.sees_unlisted(inside, seen);
   };

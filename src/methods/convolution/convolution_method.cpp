@@ -192,7 +192,9 @@ MethodEntry convolution_method() {
                              ": [bake]: convolve = false needs trace = true (with neither, "
                              "nothing would compute the shadows)");
         return std::unique_ptr<Method>(std::make_unique<ConvolutionMethod>(context));
-      }};
+      },
+      /*tile_halo=*/-1,  // its images span the receiver
+      nullptr};
 }
 
 }  // namespace sb

@@ -1,0 +1,205 @@
+// The stages of a bake around the method (receiver_stages.h).
+#include "pipeline/receiver_stages.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <memory>
+
+#include "core/stopwatch.h"
+#include "lightmaps/shadowmask.h"
+#include "pipeline/memory_budget.h"
+#include "scene/mesh_reader.h"
+#include "scene/sky.h"
+#include "scene/sun_light.h"
+#include "texels/auto_uv.h"
+#include "texels/lightmap_sizes.h"
+#include "texels/seams.h"
+
+namespace sb {
+
+namespace {
+
+// The covered texels whose value means nothing, for the seams' stitching (texels/seams.h): in a
+// visibility, those none of `lights` reaches (V = H / H0 with H0 = 0, written 0). None for an
+// irradiance, which is 0 there in truth.
+std::vector<std::uint8_t> arbitrary_texels(bool visibility, const TexelSpace& space,
+                                           const std::vector<const Light*>& lights) {
+  std::vector<std::uint8_t> arbitrary;
+  if (!visibility) return arbitrary;
+  arbitrary.assign(space.covered.size(), 0);
+  for (const Texel& t : space.texels) {
+    const Vec3 y = t.position.cast<double>(), n = t.normal.cast<double>();
+    const bool reached =
+        std::any_of(lights.begin(), lights.end(), [&](const Light* l) { return l->reaches(y, n); });
+    arbitrary[std::size_t(t.y) * std::size_t(space.width) + std::size_t(t.x)] = !reached;
+  }
+  return arbitrary;
+}
+
+// A receiver's images with their arbitrary texels, for stitch_seams: the value image (every
+// light), then each light's value and visibility images (that light alone), so that a light's
+// image is stitched as a bake of that light alone would stitch it.
+std::vector<SeamImage> seam_images(const Scene& scene, ReceiverBake& out, const TexelSpace& space,
+                                   const std::vector<Light>& lights) {
+  const bool visibility = scene.bake.quantity == Quantity::visibility;
+  std::vector<const Light*> all;
+  for (const Light& l : lights) all.push_back(&l);
+  std::vector<SeamImage> images = {{&out.image, arbitrary_texels(visibility, space, all)}};
+  // The lights a scene light is made of: itself, or a mesh light's triangles.
+  const auto parts = [&](std::size_t output) {
+    std::vector<const Light*> of;
+    for (const Light& l : lights)
+      if (std::size_t(l.output()) == output) of.push_back(&l);
+    return of;
+  };
+  for (std::size_t l = 0; l < out.per_light.size(); ++l)
+    images.push_back({&out.per_light[l], arbitrary_texels(visibility, space, parts(l))});
+  for (std::size_t l = 0; l < out.per_light_visibility.size(); ++l)
+    images.push_back({&out.per_light_visibility[l], arbitrary_texels(true, space, parts(l))});
+  return images;
+}
+
+// What a seam's lookup difference is measured against (SeamReport): 1 for a visibility, the
+// image's largest value for an irradiance (1 where it is black).
+double seam_scale(const Scene& scene, const Image& image) {
+  if (scene.bake.quantity != Quantity::irradiance || image.pixels.empty()) return 1.0;
+  const float largest = *std::max_element(image.pixels.begin(), image.pixels.end());
+  return largest > 0 ? double(largest) : 1.0;
+}
+
+}  // namespace
+
+// Every object's mesh, in scene order; skipped degenerate triangles become warnings. A mesh file
+// may be a quarter of the memory budget, and its reader may use half of it: Assimp's scene and
+// the working mesh take several times the file's size. A file that several objects share (a
+// level's nodes) is read once and kept until its last object is built. A receiver with
+// uv = "auto" gets its lightmap UVs here, packed for the side it will have.
+Expected<std::vector<Mesh>> load_meshes(const Scene& scene, std::vector<std::string>* warnings) {
+  std::vector<Mesh> meshes;
+  meshes.reserve(scene.objects.size());
+  ImportLimits limits;
+  limits.max_file_bytes = memory_budget(scene.bake) / 4;
+  limits.max_memory = memory_budget(scene.bake) / 2;
+  std::map<std::filesystem::path, std::size_t> users;
+  for (const auto& obj : scene.objects) ++users[obj.mesh];
+  std::map<std::filesystem::path, std::shared_ptr<const RawMeshFile>> read;
+  for (const auto& obj : scene.objects) {
+    std::shared_ptr<const RawMeshFile>& file = read[obj.mesh];
+    if (!file) {
+      auto raw = read_object_file(obj, scene.file, limits);
+      if (!raw) return raw.error();
+      file = std::move(*raw);
+    }
+    auto mesh = build_object_mesh(obj, *file, scene.file);
+    if (--users[obj.mesh] == 0) read.erase(obj.mesh);
+    if (!mesh) return mesh.error();
+    if (mesh->skipped_degenerate > 0 && warnings) {
+      warnings->push_back(object_location(scene.file, obj) + ": skipped " +
+                          std::to_string(mesh->skipped_degenerate) +
+                          " degenerate (zero-area) triangles");
+    }
+    if (obj.auto_uv && obj.receiver) {
+      AutoUvTarget target;
+      target.margin = scene.bake.margin;
+      target.max_side = largest_lightmap_side(scene);
+      if (scene.bake.texels_per_metre > 0)
+        target.texels_per_metre = scene.bake.texels_per_metre * obj.lightmap_scale;
+      else
+        target.side = std::min(scene.bake.resolution, target.max_side);
+      if (auto made = generate_lightmap_uvs(*mesh, target); !made)
+        return scene_error(object_location(scene.file, obj) + ": " + made.error().message);
+    }
+    meshes.push_back(std::move(*mesh));
+  }
+  return meshes;
+}
+
+std::vector<const Mesh*> blocker_meshes(const Scene& scene, const std::vector<Mesh>& meshes) {
+  std::vector<const Mesh*> blockers;
+  for (std::size_t i = 0; i < meshes.size(); ++i)
+    if (scene.objects[i].blocker) blockers.push_back(&meshes[i]);
+  return blockers;
+}
+
+// The scene's lights with every sun and sky placed for the meshes' bounds (sun_light.h, sky.h).
+std::vector<LightDesc> placed_lights(const Scene& scene, const std::vector<Mesh>& meshes) {
+  std::vector<LightDesc> lights = scene.lights;
+  const auto at_infinity = [](const LightDesc& l) {
+    return l.sun_angle_deg > 0 || l.shape == LightShape::sky;
+  };
+  if (std::none_of(lights.begin(), lights.end(), at_infinity)) return lights;
+  Bounds3 bounds;
+  for (const Mesh& m : meshes)
+    for (const auto& v : m.mesh.vertices()) {
+      const auto& p = m.mesh.point(v);
+      bounds.extend(Vec3(p[0], p[1], p[2]));
+    }
+  if (bounds.empty()) return lights;
+  for (LightDesc& l : lights) {
+    if (l.sun_angle_deg > 0) place_sun(l, bounds);
+    if (l.shape == LightShape::sky) place_sky(l, bounds);
+  }
+  return lights;
+}
+
+std::vector<std::uint8_t> lights_reaching(const Scene& scene, const TexelSpace& space,
+                                          const std::vector<Light>& lights) {
+  std::vector<std::uint8_t> reached(scene.lights.size(), 0);
+  if (scene.bake.quantity == Quantity::ambient_occlusion) return reached;
+  for (const Light& light : lights) {
+    std::uint8_t& reaches = reached[std::size_t(light.output())];
+    for (const Texel& t : space.texels) {
+      if (reaches) break;  // this light, or another part of its mesh light
+      reaches = light.reaches(t.position.cast<double>(), t.normal.cast<double>());
+    }
+  }
+  return reached;
+}
+
+Expected<std::vector<std::string>> layout_warnings(const Scene& scene, const ObjectDesc& obj,
+                                                   const UvLayoutReport& layout,
+                                                   std::int64_t covered, int side) {
+  std::vector<std::string> warnings;
+  // Its warnings say where it is in the scene file as it is now (a reused one's too).
+  const std::string where = object_location(scene.file, obj) + ": ";
+  if (covered == 0) {
+    const std::string problem = fmt::format(
+        "its lightmap UVs (channel {}) cover no texel at {}² (UV area {:.3g}, of which {:.3g} "
+        "inside [0, 1])",
+        obj.uv_channel, side, layout.uv_area, layout.uv_area - layout.uv_area_outside);
+    if (!obj.allow_uncovered) {
+      return scene_error(where + problem +
+                         "; fix the UVs, set 'uv' to the lightmap channel, or set "
+                         "allow_uncovered = true");
+    }
+    warnings.push_back(where + problem + "; its lightmap is black");
+  }
+  for (const std::string& w : uv_layout_warnings(layout)) warnings.push_back(where + w);
+  return warnings;
+}
+
+void finish_receiver(const Scene& scene, const Mesh& mesh, const TexelSpace& space,
+                     const std::vector<Light>& lights, ReceiverBake& out) {
+  for (std::size_t l = 0; l < out.per_light_visibility.size(); ++l)
+    apply_shadowmask_range(out.per_light_visibility[l], scene.lights[l], space);
+  const auto dilate_start = std::chrono::steady_clock::now();
+  dilate(out.image, space.covered, scene.bake.margin);
+  for (Image& image : out.per_light) dilate(image, space.covered, scene.bake.margin);
+  for (Image& image : out.per_light_visibility) dilate(image, space.covered, scene.bake.margin);
+  out.seconds_dilate = seconds_since(dilate_start);
+  const auto seams_start = std::chrono::steady_clock::now();
+  // The arbitrary-texel masks cost a reach test per texel and light: only for a mesh with seams.
+  if (const std::vector<SeamEdge> seams = find_seams(mesh); !seams.empty()) {
+    out.seams = stitch_seams(seams, space.covered, seam_images(scene, out, space, lights),
+                             seam_scale(scene, out.image), scene.bake.seams);
+  }
+  out.seconds_seams = seconds_since(seams_start);
+  out.covered_texels = std::int64_t(space.texels.size());
+  out.covered = space.covered;
+  if (scene.output.gltf) out.gltf_mesh = std::make_shared<const GltfMesh>(gltf_mesh(mesh));
+}
+
+}  // namespace sb
