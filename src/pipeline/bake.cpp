@@ -44,7 +44,8 @@ std::unique_ptr<tbb::global_control> limit_threads(const BakeOptions& options) {
 
 // The [bake] keys every bake reads, whatever its method.
 bool read_by_every_method(const std::string& key) {
-  for (const char* k : {"resolution", "method", "quantity", "margin", "max_memory"})
+  for (const char* k :
+       {"resolution", "texels_per_metre", "method", "quantity", "margin", "seams", "max_memory"})
     if (key == k) return true;
   return false;
 }

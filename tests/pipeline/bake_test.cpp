@@ -93,11 +93,13 @@ TEST(Bake, UnknownMethodIsAnError) {
 }
 
 // A [bake] key the chosen method does not read is reported with its line and the methods that
-// read it; keys every bake reads and keys the method reads are not.
+// read it; keys every bake reads (the lightmap's size, margin and seams too) and keys the method
+// reads are not.
 TEST(Bake, ReportsSettingsTheMethodIgnores) {
   Scene scene = parallel_scene(16, 16);
   scene.bake.method = "pcf";
-  scene.bake_keys = {{"samples", 7}, {"resolution", 5}, {"shadow_map", 9}};
+  scene.bake_keys = {{"samples", 7},          {"resolution", 5}, {"shadow_map", 9},
+                     {"texels_per_metre", 6}, {"seams", 10},     {"margin", 11}};
   auto result = bake(scene);
   ASSERT_TRUE(result) << result.error().message;
   std::vector<std::string> ignored;
