@@ -31,7 +31,9 @@ def main():
         bake, load, process, rate = [], [], [], []
         with tempfile.TemporaryDirectory() as out:
             for _ in range(args.runs):
-                cmd = [args.cli, "bake", args.scene, "-o", out, "--quiet", "--samples", str(samples)]
+                # --no-cache: every run bakes (an incremental rebake would reuse the last run).
+                cmd = [args.cli, "bake", args.scene, "-o", out, "--quiet", "--no-cache",
+                       "--samples", str(samples)]
                 if args.method:
                     cmd += ["--method", args.method]
                 if args.resolution:

@@ -23,8 +23,8 @@ CLI = ROOT / "build" / "shadowbake"
 
 def bake(scene, out, *args):
     start = time.monotonic()
-    subprocess.run([str(CLI), "bake", str(scene), "-o", str(out), "--quiet", *args], check=True,
-                   stderr=subprocess.DEVNULL)
+    subprocess.run([str(CLI), "bake", str(scene), "-o", str(out), "--quiet", "--no-cache", *args],
+                   check=True, stderr=subprocess.DEVNULL)
     return json.loads((out / "manifest.json").read_text())["bake_seconds"], time.monotonic() - start
 
 
