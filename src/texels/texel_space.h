@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cstdint>
 #include <limits>
+#include <memory>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -36,9 +38,34 @@ struct RowRange {
   bool operator==(const RowRange&) const = default;
 };
 
+// The texel records' allocator: std::allocator, but a record made without a value (resize) is
+// left as the memory holds it, so that the rasteriser sizes the array without writing it and then
+// writes each record once, in parallel. A 4096² receiver's records are a gigabyte, and a serial
+// first write of them cost a second on a virtual machine whose every first touch of a page is a
+// fault (perf: the kernel zeroing pages under std::vector::resize). Texel is an aggregate, an
+// implicit-lifetime type: its storage holds one before the rasteriser assigns it.
+static_assert(std::is_aggregate_v<Texel>, "RecordAllocator leaves Texel storage to be assigned");
+template <typename T>
+struct RecordAllocator : std::allocator<T> {
+  template <typename U>
+  struct rebind {
+    using other = RecordAllocator<U>;
+  };
+  RecordAllocator() = default;
+  template <typename U>
+  RecordAllocator(const RecordAllocator<U>&) noexcept {}
+  template <typename U>
+  void construct(U*) noexcept {}
+  template <typename U, typename... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
 struct TexelSpace {
   int width = 0, height = 0;
-  std::vector<Texel> texels;          // covered texels, in row-major order
+  // Covered texels, in row-major order.
+  std::vector<Texel, RecordAllocator<Texel>> texels;
   std::vector<std::uint8_t> covered;  // width * height; 1 where a texel of `texels` lies
   // Texels whose centre two UV triangles claim (inside one, inside or on the other): charts that
   // overlap in the lightmap, so one surface point stands for two (check_uv_layout reports it).
