@@ -34,7 +34,6 @@ struct Texel {
 // Rows [begin, end) of a lightmap.
 struct RowRange {
   int begin = 0, end = std::numeric_limits<int>::max();
-  bool contains(int y) const { return y >= begin && y < end; }
   bool operator==(const RowRange&) const = default;
 };
 

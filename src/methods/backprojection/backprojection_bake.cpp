@@ -490,7 +490,8 @@ void bake_light_by_rays(const TexelSpace& space, const BackprojectionInputs& in,
   const double offset = in.rays->surface_offset();
   const TileShafts tiles = tile_shafts(space, *in.culler, light, offset, kTileCandidates);
   // Counted: the kept rows' texels (a tile's halo is not).
-  const std::size_t kept0 = kept_texels(space).first, kept1 = kept_texels(space).second;
+  const auto kept = kept_texels(space);
+  const std::size_t kept0 = kept.first, kept1 = kept.second;
   std::atomic<std::int64_t> clear{0}, traced{0}, rays{0};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, space.texels.size(), 64),
                     [&](const auto& r) {
@@ -552,7 +553,8 @@ MixedImages bake_backprojection(const TexelSpace& space, const BackprojectionInp
   LightMix mix(space, lights, in.quantity, LightMix::Order::light_major, in.keep_per_light);
   RouteCounts counts;
   // Counted: the kept rows' texels (a tile's halo is not).
-  const std::size_t kept0 = kept_texels(space).first, kept1 = kept_texels(space).second;
+  const auto kept = kept_texels(space);
+  const std::size_t kept0 = kept.first, kept1 = kept.second;
   for (std::size_t l = 0; l < lights.size(); ++l) {
     if (lights[l].textured() || lights[l].is_point()) {
       bake_light_by_rays(space, in, l, lights[l].is_point() ? 1 : in.samples, mix, counts);
