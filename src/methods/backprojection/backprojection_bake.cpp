@@ -42,7 +42,7 @@ TileShafts tile_shafts(const TexelSpace& space, const ShaftCuller& culler, const
   tiles.candidates.resize(count);
   std::vector<Bounds3>& boxes = tiles.origins;
   boxes.assign(count, Bounds3());
-  tiles.reached.assign(space.texels.size(), 0);
+  tiles.reached.resize(space.texels.size());  // every texel's written below
   // Bands of kGroup tile rows in parallel, each in one pass over its texels (a 4096² receiver's
   // texels are a gigabyte: a pass is memory-bound): texels are in row-major order, so a band's
   // are the run from its first pixel row's first texel to the next band's.

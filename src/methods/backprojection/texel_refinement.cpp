@@ -34,6 +34,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 
 namespace sb {
 
@@ -50,29 +51,60 @@ struct Cell {
 TexelGrid::TexelGrid(const TexelSpace& space)
     : width(space.width),
       height(space.height),
-      at(std::size_t(space.width) * std::size_t(space.height), -1) {
-  // Each texel its own pixel: distinct writes.
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, space.texels.size(), 1 << 14),
-      [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t t = r.begin(); t != r.end(); ++t)
-          at[std::size_t(space.texels[t].y) * std::size_t(width) + std::size_t(space.texels[t].x)] =
-              std::int32_t(t);
-      });
+      words_per_row_(std::size_t(space.width + 63) / 64),
+      bits_(words_per_row_ * std::size_t(space.height), 0),
+      first_(bits_.size(), 0) {
+  // From the coverage mask, which marks exactly the texels' pixels: each row's count, their
+  // running sum (the index of each row's first texel), then each row's words.
+  const auto row_pixels = [&](int y) {
+    return space.covered.data() + std::size_t(y) * std::size_t(width);
+  };
+  std::vector<std::int32_t> row_first(std::size_t(height) + 1, 0);
+  tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const auto& r) {
+    for (int y = r.begin(); y != r.end(); ++y) {
+      const std::uint8_t* row = row_pixels(y);
+      row_first[std::size_t(y) + 1] = std::int32_t(std::count(row, row + width, std::uint8_t(1)));
+    }
+  });
+  for (int y = 0; y < height; ++y) row_first[std::size_t(y) + 1] += row_first[std::size_t(y)];
+  tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const auto& r) {
+    for (int y = r.begin(); y != r.end(); ++y) {
+      const std::uint8_t* row = row_pixels(y);
+      std::int32_t next = row_first[std::size_t(y)];
+      for (std::size_t w = 0; w < words_per_row_; ++w) {
+        const std::size_t word = std::size_t(y) * words_per_row_ + w;
+        first_[word] = next;
+        std::uint64_t bits = 0;
+        const int x1 = std::min(width, int(w + 1) * 64);
+        for (int x = int(w) * 64; x < x1; ++x)
+          if (row[x]) bits |= std::uint64_t(1) << (x & 63);
+        bits_[word] = bits;
+        next += std::popcount(bits);
+      }
+    }
+  });
 }
 
 LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const TileShafts& tiles,
                         const PairSource& source, const RefinementSettings& settings) {
   const std::size_t n = space.texels.size();
   LightField field;
-  field.visibility.assign(n, 1.0f);
-  field.route.assign(n, TexelRoute::none);
-  const std::vector<std::uint8_t>& reached = tiles.reached;
-  std::vector<std::uint8_t> state(n, kUnknown);
+  field.visibility.resize(n);
+  field.route.resize(n);
+  const FreshVector<std::uint8_t>& reached = tiles.reached;
+  FreshVector<std::uint8_t> state(n);
   // The evaluated texels' samples, in order of evaluation (a level's at a time), and each
   // texel's: what the cells' checks read beyond V.
   std::vector<PairSample> samples;
-  std::vector<std::int32_t> sample_of(n, -1);
+  FreshVector<std::int32_t> sample_of(n);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1 << 16), [&](const auto& r) {
+    for (std::size_t t = r.begin(); t != r.end(); ++t) {
+      field.visibility[t] = 1.0f;
+      field.route[t] = TexelRoute::none;
+      state[t] = kUnknown;
+      sample_of[t] = -1;
+    }
+  });
   // The clear tiles' texels, found through the grid (the texel records are many times larger).
   tbb::parallel_for(tbb::blocked_range<int>(0, tiles.tiles_y), [&](const auto& r) {
     for (int ty = r.begin(); ty != r.end(); ++ty)

@@ -5,6 +5,7 @@
 // change in the field, not chance.
 #pragma once
 
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -16,16 +17,32 @@
 
 namespace sb {
 
-// Texel indices by pixel, -1 where no texel is covered.
-struct TexelGrid {
+// Per-texel arrays sized without a serial first write (texel_space.h's RecordAllocator), for
+// their first writes to be parallel: a 4096² receiver's are tens of megabytes each, and each
+// fresh page's first touch is a fault.
+template <typename T>
+using FreshVector = std::vector<T, RecordAllocator<T>>;
+
+// Texel indices by pixel, -1 where no texel is covered: a bit per pixel and, per word of 64
+// pixels, the index of its first covered texel (texels are in row-major order, so the rest follow
+// by counting bits). A 4096² receiver's grid is 3 MB so, where an index per pixel was 67 MB of
+// fresh memory, zeroed and written again for every light.
+class TexelGrid {
+ public:
   int width = 0, height = 0;
-  std::vector<std::int32_t> at;
   explicit TexelGrid(const TexelSpace& space);
   std::int32_t texel(int x, int y) const {
-    return x < 0 || y < 0 || x >= width || y >= height
-               ? -1
-               : at[std::size_t(y) * width + std::size_t(x)];
+    if (x < 0 || y < 0 || x >= width || y >= height) return -1;
+    const std::size_t word = std::size_t(y) * words_per_row_ + std::size_t(x >> 6);
+    const std::uint64_t bit = std::uint64_t(1) << (x & 63);
+    if (!(bits_[word] & bit)) return -1;
+    return first_[word] + std::popcount(bits_[word] & (bit - 1));
   }
+
+ private:
+  std::size_t words_per_row_ = 0;
+  std::vector<std::uint64_t> bits_;
+  std::vector<std::int32_t> first_;
 };
 
 // The shaft test of each tile of kTile × kTile texels (ShaftCuller::tile_candidates) for one
@@ -44,7 +61,7 @@ struct TileShafts {
   std::vector<Kind> kind;
   std::vector<std::vector<std::uint32_t>> candidates;
   std::vector<Bounds3> origins;       // the box of each tile's texels' ray origins (those reached)
-  std::vector<std::uint8_t> reached;  // per texel: 1 where the light reaches it (H0 > 0)
+  FreshVector<std::uint8_t> reached;  // per texel: 1 where the light reaches it (H0 > 0)
   std::size_t tile_of(int x, int y) const {
     return std::size_t(y / kTile) * std::size_t(tiles_x) + std::size_t(x / kTile);
   }
@@ -91,8 +108,8 @@ struct RefinementSettings {
 
 // One light's visibility at every covered texel of a receiver, and the route each came by.
 struct LightField {
-  std::vector<float> visibility;  // per texel; 1 where the route is none
-  std::vector<TexelRoute> route;
+  FreshVector<float> visibility;  // per texel; 1 where the route is none
+  FreshVector<TexelRoute> route;
 };
 
 LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const TileShafts& tiles,
