@@ -116,8 +116,7 @@ MixedImages bake_accumulation(const TexelSpace& space, const BaselineInputs& in,
           const Texel& texel = space.texels[t];
           const Vec3 position = texel.position.cast<double>();
           const Vec3 normal = texel.normal.cast<double>();
-          const Vec3 origin =
-              texel.shadow_origin.cast<double>() + offset * texel.geometric_normal.cast<double>();
+          const Vec3 origin = space.ray_origin(t, offset);
           LightMix::Sum sum;
           for (std::size_t l = 0; l < lights.size(); ++l) {
             if (!lights[l].reaches(position, normal)) continue;

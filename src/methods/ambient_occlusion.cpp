@@ -31,8 +31,7 @@ Image bake_ambient_occlusion(const TexelSpace& space, const AmbientOcclusionInpu
         for (std::size_t t = range.begin(); t != range.end(); ++t) {
           const Texel& texel = space.texels[t];
           const Vec3 normal = texel.normal.cast<double>();
-          const Vec3 origin =
-              texel.shadow_origin.cast<double>() + offset * texel.geometric_normal.cast<double>();
+          const Vec3 origin = space.ray_origin(t, offset);
           Rng rng(stream_seed(in.seed, in.stream, std::uint64_t(texel.y) * space.width + texel.x));
           stratified_samples(in.samples, rng, strata);
           for (std::size_t s = 0; s < n; ++s) {

@@ -294,10 +294,10 @@ class ErosionBake {
           for (std::size_t t = range.begin(); t != range.end(); ++t) {
             const Texel& tx = space_.texels[t];
             if (!light.reaches(tx.position.cast<double>(), tx.normal.cast<double>())) continue;
-            const Vec3 origin =
-                tx.shadow_origin.cast<double>() + offset * tx.geometric_normal.cast<double>();
+            const Vec3 origin = space_.ray_origin(t, offset);
             bool at_centre = true;
-            const std::optional<Vec3> target = hard_shadow_target(light, tx, &at_centre);
+            const std::optional<Vec3> target =
+                hard_shadow_target(light, tx, space_.geometric_normal(t), &at_centre);
             state_[pixel(tx.x, tx.y)] = 1;
             if (!target) continue;
             const Vec3 d = *target - origin;
@@ -339,9 +339,9 @@ class ErosionBake {
   // horizons (the shading normal sees the light, the triangle does not): nullopt, and the texel
   // counts as lit, as the reference finds it where the shading normal is smooth.
   static std::optional<Vec3> hard_shadow_target(const Light& light, const Texel& tx,
-                                                bool* at_centre) {
+                                                const Vec3f& face_normal, bool* at_centre) {
     const Vec3 y = tx.position.cast<double>(), n = tx.normal.cast<double>();
-    const Vec3 face = tx.geometric_normal.cast<double>();
+    const Vec3 face = face_normal.cast<double>();
     const Vec3 to_centre = light.centre() - y;
     *at_centre = to_centre.dot(n) > 0 && to_centre.dot(face) > 0;
     if (*at_centre) return light.centre();
@@ -517,7 +517,8 @@ class ErosionBake {
         {std::numeric_limits<int>::max(), std::numeric_limits<int>::max(), -1, -1});
     for (const Texel& tx : space_.texels) {
       auto& b = box[std::size_t(chart_[pixel(tx.x, tx.y)])];
-      b = {std::min(b[0], tx.x), std::min(b[1], tx.y), std::max(b[2], tx.x), std::max(b[3], tx.y)};
+      b = {std::min<int>(b[0], tx.x), std::min<int>(b[1], tx.y), std::max<int>(b[2], tx.x),
+           std::max<int>(b[3], tx.y)};
     }
     tables_.assign(std::size_t(chart_count_), ChartTable{});
     tbb::parallel_for(0, chart_count_, [&](int c) {

@@ -39,8 +39,8 @@ MixedImages bake_reference(const TexelSpace& space, const ReferenceInputs& in,
               // The whole sky at its first part; its other parts add nothing.
               if (l > 0 && lights[l - 1].sky() == sky) continue;
               Vec3 h0, v;
-              if (estimate_sky(texel, *sky, rays, in.samples, in.seed,
-                               stream_seed(in.stream, lights[l].stream()), space.width,
+              if (estimate_sky(space, t, *sky, rays, in.samples, in.seed,
+                               stream_seed(in.stream, lights[l].stream()),
                                (lights[l].centre() - texel.position.cast<double>()).norm(),
                                sky_rays, &h0, &v, &local_rays))
                 mix.add(sum, l, t, h0, v);
@@ -49,8 +49,8 @@ MixedImages bake_reference(const TexelSpace& space, const ReferenceInputs& in,
             const Vec3 h0 = mix.unoccluded(l, t);
             if (h0.maxCoeff() <= 0) continue;
             Vec3 v;
-            if (!estimate_visibility(texel, lights[l], rays, in.samples, in.seed, in.stream,
-                                     space.width, batch, strata, &v))
+            if (!estimate_visibility(space, t, lights[l], rays, in.samples, in.seed, in.stream,
+                                     batch, strata, &v))
               continue;
             local_rays += batch.size();
             mix.add(sum, l, t, h0, v);

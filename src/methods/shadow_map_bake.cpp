@@ -447,7 +447,7 @@ MixedImages bake_shadow_map_filter(const TexelSpace& space, const BaselineInputs
     for (std::size_t t = 0; t < n; ++t) {
       if (!reached[t]) continue;
       lit.push_back(t);
-      positions.push_back(space.texels[t].shadow_origin.cast<double>());
+      positions.push_back(space.shadow_origin(t).cast<double>());
     }
     std::vector<Vec3> visibility(lit.size(), Vec3::Ones());
     for (const ShadowFrustum& frustum : fit_frusta(light.centre(), positions, kFrustumMargin)) {
@@ -465,7 +465,7 @@ MixedImages bake_shadow_map_filter(const TexelSpace& space, const BaselineInputs
               // reference's rays leave from (texel_space.h): on a coarsely tessellated curved
               // object the facets' own planes would put a facet-by-facet staircase into the
               // terminator; on flat faces both are the triangle's.
-              const Vec3 origin = texel.shadow_origin.cast<double>();
+              const Vec3 origin = space.shadow_origin(lit[p]).cast<double>();
               const Vec3 normal = texel.normal.cast<double>();
               if (!(frustum.frame.depth(origin) > 0)) continue;
               const ReceiverPoint r = receiver_point(map, origin, normal);

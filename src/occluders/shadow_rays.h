@@ -70,29 +70,31 @@ class ShadowRays {
 // stratified points of the part of the light above the texel's horizon (Light::above_horizon),
 // from the texel's own random stream (seed, receiver stream, the light's stream (Light::stream,
 // from its name), pixel), one shadow ray each from the lifted shadow origin.
-inline void add_reference_samples(const Texel& texel, const Light& light, const RayScene& rays,
-                                  int samples, std::uint64_t seed, std::uint64_t stream, int width,
-                                  ShadowRays& batch, std::vector<Vec2>& strata) {
+inline void add_reference_samples(const TexelSpace& space, std::size_t t, const Light& light,
+                                  const RayScene& rays, int samples, std::uint64_t seed,
+                                  std::uint64_t stream, ShadowRays& batch,
+                                  std::vector<Vec2>& strata) {
+  const Texel& texel = space.texels[t];
   const double offset = rays.surface_offset();
   const Vec3 position = texel.position.cast<double>();
   const Vec3 normal = texel.normal.cast<double>();
-  const Vec3 origin =
-      texel.shadow_origin.cast<double>() + offset * texel.geometric_normal.cast<double>();
+  const Vec3 origin = space.ray_origin(t, offset);
   Rng rng(stream_seed(seed, stream_seed(stream, light.stream()),
-                      std::uint64_t(texel.y) * width + texel.x));
+                      std::uint64_t(texel.y) * std::uint64_t(space.width) + texel.x));
   stratified_samples(samples, rng, strata);
   batch.clear();
   const HorizonPart part = light.above_horizon(position, normal);
   for (int s = 0; s < samples; ++s) batch.add(origin, part.sample(strata[s]), offset);
 }
 
-// The reference's estimate of `light`'s visibility at one texel, traced from those samples.
+// The reference's estimate of `light`'s visibility at texel t, traced from those samples.
 // False when no point contributes. Any method that traces a texel this way gets the reference's
 // value at that many samples, bit for bit.
-inline bool estimate_visibility(const Texel& texel, const Light& light, const RayScene& rays,
-                                int samples, std::uint64_t seed, std::uint64_t stream, int width,
-                                ShadowRays& batch, std::vector<Vec2>& strata, Vec3* v) {
-  add_reference_samples(texel, light, rays, samples, seed, stream, width, batch, strata);
+inline bool estimate_visibility(const TexelSpace& space, std::size_t t, const Light& light,
+                                const RayScene& rays, int samples, std::uint64_t seed,
+                                std::uint64_t stream, ShadowRays& batch, std::vector<Vec2>& strata,
+                                Vec3* v) {
+  add_reference_samples(space, t, light, rays, samples, seed, stream, batch, strata);
   return batch.visible_fraction(rays, v);
 }
 

@@ -576,7 +576,7 @@ std::vector<std::uint8_t> ShaftCuller::maybe_blocked(const TexelSpace& space, co
   std::vector<Vec3> origin(space.texels.size());
   for (std::size_t i = 0; i < space.texels.size(); ++i) {
     const Texel& t = space.texels[i];
-    origin[i] = t.shadow_origin.cast<double>() + offset * t.geometric_normal.cast<double>();
+    origin[i] = space.ray_origin(i, offset);
     tile_texels[std::size_t(t.y / kTile) * tiles_x + std::size_t(t.x / kTile)].push_back(
         std::uint32_t(i));
   }

@@ -32,14 +32,15 @@ struct SkyRays {
 // blocker), from the texel's own stream (seed, receiver stream, the sky's stream, pixel). False
 // when the sky sends it nothing (every direction below its horizon, or black there); *rays_traced
 // counts the rays.
-inline bool estimate_sky(const Texel& texel, const Sky& sky, const RayScene& rays, int samples,
-                         std::uint64_t seed, std::uint64_t stream, int width, double distance,
-                         SkyRays& s, Vec3* h0, Vec3* v, std::int64_t* rays_traced) {
+inline bool estimate_sky(const TexelSpace& space, std::size_t t, const Sky& sky,
+                         const RayScene& rays, int samples, std::uint64_t seed,
+                         std::uint64_t stream, double distance, SkyRays& s, Vec3* h0, Vec3* v,
+                         std::int64_t* rays_traced) {
+  const Texel& texel = space.texels[t];
   const double offset = rays.surface_offset();
   const Vec3 normal = texel.normal.cast<double>();
-  const Vec3 origin =
-      texel.shadow_origin.cast<double>() + offset * texel.geometric_normal.cast<double>();
-  Rng rng(stream_seed(seed, stream, std::uint64_t(texel.y) * width + texel.x));
+  const Vec3 origin = space.ray_origin(t, offset);
+  Rng rng(stream_seed(seed, stream, std::uint64_t(texel.y) * std::uint64_t(space.width) + texel.x));
   const double map_share = sky.uniform() ? 0.0 : 0.5;
   const int from_map = int(map_share * samples);
   s.origins.clear();

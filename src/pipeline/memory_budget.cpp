@@ -15,8 +15,9 @@ namespace sb {
 namespace {
 
 // Bytes per texel of the arrays rasterise_texels holds while it works: `covered` and the owner
-// code per texel of the image (uv_rasterizer.cpp), and a Texel per covered texel.
-constexpr double kRasterBytesPerTexel = 1 + 4 + sizeof(Texel);
+// code per texel of the image (uv_rasterizer.cpp), and a Texel per covered texel, with its shadow
+// origin's lift where the mesh is curved.
+constexpr double kRasterBytesPerTexel = 1 + 4 + sizeof(Texel) + sizeof(Vec3f);
 // A receiver's result until it is written: RGB float lightmap and the coverage byte.
 constexpr double kResultBytesPerTexel = 3 * 4 + 1;
 // Writing one receiver or atlas: the preview's tone-mapped copy (RGB float), its 8-bit bytes

@@ -18,18 +18,17 @@
 namespace sb {
 
 // Single precision: a 2048² lightmap has 4 M texels, and their memory traffic, not arithmetic,
-// bounds the fast methods; the methods compute in double from these.
+// bounds the fast methods; the methods compute in double from these. 32 bytes: a 4096² receiver's
+// 16.8 M records are half a gigabyte, each page of it a fault on first touch, and every method
+// passes over them. What a texel shares with its triangle is kept per face (TexelSpace), and its
+// shadow origin only where it differs from its position.
 struct Texel {
-  int x = 0, y = 0;        // pixel; row 0 is v = 1
-  Vec3f position;          // world space, on the triangle
-  Vec3f normal;            // interpolated shading normal, unit
-  Vec3f geometric_normal;  // the triangle's face normal, unit, on the side of `normal`
-  // Where shadow rays leave from: `position` lifted onto the smooth surface the vertex normals
-  // describe (uv_rasterizer.cpp), so a coarsely tessellated curved object does not shadow
-  // itself along its terminator. Equal to `position` on flat faces.
-  Vec3f shadow_origin;
-  int face = -1;  // index of the covering triangle
+  std::uint16_t x = 0, y = 0;  // pixel; row 0 is v = 1 (a lightmap is at most 16384 wide)
+  Vec3f position;              // world space, on the triangle
+  Vec3f normal;                // interpolated shading normal, unit
+  int face = -1;               // index of the covering triangle
 };
+static_assert(sizeof(Texel) == 32, "a texel record is 32 bytes");
 
 // Rows [begin, end) of a lightmap.
 struct RowRange {
@@ -37,34 +36,44 @@ struct RowRange {
   bool operator==(const RowRange&) const = default;
 };
 
-// The texel records' allocator: std::allocator, but a record made without a value (resize) is
-// left as the memory holds it, so that the rasteriser sizes the array without writing it and then
-// writes each record once, in parallel. A 4096² receiver's records are a gigabyte, and a serial
-// first write of them cost a second on a virtual machine whose every first touch of a page is a
-// fault (perf: the kernel zeroing pages under std::vector::resize). Texel is an aggregate, an
-// implicit-lifetime type: its storage holds one before the rasteriser assigns it.
-static_assert(std::is_aggregate_v<Texel>, "RecordAllocator leaves Texel storage to be assigned");
+// An allocator for large per-texel arrays: std::allocator, but an element made without a value
+// (resize, or a count) is left as the memory holds it, so that an array is sized without being
+// written and then written once, in parallel. A 4096² receiver's records are half a gigabyte,
+// and a serial first write of them cost a second on a virtual machine whose every first touch
+// of a page is a fault (perf: the kernel zeroing pages under std::vector::resize). For types
+// whose storage may be assigned without a constructor run first: scalars, aggregates (Texel) and
+// Eigen's fixed-size vectors, whose default constructor writes nothing anyway.
 template <typename T>
-struct RecordAllocator : std::allocator<T> {
+struct FreshAllocator : std::allocator<T> {
   template <typename U>
   struct rebind {
-    using other = RecordAllocator<U>;
+    using other = FreshAllocator<U>;
   };
-  RecordAllocator() = default;
+  FreshAllocator() = default;
   template <typename U>
-  RecordAllocator(const RecordAllocator<U>&) noexcept {}
+  FreshAllocator(const FreshAllocator<U>&) noexcept {}
   template <typename U>
-  void construct(U*) noexcept {}
+  void construct(U*) noexcept {
+    static_assert(std::is_trivially_destructible_v<U>,
+                  "FreshAllocator leaves storage to be assigned");
+  }
   template <typename U, typename... Args>
   void construct(U* p, Args&&... args) {
     ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
   }
 };
+template <typename T>
+using FreshVector = std::vector<T, FreshAllocator<T>>;
 
 struct TexelSpace {
   int width = 0, height = 0;
   // Covered texels, in row-major order.
-  std::vector<Texel, RecordAllocator<Texel>> texels;
+  FreshVector<Texel> texels;
+  // Per face of the mesh: its unit normal (from its corners' positions).
+  std::vector<Vec3f> face_normals;
+  // Per texel, where some texel's shadow origin is not its position (a curved mesh's, below):
+  // shadow origin − position; empty where every texel's is its position.
+  FreshVector<Vec3f> lifts;
   std::vector<std::uint8_t> covered;  // width * height; 1 where a texel of `texels` lies
   // Texels whose centre two UV triangles claim (inside one, inside or on the other): charts that
   // overlap in the lightmap, so one surface point stands for two (check_uv_layout reports it).
@@ -74,6 +83,24 @@ struct TexelSpace {
   // count the kept rows' texels alone (a tile's counts add up to the whole receiver's); the
   // halo's values are dropped. A whole receiver's keeps every row.
   RowRange kept;
+
+  // Texel i's face normal, on the side of its shading normal.
+  Vec3f geometric_normal(std::size_t i) const {
+    const Texel& t = texels[i];
+    const Vec3f& n = face_normals[std::size_t(t.face)];
+    return n.dot(t.normal) < 0 ? Vec3f(-n) : n;
+  }
+  // Where texel i's shadow rays leave from: its position lifted onto the smooth surface the
+  // vertex normals describe (uv_rasterizer.cpp), so a coarsely tessellated curved object does not
+  // shadow itself along its terminator; its position on flat faces.
+  Vec3f shadow_origin(std::size_t i) const {
+    return lifts.empty() ? texels[i].position : Vec3f(texels[i].position + lifts[i]);
+  }
+  // The shadow origin moved `offset` metres off the surface along the face normal: where the
+  // methods' shadow rays start.
+  Vec3 ray_origin(std::size_t i, double offset) const {
+    return shadow_origin(i).cast<double>() + offset * geometric_normal(i).cast<double>();
+  }
 };
 
 // The kept rows' texels: indices [first, second) into space.texels (row-major).

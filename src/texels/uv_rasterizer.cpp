@@ -1,7 +1,7 @@
 // Rasterises a receiver's triangles in lightmap UV space: for each texel of a width × height
 // lightmap, whether the UV layout covers it and, if so, the surface point it stands for (world
-// position, interpolated shading normal, face normal, face, shadow-ray origin). The bake methods
-// shade exactly these points, so every later image is only as complete as this coverage.
+// position, interpolated shading normal, face, shadow-ray origin; the faces' normals). The bake
+// methods shade exactly these points, so every later image is only as complete as this coverage.
 //
 // Two passes per row of texels:
 //  1. Centre sampling. A texel whose centre lies inside a triangle or on its edge takes the point
@@ -80,6 +80,9 @@ struct FaceSurface {
   Vec3 position[3];
   Vec3 normal[3];
   Vec3 face_normal;  // unit, from the world positions
+  // Whether its vertex normals may lift a point of it (make_texel): some corner lies above
+  // another's tangent plane by more than a millionth of its longest side.
+  bool curved = false;
 };
 
 // Twice the signed area of (a, b, p); positive when p lies to the left of a → b.
@@ -207,28 +210,30 @@ Vec3 unit_or(const Vec3& v, const Vec3& fallback) {
   return length > 1e-12 ? Vec3(v * (1.0 / length)) : fallback;
 }
 
-Texel make_texel(const FaceSurface& s, int face, int x, int y, const double bary[3]) {
+// The texel at barycentric `bary` of face `face`, and its shadow origin's lift off its position.
+Texel make_texel(const FaceSurface& s, int face, int x, int y, const double bary[3], Vec3f& lift) {
   Texel t;
-  t.x = x;
-  t.y = y;
+  t.x = std::uint16_t(x);
+  t.y = std::uint16_t(y);
   t.face = face;
   const Vec3 position = bary[0] * s.position[0] + bary[1] * s.position[1] + bary[2] * s.position[2];
   const Vec3 normal =
       unit_or(bary[0] * s.normal[0] + bary[1] * s.normal[1] + bary[2] * s.normal[2], s.face_normal);
   t.position = position.cast<float>();
   t.normal = normal.cast<float>();
-  t.geometric_normal =
-      (normal.dot(s.face_normal) < 0.0 ? Vec3(-s.face_normal) : s.face_normal).cast<float>();
   // Shadow-terminator offset (Hanika, "Hacking the Shadow Terminator", Ray Tracing Gems II,
   // ch. 4, 2021): a flat triangle of a curved mesh lies inside the smooth surface its vertex
   // normals describe, so rays towards a grazing light hit the neighbouring triangles. Lift the
   // point by the barycentric mean of its heights below each vertex's tangent plane.
-  Vec3 shadow_origin = position;
-  for (int i = 0; i < 3; ++i) {
-    const double below = (s.position[i] - position).dot(s.normal[i]);
-    if (below > 0) shadow_origin += bary[i] * below * s.normal[i];
+  lift = Vec3f::Zero();
+  if (s.curved) {
+    Vec3 shadow_origin = position;
+    for (int i = 0; i < 3; ++i) {
+      const double below = (s.position[i] - position).dot(s.normal[i]);
+      if (below > 0) shadow_origin += bary[i] * below * s.normal[i];
+    }
+    lift = shadow_origin.cast<float>() - t.position;
   }
-  t.shadow_origin = shadow_origin.cast<float>();
   return t;
 }
 
@@ -290,6 +295,16 @@ TexelSpace rasterise_texels(const Mesh& mesh, int width, int height, RowRange ro
     const Vec3 average_normal = tri.n[0] + tri.n[1] + tri.n[2];
     s.face_normal = unit_or((tri.p[1] - tri.p[0]).cross(tri.p[2] - tri.p[0]),
                             unit_or(average_normal, Vec3::UnitZ()));
+    // A point's height below corner i's tangent plane is linear over the face, so it is
+    // greatest at a corner: below that bound nothing lifts (a flat face's vertex normals, up to
+    // the rounding of its file's floats).
+    double longest = 0, highest = 0;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        longest = std::max(longest, (tri.p[i] - tri.p[j]).norm());
+        highest = std::max(highest, (tri.p[i] - tri.p[j]).dot(tri.n[i]));
+      }
+    s.curved = highest > 1e-6 * longest;
     footprints.push_back(fp);
   }
 
@@ -389,12 +404,20 @@ TexelSpace rasterise_texels(const Mesh& mesh, int width, int height, RowRange ro
   // Offsets of each row's texels in the row-major output, then the texels themselves.
   for (int y = 0; y < window; ++y) row_count[std::size_t(y) + 1] += row_count[std::size_t(y)];
   space.texels.resize(row_count[std::size_t(window)]);
+  space.face_normals.resize(tri_mesh.n_faces(), Vec3f::Zero());
+  bool lifted = false;
+  for (const FaceFootprint& fp : footprints) {
+    const FaceSurface& s = surfaces[std::size_t(fp.face)];
+    space.face_normals[std::size_t(fp.face)] = s.face_normal.cast<float>();
+    lifted = lifted || s.curved;
+  }
+  if (lifted) space.lifts.resize(space.texels.size());
   std::vector<int> footprint_of_face(tri_mesh.n_faces(), -1);
   for (std::size_t i = 0; i < footprints.size(); ++i)
     footprint_of_face[std::size_t(footprints[i].face)] = int(i);
   tbb::parallel_for(tbb::blocked_range<int>(row0, row1), [&](const tbb::blocked_range<int>& rows) {
     for (int y = rows.begin(); y != rows.end(); ++y) {
-      Texel* out = space.texels.data() + row_count[std::size_t(y - row0)];
+      std::size_t out = row_count[std::size_t(y - row0)];
       const std::size_t row_offset = std::size_t(y) * std::size_t(width);
       const std::size_t owner_offset = std::size_t(y - row0) * std::size_t(width);
       const double centre_y = y + 0.5;
@@ -409,7 +432,10 @@ TexelSpace rasterise_texels(const Mesh& mesh, int width, int height, RowRange ro
         // the same point should it not.
         if (!is_centre_code(code) || !centre_barycentrics(fp, x + 0.5, centre_y, bary))
           nearest_point(fp.uv[0], fp.uv[1], fp.uv[2], Vec2((x + 0.5) / width, centre_v), bary);
-        *out++ = make_texel(surfaces[std::size_t(face)], face, x, y, bary);
+        Vec3f lift;
+        space.texels[out] = make_texel(surfaces[std::size_t(face)], face, x, y, bary, lift);
+        if (lifted) space.lifts[out] = lift;
+        ++out;
         space.covered[row_offset + std::size_t(x)] = 1;
       }
     }

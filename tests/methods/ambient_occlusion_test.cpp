@@ -34,11 +34,13 @@ TexelSpace floor_texels(double x0, double x1, int n) {
   s.width = n;
   s.height = 1;
   s.covered.assign(std::size_t(n), 1);
+  s.face_normals = {Vec3f::UnitZ()};
   for (int i = 0; i < n; ++i) {
     Texel t;
-    t.x = i;
-    t.position = t.shadow_origin = Vec3f(float(x0 + (x1 - x0) * i / (n - 1)), 0.0f, 0.0f);
-    t.normal = t.geometric_normal = Vec3f::UnitZ();
+    t.x = std::uint16_t(i);
+    t.face = 0;
+    t.position = Vec3f(float(x0 + (x1 - x0) * i / (n - 1)), 0.0f, 0.0f);
+    t.normal = Vec3f::UnitZ();
     s.texels.push_back(t);
   }
   return s;

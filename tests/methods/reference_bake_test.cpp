@@ -38,12 +38,14 @@ TexelSpace floor_texels(const std::vector<double>& xs, double y0) {
   s.width = int(xs.size());
   s.height = 1;
   s.covered.assign(xs.size(), 1);
+  s.face_normals = {Vec3f::UnitZ()};
   for (std::size_t i = 0; i < xs.size(); ++i) {
     Texel t;
-    t.x = int(i);
+    t.x = std::uint16_t(i);
     t.y = 0;
-    t.position = t.shadow_origin = Vec3f(float(xs[i]), float(y0), 0.0f);
-    t.normal = t.geometric_normal = Vec3f::UnitZ();
+    t.face = 0;
+    t.position = Vec3f(float(xs[i]), float(y0), 0.0f);
+    t.normal = Vec3f::UnitZ();
     s.texels.push_back(t);
   }
   return s;
@@ -144,7 +146,7 @@ TEST(Reference, FacingAwayIsZero) {
   ASSERT_TRUE(rays);
   const std::vector<Light> lights = {Light(square_light())};
   TexelSpace s = floor_texels({0.0, 0.5}, 0.0);
-  for (auto& t : s.texels) t.normal = t.geometric_normal = -Vec3f::UnitZ();
+  for (auto& t : s.texels) t.normal = -Vec3f::UnitZ();  // its face normal follows
   const Image vis = run(s, lights, *rays, Quantity::visibility, 16);
   EXPECT_EQ(vis.at(0, 0)[0], 0.0f);
   EXPECT_EQ(vis.at(1, 0)[0], 0.0f);

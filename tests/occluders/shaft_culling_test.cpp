@@ -68,8 +68,7 @@ Counts check_scene(const std::string& name, int resolution, int samples) {
         std::vector<Vec2> strata;
         stratified_samples(samples, rng, strata);
         ShadowRays batch(samples);
-        const Vec3 origin =
-            t.shadow_origin.cast<double>() + offset * t.geometric_normal.cast<double>();
+        const Vec3 origin = space.ray_origin(i, offset);
         for (const Vec2& u : strata) batch.add(origin, light.sample(p, n, u), offset);
         Vec3 v;
         if (batch.visible_fraction(*rays, &v) && v.minCoeff() < 1) ++wrong;

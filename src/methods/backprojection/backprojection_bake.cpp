@@ -26,10 +26,6 @@ namespace sb {
 
 namespace {
 
-Vec3 ray_origin(const Texel& t, double offset) {
-  return t.shadow_origin.cast<double>() + offset * t.geometric_normal.cast<double>();
-}
-
 // Stage 1: every tile's shaft, as one box of its texels' ray origins.
 TileShafts tile_shafts(const TexelSpace& space, const ShaftCuller& culler, const Light& light,
                        double offset, std::size_t max) {
@@ -68,7 +64,7 @@ TileShafts tile_shafts(const TexelSpace& space, const ShaftCuller& culler, const
     for (std::size_t i = row_start(ty0 * k); i < row_start(ty1 * k); ++i) {
       const Texel& t = space.texels[i];
       tiles.reached[i] = light.reaches(t.position.cast<double>(), t.normal.cast<double>());
-      if (tiles.reached[i]) boxes[tiles.tile_of(t.x, t.y)].extend(ray_origin(t, offset));
+      if (tiles.reached[i]) boxes[tiles.tile_of(t.x, t.y)].extend(space.ray_origin(i, offset));
     }
     // A group of g × g tiles whose joint box's shaft is clear is clear throughout (each tile's
     // shaft lies inside it); otherwise its tiles are tested one by one.
@@ -294,7 +290,7 @@ class LightPairs final : public PairSource {
   void evaluate(std::size_t t, PairSample& out) const override {
     const Texel& tx = space_.texels[t];
     const Vec3 p = tx.position.cast<double>(), n = tx.normal.cast<double>();
-    const Vec3 origin = ray_origin(tx, offset_);
+    const Vec3 origin = space_.ray_origin(t, offset_);
     out = PairSample();
     const double form_factor = light_.form_factor(p, n);
     if (!(form_factor > 0)) return;
@@ -309,8 +305,8 @@ class LightPairs final : public PairSource {
       thread_local std::vector<Vec2> strata;
       Vec3 v;
       out = PairSample();
-      if (!estimate_visibility(tx, light_, *in_.rays, in_.samples, in_.seed, in_.stream,
-                               space_.width, batch, strata, &v))
+      if (!estimate_visibility(space_, t, light_, *in_.rays, in_.samples, in_.seed, in_.stream,
+                               batch, strata, &v))
         return;
       out.route = TexelRoute::traced;
       out.visibility = float(v.x());
@@ -412,7 +408,7 @@ class LightPairs final : public PairSource {
     if (tiles_.kind[tile] != TileShafts::Kind::listed) {  // the whole hierarchy, texel by texel
       for (std::size_t t : texels) {
         const Texel& tx = space_.texels[t];
-        if (in_.culler->maybe_blocked(ray_origin(tx, offset_), tx.position.cast<double>(),
+        if (in_.culler->maybe_blocked(space_.ray_origin(t, offset_), tx.position.cast<double>(),
                                       tx.normal.cast<double>(), light_, nullptr, &listed))
           return true;
       }
@@ -425,7 +421,7 @@ class LightPairs final : public PairSource {
     origins.clear();
     Bounds3 box;
     for (std::size_t t : texels) {
-      origins.push_back(ray_origin(space_.texels[t], offset_));
+      origins.push_back(space_.ray_origin(t, offset_));
       box.extend(origins.back());
     }
     thread_local std::vector<std::uint32_t> unlisted;
@@ -504,7 +500,7 @@ void bake_light_by_rays(const TexelSpace& space, const BackprojectionInputs& in,
                         if (!light.reaches(p, n)) continue;
                         const std::size_t tile = tiles.tile_of(tx.x, tx.y);
                         if (tiles.kind[tile] == TileShafts::Kind::clear ||
-                            !in.culler->maybe_blocked(ray_origin(tx, offset), p, n, light,
+                            !in.culler->maybe_blocked(space.ray_origin(t, offset), p, n, light,
                                                       tiles.kind[tile] == TileShafts::Kind::listed
                                                           ? &tiles.candidates[tile]
                                                           : nullptr)) {
@@ -513,8 +509,8 @@ void bake_light_by_rays(const TexelSpace& space, const BackprojectionInputs& in,
                           continue;
                         }
                         Vec3 v;
-                        if (!estimate_visibility(tx, light, *in.rays, samples, in.seed, in.stream,
-                                                 space.width, batch, strata, &v))
+                        if (!estimate_visibility(space, t, light, *in.rays, samples, in.seed,
+                                                 in.stream, batch, strata, &v))
                           continue;
                         mix.set(l, t, v);
                         if (t < kept0 || t >= kept1) continue;

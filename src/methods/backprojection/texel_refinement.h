@@ -17,12 +17,6 @@
 
 namespace sb {
 
-// Per-texel arrays sized without a serial first write (texel_space.h's RecordAllocator), for
-// their first writes to be parallel: a 4096² receiver's are tens of megabytes each, and each
-// fresh page's first touch is a fault.
-template <typename T>
-using FreshVector = std::vector<T, RecordAllocator<T>>;
-
 // Texel indices by pixel, -1 where no texel is covered: a bit per pixel and, per word of 64
 // pixels, the index of its first covered texel (texels are in row-major order, so the rest follow
 // by counting bits). A 4096² receiver's grid is 3 MB so, where an index per pixel was 67 MB of
@@ -108,7 +102,9 @@ struct RefinementSettings {
 
 // One light's visibility at every covered texel of a receiver, and the route each came by.
 struct LightField {
-  FreshVector<float> visibility;  // per texel; 1 where the route is none
+  // Per texel; 1 where the route is none. Sized without a serial first write (FreshVector), as
+  // are the refinement's other per-texel arrays: their first writes are parallel.
+  FreshVector<float> visibility;
   FreshVector<TexelRoute> route;
 };
 

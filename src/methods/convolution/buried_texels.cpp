@@ -53,7 +53,7 @@ std::vector<std::uint8_t> buried_texels(const TexelSpace& space, const Mesh& rec
                             if (((p - box.lo).array() < -tolerance).any() ||
                                 ((p - box.hi).array() > tolerance).any())
                               continue;
-                            const Vec3 normal = tx.geometric_normal.cast<double>();
+                            const Vec3 normal = space.geometric_normal(t).cast<double>();
                             bool inside = true;
                             for (const auto& [n, offset] : planes[c]) {
                               // A face lying against the receiver's surface (a box's bottom on the

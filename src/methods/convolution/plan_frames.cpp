@@ -108,11 +108,11 @@ std::vector<TexelGroup> group_texels(const TexelSpace& space, const PlanInputs& 
     // Planar: every texel's face normal within ~0.1° of the first's and every texel within
     // 0.1 mm of its plane.
     const Texel& first = space.texels[members.front()];
-    const Vec3 n = first.geometric_normal.cast<double>().normalized();
+    const Vec3 n = space.geometric_normal(members.front()).cast<double>().normalized();
     const double offset = n.dot(first.position.cast<double>());
     g.planar = std::all_of(members.begin(), members.end(), [&](std::size_t t) {
       const Texel& x = space.texels[t];
-      return x.geometric_normal.cast<double>().dot(n) > 1 - 2e-6 &&
+      return space.geometric_normal(t).cast<double>().dot(n) > 1 - 2e-6 &&
              std::abs(n.dot(x.position.cast<double>()) - offset) < 1e-4;
     });
     g.height = n.dot(light.centre()) - offset;

@@ -130,8 +130,8 @@ Expected<MixedImages> bake_traced_convolution(const TexelSpace& space,
           Vec3 traced_v;
           ++local_traced;
           // As the reference does: a light none of whose samples contributes is left out.
-          if (!estimate_visibility(tx, lights[l], *in.rays, in.samples, in.seed, in.stream,
-                                   space.width, batch, strata, &traced_v))
+          if (!estimate_visibility(space, t, lights[l], *in.rays, in.samples, in.seed, in.stream,
+                                   batch, strata, &traced_v))
             continue;
           v = traced_v;
           local_rays += batch.size();

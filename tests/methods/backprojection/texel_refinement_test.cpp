@@ -20,14 +20,15 @@ TexelSpace flat_space(int border_at = -1) {
   TexelSpace space;
   space.width = space.height = kSide;
   space.covered.assign(kSide * kSide, 1);
+  space.face_normals = {Vec3f::UnitZ()};
   for (int y = 0; y < kSide; ++y)
     for (int x = 0; x < kSide; ++x) {
       Texel t;
       t.x = x, t.y = y;
       t.position = Vec3f((x + 0.5f) / kSide + (border_at >= 0 && x >= border_at ? 1.0f : 0.0f),
                          (y + 0.5f) / kSide, 0);
-      t.normal = t.geometric_normal = Vec3f::UnitZ();
-      t.shadow_origin = t.position;
+      t.normal = Vec3f::UnitZ();
+      t.face = 0;
       space.texels.push_back(t);
     }
   return space;
