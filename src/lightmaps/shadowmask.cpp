@@ -70,7 +70,7 @@ Image compose_shadowmask(const std::vector<Image>& light_visibility,
   const std::size_t texels = std::size_t(width) * std::size_t(height);
   for (std::size_t l = 0; l < light_visibility.size(); ++l) {
     if (channel[l] < 0) continue;
-    const std::vector<float>& v = light_visibility[l].pixels;
+    const auto& v = light_visibility[l].pixels;
     for (std::size_t i = 0; i < texels; ++i)
       mask.pixels[4 * i + std::size_t(channel[l])] *= v[2 * i];
   }

@@ -6,11 +6,10 @@
 #include <algorithm>
 #include <cstdint>
 #include <limits>
-#include <memory>
-#include <type_traits>
 #include <utility>
 #include <vector>
 
+#include "core/fresh_memory.h"
 #include "core/geometry.h"
 #include "core/image.h"
 #include "scene/mesh.h"
@@ -35,35 +34,6 @@ struct RowRange {
   int begin = 0, end = std::numeric_limits<int>::max();
   bool operator==(const RowRange&) const = default;
 };
-
-// An allocator for large per-texel arrays: std::allocator, but an element made without a value
-// (resize, or a count) is left as the memory holds it, so that an array is sized without being
-// written and then written once, in parallel. A 4096² receiver's records are half a gigabyte,
-// and a serial first write of them cost a second on a virtual machine whose every first touch
-// of a page is a fault (perf: the kernel zeroing pages under std::vector::resize). For types
-// whose storage may be assigned without a constructor run first: scalars, aggregates (Texel) and
-// Eigen's fixed-size vectors, whose default constructor writes nothing anyway.
-template <typename T>
-struct FreshAllocator : std::allocator<T> {
-  template <typename U>
-  struct rebind {
-    using other = FreshAllocator<U>;
-  };
-  FreshAllocator() = default;
-  template <typename U>
-  FreshAllocator(const FreshAllocator<U>&) noexcept {}
-  template <typename U>
-  void construct(U*) noexcept {
-    static_assert(std::is_trivially_destructible_v<U>,
-                  "FreshAllocator leaves storage to be assigned");
-  }
-  template <typename U, typename... Args>
-  void construct(U* p, Args&&... args) {
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-  }
-};
-template <typename T>
-using FreshVector = std::vector<T, FreshAllocator<T>>;
 
 struct TexelSpace {
   int width = 0, height = 0;

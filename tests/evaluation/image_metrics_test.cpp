@@ -12,7 +12,7 @@ namespace {
 
 sb::Image make(int w, int h, int c, const std::vector<float>& values) {
   sb::Image image(w, h, c);
-  image.pixels = values;
+  image.pixels.assign(values.begin(), values.end());
   return image;
 }
 
