@@ -311,6 +311,45 @@ const LightRows& PenumbraEstimator::rows_for(const LightFrame& f, const Vec3& po
   return scratch;
 }
 
+namespace {
+
+// A row's exact intervals in order of their starts (insertion sort: a handful).
+std::array<std::pair<double, double>, kExactIntervals> sorted_intervals(
+    const BlockedRows::Row& row) {
+  std::array<std::pair<double, double>, kExactIntervals> sorted = row.intervals;
+  for (int k = 1; k < row.count; ++k)
+    for (int j = k; j > 0 && sorted[std::size_t(j)] < sorted[std::size_t(j - 1)]; --j)
+      std::swap(sorted[std::size_t(j)], sorted[std::size_t(j - 1)]);
+  return sorted;
+}
+
+// Whether every row of the light is hidden from end to end, as integrate's sweep decides it: a
+// texel in an umbra, most of what a sun's refinement evaluates, needs none of the rows' integrals.
+bool every_row_hidden(const LightRows& rows, const BlockedRows& blocked) {
+  for (int r = 0; r < rows.count; ++r) {
+    const BlockedRows::Row& row = blocked.rows[std::size_t(r)];
+    const double enter = rows.enter[std::size_t(r)], leave = rows.leave[std::size_t(r)];
+    if (!(leave > enter)) continue;
+    if (row.count == 0) return false;
+    if (row.count > kExactIntervals) {
+      if (row.cells != kAllCells) return false;
+      continue;
+    }
+    const auto sorted = sorted_intervals(row);
+    if (sorted[0].first > enter) return false;
+    double to = sorted[0].second;
+    for (int k = 1; k < row.count; ++k) {
+      const auto [a, b] = sorted[std::size_t(k)];
+      if (a > to && to < leave) return false;
+      to = std::max(to, b);
+    }
+    if (to < leave) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 void PenumbraEstimator::integrate(const LightFrame& f, const LightRows& rows, const Vec3& position,
                                   const Vec3& normal, const BlockedRows& blocked,
                                   double form_factor, PenumbraSample& out) const {
@@ -324,6 +363,13 @@ void PenumbraEstimator::integrate(const LightFrame& f, const LightRows& rows, co
   // Over the whole light, its closed-form F is the whole; over the part above the horizon, the
   // rows' own total is.
   const bool exact_total = !biased && rows.whole;
+  if (exact_total && every_row_hidden(rows, blocked)) {
+    const double f0 = form_factor > 0 ? form_factor : light_->form_factor(position, normal);
+    if (!(f0 * std::numbers::pi / (h * rows.pitch) > 0)) return;
+    out.contributes = true;
+    out.visibility = 0.0;
+    return;
+  }
   double hidden = 0, total = 0;
   bool any = false, every = true;  // some part blocked; every row blocked from end to end
   for (int r = 0; r < rows.count; ++r) {
@@ -347,10 +393,7 @@ void PenumbraEstimator::integrate(const LightFrame& f, const LightRows& rows, co
       every = false;
     } else if (row.count <= kExactIntervals) {
       // The union of the intervals, swept in order of their starts, within the row's chord.
-      std::array<std::pair<double, double>, kExactIntervals> sorted = row.intervals;
-      for (int k = 1; k < row.count; ++k)  // insertion sort: a handful
-        for (int j = k; j > 0 && sorted[std::size_t(j)] < sorted[std::size_t(j - 1)]; --j)
-          std::swap(sorted[std::size_t(j)], sorted[std::size_t(j - 1)]);
+      const auto sorted = sorted_intervals(row);
       double from = sorted[0].first, to = sorted[0].second;
       bool whole = from <= enter;
       const auto close = [&] {
