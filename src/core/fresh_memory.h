@@ -11,11 +11,10 @@ namespace sb {
 // An allocator for large arrays (texel records, per-texel values, images): std::allocator, but an
 // element made without a value (resize, or a count) is left as the memory holds it, so that an
 // array is sized without being written and then written once, in parallel. A 4096² receiver's
-// texel records are half a gigabyte,
-// and a serial first write of them cost a second on a virtual machine whose every first touch
-// of a page is a fault (perf: the kernel zeroing pages under std::vector::resize). For types
-// whose storage may be assigned without a constructor run first: scalars, aggregates (Texel) and
-// Eigen's fixed-size vectors, whose default constructor writes nothing anyway.
+// texel records are half a gigabyte, and on a virtual machine every first touch of a page is a
+// fault: a serial first write (std::vector::resize) spends its time in the kernel zeroing pages
+// on one core. For types whose storage may be assigned without a constructor run first: scalars,
+// aggregates (Texel) and Eigen's fixed-size vectors, whose default constructor writes nothing.
 template <typename T>
 struct FreshAllocator : std::allocator<T> {
   template <typename U>

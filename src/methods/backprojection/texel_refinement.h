@@ -19,8 +19,8 @@ namespace sb {
 
 // Texel indices by pixel, -1 where no texel is covered: a bit per pixel and, per word of 64
 // pixels, the index of its first covered texel (texels are in row-major order, so the rest follow
-// by counting bits). A 4096² receiver's grid is 3 MB so, where an index per pixel was 67 MB of
-// fresh memory, zeroed and written again for every light.
+// by counting bits). A 4096² receiver's grid is 3 MB, where an index per pixel would be 67 MB of
+// fresh memory, zeroed and written for every light.
 class TexelGrid {
  public:
   int width = 0, height = 0;
