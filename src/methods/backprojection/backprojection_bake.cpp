@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <atomic>
 #include <limits>
+#include <optional>
 
 #include "methods/backprojection/penumbra_estimator.h"
 #include "occluders/blocker_solids.h"
@@ -534,13 +535,23 @@ std::int64_t RouteCounts::reached() const {
   return sum;
 }
 
-LightField backprojection_light(const TexelSpace& space, const BackprojectionInputs& in,
-                                std::size_t l) {
+namespace {
+
+// Light l's field over the receiver whose texel grid (light-independent) is `grid`.
+LightField light_field(const TexelSpace& space, const TexelGrid& grid,
+                       const BackprojectionInputs& in, std::size_t l) {
   const Light& light = (*in.lights)[l];
   const TileShafts tiles =
       tile_shafts(space, *in.culler, light, in.rays->surface_offset(), kTileCandidates);
   const LightPairs pairs(space, light, in, tiles);
-  return refine_light(space, TexelGrid(space), tiles, pairs, in.refinement);
+  return refine_light(space, grid, tiles, pairs, in.refinement);
+}
+
+}  // namespace
+
+LightField backprojection_light(const TexelSpace& space, const BackprojectionInputs& in,
+                                std::size_t l) {
+  return light_field(space, TexelGrid(space), in, l);
 }
 
 MixedImages bake_backprojection(const TexelSpace& space, const BackprojectionInputs& in,
@@ -551,12 +562,14 @@ MixedImages bake_backprojection(const TexelSpace& space, const BackprojectionInp
   // Counted: the kept rows' texels (a tile's halo is not).
   const auto kept = kept_texels(space);
   const std::size_t kept0 = kept.first, kept1 = kept.second;
+  std::optional<TexelGrid> grid;  // built once, for the first light the estimator takes
   for (std::size_t l = 0; l < lights.size(); ++l) {
     if (lights[l].textured() || lights[l].is_point()) {
       bake_light_by_rays(space, in, l, lights[l].is_point() ? 1 : in.samples, mix, counts);
       continue;
     }
-    const LightField field = backprojection_light(space, in, l);
+    if (!grid) grid.emplace(space);
+    const LightField field = light_field(space, *grid, in, l);
     // Distinct texels in parallel (LightMix::set allows it), each range counting its routes.
     tbb::combinable<RouteCounts> local;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, space.texels.size(), 1 << 14),
