@@ -447,6 +447,26 @@ class LightPairs final : public PairSource {
     return false;
   }
 
+  bool one_triangle_hides(const std::array<std::size_t, 5>& samples,
+                          const std::vector<std::uint32_t>& seen) const override {
+    const Texel& first = space_.texels[samples[0]];
+    const std::size_t tile = tiles_.tile_of(first.x, first.y);
+    if (tiles_.kind[tile] != TileShafts::Kind::listed) return false;
+    std::array<Vec3, 5> origins;
+    for (std::size_t k = 0; k < 5; ++k) origins[k] = space_.ray_origin(samples[k], offset_);
+    // The tile's candidates of what the samples saw (a triangle hiding all of the light from
+    // one of them is among them), each checked from every sample, the centre first.
+    for (std::uint32_t i : tiles_.candidates[tile]) {
+      if (!std::binary_search(seen.begin(), seen.end(), in_.culler->blocker_key(i))) continue;
+      const Vec3* corners = in_.culler->triangle_corners(i);
+      bool hides = true;
+      for (std::size_t k = 5; k-- > 0 && hides;)
+        hides = triangle_hides_light(light_, corners, origins[k], offset_);
+      if (hides) return true;
+    }
+    return false;
+  }
+
  private:
   // Whether every one of the texels' ray origins lies on the convex solid `key` (or in it): in
   // front of none of its face planes by more than the rays' offset, four times over, or a

@@ -542,4 +542,45 @@ PenumbraSample PenumbraEstimator::visibility_traced(const Vec3& position, const 
   return out;
 }
 
+bool triangle_hides_light(const Light& light, const Vec3* corners, const Vec3& origin,
+                          double light_offset) {
+  if (light.shape() != LightShape::rectangle && light.shape() != LightShape::disk &&
+      light.shape() != LightShape::polygon)
+    return false;
+  // Between the light's plane and the origin, each corner clear of both.
+  const Vec3& m = light.normal();
+  const double h_origin = m.dot(origin - light.centre());
+  Vec3 lo = corners[0], hi = corners[0];
+  for (int k = 0; k < 3; ++k) {
+    const double h = m.dot(corners[k] - light.centre());
+    if (!(h > light_offset && h < h_origin * (1 - 1e-9))) return false;
+    lo = lo.cwiseMin(corners[k]), hi = hi.cwiseMax(corners[k]);
+  }
+  if ((lo - origin).cwiseMax(origin - hi).cwiseMax(Vec3::Zero()).norm() < light_offset)
+    return false;
+  // The light inside the cone from the origin over the triangle: on the inner side of each plane
+  // through the origin and an edge, with a margin of a billionth against rounding.
+  std::array<Vec3, 4> outline;
+  const int count = light.outline(outline);
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 a = corners[k] - origin, b = corners[(k + 1) % 3] - origin;
+    Vec3 n = a.cross(b);
+    const double norm = n.norm();
+    if (!(norm > 0)) return false;
+    n /= norm;
+    if (n.dot(corners[(k + 2) % 3] - origin) < 0) n = -n;
+    if (count > 0) {
+      for (int c = 0; c < count; ++c) {
+        const Vec3 d = outline[std::size_t(c)] - origin;
+        if (!(n.dot(d) > 1e-9 * d.norm())) return false;
+      }
+    } else {  // a disk: its nearest point to the plane
+      const Vec3 d = light.centre() - origin;
+      const double across = std::sqrt(std::max(0.0, 1 - std::pow(n.dot(m), 2)));
+      if (!(n.dot(d) - light.desc().radius * across > 1e-9 * d.norm())) return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace sb

@@ -179,6 +179,14 @@ class PenumbraEstimator {
   std::array<Vec2, 4> corners_;   // a rectangle's or polygon's corners in (s, t)
 };
 
+// Whether the triangle `corners` hides all of `light` from `origin` (exactly: every segment from
+// the origin to the light passes through it), clear of the origin and of the light's plane by
+// `light_offset` as a shadow ray is (RayScene::surface_offset). Its umbra, the points from which
+// it does, is convex under a convex light. False for a sphere (its silhouette moves with the
+// origin; no test here).
+bool triangle_hides_light(const Light& light, const Vec3* corners, const Vec3& origin,
+                          double light_offset);
+
 // The angle between a light's own axes and its rows, radians: far from 0°, 45° and 90°, the
 // directions furniture and panels share most.
 constexpr double kRowAngle = 0.4;

@@ -18,7 +18,10 @@
 //      samples would otherwise vanish), and every blocker the samples saw is far enough from the
 //      cell that no penumbra it casts is narrower than `feature_cells` cells: a blocker at
 //      distance d from a texel casts a penumbra at least d·θ wide (θ the light's narrowest
-//      apparent width), so shadows near contact refine down to single texels.
+//      apparent width), so shadows near contact refine down to single texels; unless all five
+//      samples lie in the umbra of one convex solid or one triangle (PairSource::
+//      one_triangle_hides): a convex blocker's umbra under a convex light is convex, so every
+//      texel between them lies in it, however near.
 // Inside a cell that passes, V is interpolated linearly over the four triangles the centre makes
 // with the cell's sides, so it is exact at all five samples and continuous across cells. Texels
 // of a cell that fails at S = 2 are each evaluated. Every decision depends on exact values and
@@ -218,6 +221,14 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
     }
     std::sort(seen.begin(), seen.end());
     seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
+    // All five in the umbra of one triangle of what they saw (a tree crown's facet over its
+    // shadow, where the samples' own umbrae are of other facets or of the crown as a whole):
+    // whatever the distance, as above.
+    if (v(0) == 0 && v(1) == 0 && v(2) == 0 && v(3) == 0 && v(4) == 0) {
+      std::array<std::size_t, 5> points;
+      for (int k = 0; k < 5; ++k) points[std::size_t(k)] = std::size_t(at[std::size_t(k)]);
+      if (source.one_triangle_hides(points, seen)) return true;
+    }
     if (std::isfinite(distance) &&
         (distance - box.diagonal()) * width < settings.feature_cells * s * texel_extent)
       return false;

@@ -5,6 +5,7 @@
 // change in the field, not chance.
 #pragma once
 
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -90,6 +91,14 @@ class PairSource {
   // (a cell's, all in one tile): one that none of the cell's samples saw.
   virtual bool sees_unlisted(const std::vector<std::size_t>& texels,
                              const std::vector<std::uint32_t>& listed) const = 0;
+  // Whether one triangle of the blockers `seen` (keys, sorted) hides all of the light from each
+  // of `samples` (a cell's five, the first in its tile): a triangle's umbra is convex, so it holds
+  // every point between them. False where the source cannot tell.
+  virtual bool one_triangle_hides(const std::array<std::size_t, 5>& samples,
+                                  const std::vector<std::uint32_t>& seen) const {
+    (void)samples, (void)seen;
+    return false;
+  }
 };
 
 struct RefinementSettings {

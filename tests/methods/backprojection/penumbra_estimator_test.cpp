@@ -173,6 +173,45 @@ TEST(PenumbraEstimator, OnePolygonCoveringTheLightIsAnUmbra) {
   EXPECT_EQ(partly.umbra, PenumbraSample::kNoUmbra);
 }
 
+// triangle_hides_light, the refinement's proof that a cell lies in one triangle's umbra: never
+// where the exact oracle sees any of the light, and for most of the triangles that hide it all.
+TEST(PenumbraEstimator, ATriangleHidesTheLightOnlyWhereTheOracleSeesNone) {
+  for (const LightDesc& desc : {rectangle_light(), disk_light()}) {
+    const Light light(desc);
+    std::mt19937 rng(11);
+    int hidden = 0, said = 0;
+    for (int i = 0; i < 4000; ++i) {
+      Case c = random_case(rng, light);
+      c.triangles.resize(1);
+      // Grown about its centroid, so that some hide all of the light.
+      Triangle3& t = c.triangles[0];
+      const Vec3 mid = (t[0] + t[1] + t[2]) / 3;
+      const double grow = 1 + 6 * std::uniform_real_distribution<double>(0, 1)(rng);
+      for (Vec3& p : t)
+        p = mid + grow * Vec3(p.x() - mid.x(), p.y() - mid.y(), 0) + Vec3(0, 0, p.z() - mid.z());
+      for (Vec3& p : t) p.z() = std::clamp(p.z(), c.y.z() + 0.05, light.centre().z() - 0.05);
+      const bool says = triangle_hides_light(light, t.data(), c.y, 1e-4);
+      const double truth = oracle(light, c);
+      hidden += truth < 1e-12;
+      said += says;
+      if (says) {
+        EXPECT_LT(truth, 1e-12) << desc.name << " case " << i;
+      }
+    }
+    std::printf("%s: %d of 4000 triangles hide all of the light, %d found so\n", desc.name.c_str(),
+                hidden, said);
+    EXPECT_GT(said, hidden / 2) << desc.name;
+  }
+  // Shifted by a hair past the light's edge, the square that hid it no longer does.
+  const Light light(rectangle_light());
+  const Vec3 y(0.1, -0.2, 0);
+  // The cone's section at z = 1 is the light halved: s in [−0.2, 0.4], t in [−0.35, −0.05].
+  const Triangle3 just = {Vec3(-0.2, -0.35, 1), Vec3(2.0, -0.35, 1), Vec3(-0.2, 1.85, 1)};
+  EXPECT_FALSE(triangle_hides_light(light, just.data(), y, 1e-4));  // its corner on the cone
+  const Triangle3 over = {Vec3(-0.21, -0.36, 1), Vec3(2.0, -0.36, 1), Vec3(-0.21, 1.85, 1)};
+  EXPECT_TRUE(triangle_hides_light(light, over.data(), y, 1e-4));
+}
+
 // The bake's 32 rows, and 64 (rows are the estimator's one approximation that matters: its error
 // falls about threefold per doubling).
 TEST(PenumbraEstimator, MatchesTheExactOracleOnRandomTriangles) {

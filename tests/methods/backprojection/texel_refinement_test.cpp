@@ -3,6 +3,7 @@
 // kink between samples, a thin shadow no sample falls on, a UV chart border).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <functional>
@@ -69,9 +70,16 @@ class FieldSource final : public PairSource {
       if (unlisted_where(space_.texels[t].x, space_.texels[t].y)) return true;
     return false;
   }
+  bool one_triangle_hides(const std::array<std::size_t, 5>& samples,
+                          const std::vector<std::uint32_t>&) const override {
+    if (!triangle_umbra_where) return false;
+    for (std::size_t t : samples)
+      if (!triangle_umbra_where(space_.texels[t].x, space_.texels[t].y)) return false;
+    return true;
+  }
   mutable std::atomic<int> evaluations{0};  // evaluated in parallel
   double nearest = 10.0;                    // metres: far, for penumbrae far wider than any cell
-  std::function<bool(int, int)> unlisted_where, umbra_where;
+  std::function<bool(int, int)> unlisted_where, umbra_where, triangle_umbra_where;
 
  private:
   const TexelSpace& space_;
@@ -154,6 +162,25 @@ TEST(TexelRefinement, InterpolatesInsideOneConvexSolidsUmbra) {
   FieldSource none(space, dark);
   none.nearest = 0.001;
   EXPECT_EQ(refine(space, none, dark).interpolated, 0);
+}
+
+// The same where one triangle hides the light from all five samples, though their own umbrae
+// are of nothing single (the sun under a tree crown's facets): only the cells whose samples all
+// lie in that triangle's umbra interpolate.
+TEST(TexelRefinement, InterpolatesInsideOneTrianglesUmbra) {
+  const TexelSpace space = flat_space();
+  const auto dark = [](int, int) { return 0.0; };
+  FieldSource one(space, dark);
+  one.nearest = 0.001;
+  one.triangle_umbra_where = [](int x, int) { return x <= 32; };
+  const Outcome o = refine(space, one, dark);
+  EXPECT_GT(o.interpolated, kSide * kSide / 4);
+  const LightField field = refine_light(space, TexelGrid(space), listed_tiles(), one, {});
+  for (std::size_t t = 0; t < space.texels.size(); ++t) {
+    if (space.texels[t].x >= 32) {
+      EXPECT_NE(field.route[t], TexelRoute::interpolated) << space.texels[t].x;
+    }
+  }
 }
 
 // Two UV charts side by side in the lightmap, far apart on the surface: no cell interpolates
