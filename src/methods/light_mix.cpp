@@ -91,9 +91,13 @@ void LightMix::write(std::size_t texel, const Sum& sum) {
 }
 
 void LightMix::set(std::size_t light, std::size_t texel, const Vec3& v) {
+  const Texel& tx = space_.texels[texel];
+  set(light, texel, tx.x, tx.y, v);
+}
+
+void LightMix::set(std::size_t light, std::size_t texel, int x, int y, const Vec3& v) {
   if (direct_) {
-    const Texel& tx = space_.texels[texel];
-    float* px = out_.image.at(tx.x, tx.y);
+    float* px = out_.image.at(x, y);
     for (int c = 0; c < 3; ++c) px[c] = lights_[0].exitance()[c] > 0 ? float(v[c]) : 0.0f;
     return;
   }

@@ -59,6 +59,9 @@ class LightMix {
   // Methods that run light by light: light l's visibility at texel t (per channel, [0, 1]); a
   // pair never set is left out. Combined in finish(). Many threads may set distinct pairs.
   void set(std::size_t light, std::size_t texel, const Vec3& v);
+  // The same for a caller that knows the texel's pixel (x, y), which then need not be read from
+  // its record (a 4096² receiver's records are half a gigabyte).
+  void set(std::size_t light, std::size_t texel, int x, int y, const Vec3& v);
 
   MixedImages finish();
 

@@ -398,6 +398,36 @@ bool Light::reaches(const Vec3& y, const Vec3& n) const {
   return false;
 }
 
+bool Light::reaches_all(const Bounds3& ys, const Vec3& n) const {
+  if (desc_.spot_outer > 0 || ys.empty()) return false;
+  if (desc_.shape != LightShape::rectangle && desc_.shape != LightShape::disk &&
+      desc_.shape != LightShape::polygon)
+    return false;
+  // What the centre's side and the horizon's part take beside n·c (reaches, above): constant
+  // for one normal.
+  double across = 0;
+  if (desc_.shape == LightShape::rectangle) {
+    across =
+        0.5 * desc_.width * std::abs(n.dot(right_)) + 0.5 * desc_.height * std::abs(n.dot(up_));
+  } else if (desc_.shape == LightShape::disk) {
+    across = desc_.radius * (n - n.dot(desc_.normal) * desc_.normal).norm();
+  }
+  for (int k = 0; k < 8; ++k) {
+    const Vec3 y((k & 1 ? ys.hi : ys.lo).x(), (k & 2 ? ys.hi : ys.lo).y(),
+                 (k & 4 ? ys.hi : ys.lo).z());
+    const Vec3 c = desc_.position - y;
+    const double margin = 1e-9 * (c.norm() + across + ys.diagonal());
+    if (!(c.dot(desc_.normal) < -margin)) return false;
+    double height = n.dot(c) + across;
+    if (desc_.shape == LightShape::polygon) {
+      height = -std::numeric_limits<double>::infinity();
+      for (const Vec3& corner : desc_.corners) height = std::max(height, n.dot(corner - y));
+    }
+    if (!(height > margin)) return false;
+  }
+  return true;
+}
+
 Vec3 Light::unoccluded_irradiance(const Vec3& y, const Vec3& n) const {
   return exitance_ * (form_factor(y, n) * spot_factor(y));
 }

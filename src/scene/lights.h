@@ -114,6 +114,10 @@ class Light {
   // Whether any of the light lies above the horizon of (y, n) and faces y, i.e. F > 0, and y is
   // inside a spot's cone; much cheaper than F itself.
   bool reaches(const Vec3& y, const Vec3& n) const;
+  // True only where reaches(y, n) holds at every point y of the box: a rectangle's, disk's or
+  // polygon's conditions are linear in y, so they hold inside if they hold at its corners (with
+  // a margin against rounding). False where it cannot tell (a sphere, a spot, a mesh or sky).
+  bool reaches_all(const Bounds3& ys, const Vec3& n) const;
   // The form factor F alone (dimensionless, H0 = E · F · spot_factor).
   double form_factor(const Vec3& y, const Vec3& n) const;
   // A spot's cone at y (LightDesc::spot_axis): 1 inside the inner cone, 0 outside the outer one,

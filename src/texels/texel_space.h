@@ -29,6 +29,19 @@ struct Texel {
 };
 static_assert(sizeof(Texel) == 32, "a texel record is 32 bytes");
 
+// What a square of kSide × kSide pixels of a texel space holds, for a method that tests texels
+// block by block without reading their records: the box of their positions and, where they
+// share them, their shading and face normals (a flat receiver's blocks all do).
+struct TexelBlock {
+  static constexpr int kSide = 8;
+  Vec3f lo{1, 1, 1}, hi{0, 0, 0};  // lo > hi: no texel
+  // Whether every texel has `normal` as its shading normal, `geometric` as its geometric_normal
+  // and no lift (its shadow origin is its position).
+  bool uniform = false;
+  Vec3f normal = Vec3f::Zero(), geometric = Vec3f::Zero();
+  bool empty() const { return lo.x() > hi.x(); }
+};
+
 // Rows [begin, end) of a lightmap.
 struct RowRange {
   int begin = 0, end = std::numeric_limits<int>::max();
@@ -45,6 +58,9 @@ struct TexelSpace {
   // shadow origin − position; empty where every texel's is its position.
   FreshVector<Vec3f> lifts;
   std::vector<std::uint8_t> covered;  // width * height; 1 where a texel of `texels` lies
+  // Per block of TexelBlock::kSide² pixels, row-major (blocks_x per row): what its texels hold.
+  int blocks_x = 0;
+  std::vector<TexelBlock> blocks;
   // Texels whose centre two UV triangles claim (inside one, inside or on the other): charts that
   // overlap in the lightmap, so one surface point stands for two (check_uv_layout reports it).
   std::int64_t overlapping_texels = 0;

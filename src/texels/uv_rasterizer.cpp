@@ -415,31 +415,58 @@ TexelSpace rasterise_texels(const Mesh& mesh, int width, int height, RowRange ro
   std::vector<int> footprint_of_face(tri_mesh.n_faces(), -1);
   for (std::size_t i = 0; i < footprints.size(); ++i)
     footprint_of_face[std::size_t(footprints[i].face)] = int(i);
-  tbb::parallel_for(tbb::blocked_range<int>(row0, row1), [&](const tbb::blocked_range<int>& rows) {
-    for (int y = rows.begin(); y != rows.end(); ++y) {
-      std::size_t out = row_count[std::size_t(y - row0)];
-      const std::size_t row_offset = std::size_t(y) * std::size_t(width);
-      const std::size_t owner_offset = std::size_t(y - row0) * std::size_t(width);
-      const double centre_y = y + 0.5;
-      const double centre_v = 1.0 - centre_y / height;
-      for (int x = 0; x < width; ++x) {
-        const std::int32_t code = owner[owner_offset + std::size_t(x)];
-        if (code == kUncovered) continue;
-        const int face = face_of(code);
-        const FaceFootprint& fp = footprints[std::size_t(footprint_of_face[std::size_t(face)])];
-        double bary[3] = {};
-        // Pass 1 found the centre inside, so centre_barycentrics succeeds; the nearest point is
-        // the same point should it not.
-        if (!is_centre_code(code) || !centre_barycentrics(fp, x + 0.5, centre_y, bary))
-          nearest_point(fp.uv[0], fp.uv[1], fp.uv[2], Vec2((x + 0.5) / width, centre_v), bary);
-        Vec3f lift;
-        space.texels[out] = make_texel(surfaces[std::size_t(face)], face, x, y, bary, lift);
-        if (lifted) space.lifts[out] = lift;
-        ++out;
-        space.covered[row_offset + std::size_t(x)] = 1;
-      }
+  // By rows of blocks, so that each block's summary (TexelBlock) is one task's.
+  constexpr int kBlock = TexelBlock::kSide;
+  space.blocks_x = (width + kBlock - 1) / kBlock;
+  space.blocks.assign(std::size_t(space.blocks_x) * std::size_t((height + kBlock - 1) / kBlock),
+                      TexelBlock());
+  const auto add_to_block = [&](const Texel& t, const Vec3f& lift) {
+    TexelBlock& b = space.blocks[std::size_t(t.y / kBlock) * std::size_t(space.blocks_x) +
+                                 std::size_t(t.x / kBlock)];
+    const Vec3f& n = space.face_normals[std::size_t(t.face)];
+    const Vec3f geometric = n.dot(t.normal) < 0 ? Vec3f(-n) : n;
+    const bool flat = lift == Vec3f::Zero();
+    if (b.empty()) {
+      b.lo = b.hi = t.position;
+      b.uniform = flat;
+      b.normal = t.normal;
+      b.geometric = geometric;
+      return;
     }
-  });
+    b.lo = b.lo.cwiseMin(t.position);
+    b.hi = b.hi.cwiseMax(t.position);
+    b.uniform = b.uniform && flat && t.normal == b.normal && geometric == b.geometric;
+  };
+  tbb::parallel_for(
+      tbb::blocked_range<int>(row0 / kBlock, (row1 + kBlock - 1) / kBlock),
+      [&](const tbb::blocked_range<int>& block_rows) {
+        const int y_begin = std::max(row0, block_rows.begin() * kBlock);
+        const int y_end = std::min(row1, block_rows.end() * kBlock);
+        for (int y = y_begin; y < y_end; ++y) {
+          std::size_t out = row_count[std::size_t(y - row0)];
+          const std::size_t row_offset = std::size_t(y) * std::size_t(width);
+          const std::size_t owner_offset = std::size_t(y - row0) * std::size_t(width);
+          const double centre_y = y + 0.5;
+          const double centre_v = 1.0 - centre_y / height;
+          for (int x = 0; x < width; ++x) {
+            const std::int32_t code = owner[owner_offset + std::size_t(x)];
+            if (code == kUncovered) continue;
+            const int face = face_of(code);
+            const FaceFootprint& fp = footprints[std::size_t(footprint_of_face[std::size_t(face)])];
+            double bary[3] = {};
+            // Pass 1 found the centre inside, so centre_barycentrics succeeds; the nearest point
+            // is the same point should it not.
+            if (!is_centre_code(code) || !centre_barycentrics(fp, x + 0.5, centre_y, bary))
+              nearest_point(fp.uv[0], fp.uv[1], fp.uv[2], Vec2((x + 0.5) / width, centre_v), bary);
+            Vec3f lift = Vec3f::Zero();
+            space.texels[out] = make_texel(surfaces[std::size_t(face)], face, x, y, bary, lift);
+            if (lifted) space.lifts[out] = lift;
+            add_to_block(space.texels[out], lifted ? lift : Vec3f::Zero());
+            ++out;
+            space.covered[row_offset + std::size_t(x)] = 1;
+          }
+        }
+      });
   return space;
 }
 

@@ -254,6 +254,42 @@ TEST(Lambert, ReachesIsFormFactorPositive) {
   }
 }
 
+// reaches_all never claims a box the light misses a point of, and claims boxes wholly in front
+// of a light (below a ceiling panel, facing up).
+TEST(Lambert, ReachesAllHoldsAtEveryPointOfTheBox) {
+  Rng rng(9);
+  for (const LightDesc& d : {rectangle(0.5, 0.3), tilted_disk(0.25), triangle()}) {
+    const Light light(d);
+    int claimed = 0;
+    for (int i = 0; i < 4000; ++i) {
+      const Vec3 a(4 * rng.next_double() - 2, 4 * rng.next_double() - 2, 3 * rng.next_double() - 1);
+      const double size = 0.3 * rng.next_double();
+      const Vec3 b = a + size * Vec3(rng.next_double(), rng.next_double(), rng.next_double());
+      const Vec3 n = Vec3(rng.next_double() - 0.5, rng.next_double() - 0.5, rng.next_double() - 0.5)
+                         .normalized();
+      Bounds3 box;
+      box.extend(a);
+      box.extend(b);
+      if (!light.reaches_all(box, n)) continue;
+      ++claimed;
+      for (int k = 0; k < 64; ++k) {
+        const Vec3 y =
+            a + (b - a).cwiseProduct(Vec3(rng.next_double(), rng.next_double(), rng.next_double()));
+        EXPECT_TRUE(light.reaches(y, n)) << to_string(d.shape) << " " << y.transpose();
+      }
+      for (int c = 0; c < 8; ++c)
+        EXPECT_TRUE(light.reaches(
+            Vec3(c & 1 ? b.x() : a.x(), c & 2 ? b.y() : a.y(), c & 4 ? b.z() : a.z()), n));
+    }
+    EXPECT_GT(claimed, 100) << to_string(d.shape);
+  }
+  // Neither a sphere nor a spot: no claim.
+  Bounds3 below;
+  below.extend(Vec3(-0.1, -0.1, -1));
+  below.extend(Vec3(0.1, 0.1, -0.9));
+  EXPECT_FALSE(Light(sphere(0.2)).reaches_all(below, Vec3::UnitZ()));
+}
+
 TEST(Lambert, DiskOnAxisIsClassicFormula) {
   // On the axis of a disk of radius R at height h, facing it: F = R² / (R² + h²).
   LightDesc d = tilted_disk(0.4);

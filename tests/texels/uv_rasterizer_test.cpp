@@ -119,6 +119,42 @@ std::set<std::pair<int, int>> covered_set(const TexelSpace& space) {
   return set;
 }
 
+// Each block's summary is its texels' own: the box of their positions, exactly, and uniform just
+// where they share their shading and geometric normals and lift nothing.
+void expect_blocks(const TexelSpace& space) {
+  constexpr int k = TexelBlock::kSide;
+  ASSERT_EQ(space.blocks_x, (space.width + k - 1) / k);
+  ASSERT_EQ(space.blocks.size(), std::size_t(space.blocks_x) * ((space.height + k - 1) / k));
+  std::vector<TexelBlock> own(space.blocks.size());
+  std::vector<std::uint8_t> shared(space.blocks.size(), 1);
+  for (std::size_t i = 0; i < space.texels.size(); ++i) {
+    const Texel& t = space.texels[i];
+    const std::size_t b = std::size_t(t.y / k) * std::size_t(space.blocks_x) + t.x / k;
+    TexelBlock& o = own[b];
+    if (o.empty()) {
+      o.lo = o.hi = t.position;
+      o.normal = t.normal;
+      o.geometric = space.geometric_normal(i);
+    }
+    o.lo = o.lo.cwiseMin(t.position);
+    o.hi = o.hi.cwiseMax(t.position);
+    shared[b] = shared[b] && t.normal == o.normal && space.geometric_normal(i) == o.geometric &&
+                space.shadow_origin(i) == t.position;
+  }
+  for (std::size_t b = 0; b < own.size(); ++b) {
+    const TexelBlock& got = space.blocks[b];
+    ASSERT_EQ(got.empty(), own[b].empty()) << "block " << b;
+    if (got.empty()) continue;
+    EXPECT_EQ(got.lo, own[b].lo) << "block " << b;
+    EXPECT_EQ(got.hi, own[b].hi) << "block " << b;
+    EXPECT_EQ(got.uniform, bool(shared[b])) << "block " << b;
+    if (got.uniform) {
+      EXPECT_EQ(got.normal, own[b].normal);
+      EXPECT_EQ(got.geometric, own[b].geometric);
+    }
+  }
+}
+
 // Common invariants: row-major order, no duplicates, `covered` agrees with `texels`.
 void expect_consistent(const TexelSpace& space) {
   ASSERT_EQ(space.covered.size(), std::size_t(space.width) * space.height);
@@ -134,6 +170,7 @@ void expect_consistent(const TexelSpace& space) {
     ASSERT_TRUE(t.x >= 0 && t.x < space.width && t.y >= 0 && t.y < space.height);
     EXPECT_EQ(space.covered[std::size_t(t.y) * space.width + t.x], 1);
   }
+  expect_blocks(space);
 }
 
 TEST(UvRasterizer, FullQuadCoversEveryTexelWithExactPositions) {
@@ -421,6 +458,21 @@ TEST(UvRasterizer, ShadowOriginIsThePositionOnFlatFaces) {
   EXPECT_TRUE(space.lifts.empty());
   for (std::size_t i = 0; i < space.texels.size(); ++i)
     EXPECT_EQ(space.shadow_origin(i), space.texels[i].position);
+}
+
+// A flat quad's blocks are all uniform; a curved triangle's, whose normals vary, none.
+TEST(UvRasterizer, BlocksSummariseTheirTexels) {
+  const TexelSpace flat_space = rasterise_texels(full_quad(), 20, 12);
+  expect_blocks(flat_space);
+  for (const TexelBlock& b : flat_space.blocks) EXPECT_TRUE(b.uniform);
+  const Vec3 n0 = Vec3(-1, -1, 2).normalized(), n1 = Vec3(1, -1, 2).normalized(),
+             n2 = Vec3(0, 1, 2).normalized();
+  const Mesh curved = make_mesh({flat(0, 0, n0), flat(1, 0, n1), flat(0.5, 1, n2)}, {{0, 1, 2}});
+  const TexelSpace space = rasterise_texels(curved, 32, 32);
+  expect_blocks(space);
+  int uniform = 0;
+  for (const TexelBlock& b : space.blocks) uniform += b.uniform;
+  EXPECT_EQ(uniform, 0);
 }
 
 TEST(UvRasterizer, ShadowOriginLiftsOntoTheSmoothSurface) {

@@ -17,7 +17,6 @@
 #include <algorithm>
 #include <atomic>
 #include <limits>
-#include <optional>
 
 #include "methods/backprojection/penumbra_estimator.h"
 #include "occluders/blocker_solids.h"
@@ -28,8 +27,9 @@ namespace sb {
 namespace {
 
 // Stage 1: every tile's shaft, as one box of its texels' ray origins.
-TileShafts tile_shafts(const TexelSpace& space, const ShaftCuller& culler, const Light& light,
-                       double offset, std::size_t max) {
+TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const ShaftCuller& culler,
+                       const Light& light, double offset, std::size_t max) {
+  static_assert(TileShafts::kTile == TexelBlock::kSide, "a tile is a block of the texel space");
   TileShafts tiles;
   constexpr int k = TileShafts::kTile;
   tiles.tiles_x = (space.width + k - 1) / k;
@@ -40,15 +40,12 @@ TileShafts tile_shafts(const TexelSpace& space, const ShaftCuller& culler, const
   std::vector<Bounds3>& boxes = tiles.origins;
   boxes.assign(count, Bounds3());
   tiles.reached.resize(space.texels.size());  // every texel's written below
-  // Bands of kGroup tile rows in parallel, each in one pass over its texels (a 4096² receiver's
-  // texels are a gigabyte: a pass is memory-bound): texels are in row-major order, so a band's
-  // are the run from its first pixel row's first texel to the next band's.
+  const bool blocks = space.blocks.size() == count;
+  // Bands of kGroup tile rows in parallel, each in one pass over its texels through the grid.
+  // A tile whose block shares one normal and that the light reaches all of (the sun over flat
+  // ground) takes its box from the block, shifted as each ray origin is (the same box: rounding
+  // is monotonic), and its texels' records are not read.
   constexpr int g = TileShafts::kGroup;
-  const auto row_start = [&](int y) {
-    return std::size_t(std::lower_bound(space.texels.begin(), space.texels.end(), y,
-                                        [](const Texel& t, int row) { return t.y < row; }) -
-                       space.texels.begin());
-  };
   const auto test = [&](std::size_t i) {
     std::vector<std::uint32_t>& list = tiles.candidates[i];
     if (!culler.tile_candidates(boxes[i], light, max, list)) {
@@ -62,11 +59,31 @@ TileShafts tile_shafts(const TexelSpace& space, const ShaftCuller& culler, const
   };
   tbb::parallel_for(tbb::blocked_range<int>(0, (tiles.tiles_y + g - 1) / g), [&](const auto& r) {
     const int ty0 = r.begin() * g, ty1 = std::min(r.end() * g, tiles.tiles_y);
-    for (std::size_t i = row_start(ty0 * k); i < row_start(ty1 * k); ++i) {
-      const Texel& t = space.texels[i];
-      tiles.reached[i] = light.reaches(t.position.cast<double>(), t.normal.cast<double>());
-      if (tiles.reached[i]) boxes[tiles.tile_of(t.x, t.y)].extend(space.ray_origin(i, offset));
+    const std::size_t first_tile = std::size_t(ty0) * std::size_t(tiles.tiles_x);
+    thread_local std::vector<std::uint8_t> whole;  // per tile of the band
+    whole.assign(std::size_t(ty1 - ty0) * std::size_t(tiles.tiles_x), 0);
+    for (std::size_t i = first_tile; blocks && i < first_tile + whole.size(); ++i) {
+      const TexelBlock& b = space.blocks[i];
+      if (!b.uniform || b.empty()) continue;
+      Bounds3 positions;
+      positions.extend(b.lo.cast<double>());
+      positions.extend(b.hi.cast<double>());
+      if (!light.reaches_all(positions, b.normal.cast<double>())) continue;
+      whole[i - first_tile] = 1;
+      const Vec3 shift = offset * b.geometric.cast<double>();
+      boxes[i].extend(Vec3(b.lo.cast<double>() + shift));
+      boxes[i].extend(Vec3(b.hi.cast<double>() + shift));
     }
+    grid.for_each(ty0 * k, std::min(space.height, ty1 * k), [&](std::size_t t, int x, int y) {
+      const std::size_t tile = tiles.tile_of(x, y);
+      if (whole[tile - first_tile]) {
+        tiles.reached[t] = 1;
+        return;
+      }
+      const Texel& tx = space.texels[t];
+      tiles.reached[t] = light.reaches(tx.position.cast<double>(), tx.normal.cast<double>());
+      if (tiles.reached[t]) boxes[tile].extend(space.ray_origin(t, offset));
+    });
     // A group of g × g tiles whose joint box's shaft is clear is clear throughout (each tile's
     // shaft lies inside it); otherwise its tiles are tested one by one.
     thread_local std::vector<std::uint32_t> group_list;
@@ -501,11 +518,12 @@ class LightPairs final : public PairSource {
 // A light baked by rays alone: clear tiles and texels are 1, the rest the reference's own
 // estimate at `samples` rays: a textured light's (the estimator weighs a uniform light only), or a
 // point's at one ray, which is exact (its shadows are hard: nothing to estimate or interpolate).
-void bake_light_by_rays(const TexelSpace& space, const BackprojectionInputs& in, std::size_t l,
-                        int samples, LightMix& mix, RouteCounts& counts) {
+void bake_light_by_rays(const TexelSpace& space, const TexelGrid& grid,
+                        const BackprojectionInputs& in, std::size_t l, int samples, LightMix& mix,
+                        RouteCounts& counts) {
   const Light& light = (*in.lights)[l];
   const double offset = in.rays->surface_offset();
-  const TileShafts tiles = tile_shafts(space, *in.culler, light, offset, kTileCandidates);
+  const TileShafts tiles = tile_shafts(space, grid, *in.culler, light, offset, kTileCandidates);
   // Counted: the kept rows' texels (a tile's halo is not).
   const auto kept = kept_texels(space);
   const std::size_t kept0 = kept.first, kept1 = kept.second;
@@ -562,7 +580,7 @@ LightField light_field(const TexelSpace& space, const TexelGrid& grid,
                        const BackprojectionInputs& in, std::size_t l) {
   const Light& light = (*in.lights)[l];
   const TileShafts tiles =
-      tile_shafts(space, *in.culler, light, in.rays->surface_offset(), kTileCandidates);
+      tile_shafts(space, grid, *in.culler, light, in.rays->surface_offset(), kTileCandidates);
   const LightPairs pairs(space, light, in, tiles);
   return refine_light(space, grid, tiles, pairs, in.refinement);
 }
@@ -582,28 +600,28 @@ MixedImages bake_backprojection(const TexelSpace& space, const BackprojectionInp
   // Counted: the kept rows' texels (a tile's halo is not).
   const auto kept = kept_texels(space);
   const std::size_t kept0 = kept.first, kept1 = kept.second;
-  std::optional<TexelGrid> grid;  // built once, for the first light the estimator takes
+  const TexelGrid grid(space);  // built once: it does not depend on the light
   for (std::size_t l = 0; l < lights.size(); ++l) {
     if (lights[l].textured() || lights[l].is_point()) {
-      bake_light_by_rays(space, in, l, lights[l].is_point() ? 1 : in.samples, mix, counts);
+      bake_light_by_rays(space, grid, in, l, lights[l].is_point() ? 1 : in.samples, mix, counts);
       continue;
     }
-    if (!grid) grid.emplace(space);
-    const LightField field = light_field(space, *grid, in, l);
-    // Distinct texels in parallel (LightMix::set allows it), each range counting its routes.
+    const LightField field = light_field(space, grid, in, l);
+    // Distinct texels in parallel (LightMix::set allows it), rows by rows through the grid (so
+    // that no texel's record is read), each range counting its routes.
     tbb::combinable<RouteCounts> local;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, space.texels.size(), 1 << 14),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
+    tbb::parallel_for(tbb::blocked_range<int>(0, space.height, 16),
+                      [&](const tbb::blocked_range<int>& rows) {
                         RouteCounts& c = local.local();
-                        for (std::size_t t = range.begin(); t != range.end(); ++t) {
+                        grid.for_each(rows.begin(), rows.end(), [&](std::size_t t, int x, int y) {
                           const TexelRoute route = field.route[t];
-                          if (route == TexelRoute::none) continue;
-                          mix.set(l, t, Vec3::Constant(double(field.visibility[t])));
-                          if (t < kept0 || t >= kept1) continue;
+                          if (route == TexelRoute::none) return;
+                          mix.set(l, t, x, y, Vec3::Constant(double(field.visibility[t])));
+                          if (t < kept0 || t >= kept1) return;
                           ++c[route];
                           if (route == TexelRoute::traced)
                             c.rays += in.light_rows * LightRows::kCells / 2;
-                        }
+                        });
                       });
     local.combine_each([&](const RouteCounts& c) {
       for (std::size_t r = 0; r < c.pairs.size(); ++r) counts.pairs[r] += c.pairs[r];

@@ -100,29 +100,17 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
   // texel's: what the cells' checks read beyond V.
   std::vector<PairSample> samples;
   FreshVector<std::int32_t> sample_of(n);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1 << 16), [&](const auto& r) {
-    for (std::size_t t = r.begin(); t != r.end(); ++t) {
-      field.visibility[t] = 1.0f;
-      field.route[t] = TexelRoute::none;
-      state[t] = kUnknown;
-      sample_of[t] = -1;
-    }
-  });
-  // The clear tiles' texels, found through the grid (the texel records are many times larger).
+  // Every array's first write, in one pass through the grid (the texel records are many times
+  // larger): the clear tiles' reached texels are clear and valued, the rest unknown.
   tbb::parallel_for(tbb::blocked_range<int>(0, tiles.tiles_y), [&](const auto& r) {
-    for (int ty = r.begin(); ty != r.end(); ++ty)
-      for (int tx = 0; tx < tiles.tiles_x; ++tx) {
-        if (tiles.kind[std::size_t(ty) * std::size_t(tiles.tiles_x) + std::size_t(tx)] !=
-            TileShafts::Kind::clear)
-          continue;
-        for (int y = ty * TileShafts::kTile; y < (ty + 1) * TileShafts::kTile; ++y)
-          for (int x = tx * TileShafts::kTile; x < (tx + 1) * TileShafts::kTile; ++x) {
-            const std::int32_t t = grid.texel(x, y);
-            if (t < 0 || !reached[std::size_t(t)]) continue;
-            field.route[std::size_t(t)] = TexelRoute::clear;
-            state[std::size_t(t)] = kValued;
-          }
-      }
+    const int y1 = std::min(space.height, r.end() * TileShafts::kTile);
+    grid.for_each(r.begin() * TileShafts::kTile, y1, [&](std::size_t t, int x, int y) {
+      const bool clear = reached[t] && tiles.kind[tiles.tile_of(x, y)] == TileShafts::Kind::clear;
+      field.visibility[t] = 1.0f;
+      field.route[t] = clear ? TexelRoute::clear : TexelRoute::none;
+      state[t] = clear ? kValued : kUnknown;
+      sample_of[t] = -1;
+    });
   });
 
   const auto evaluate_all = [&](const std::vector<std::size_t>& queue) {

@@ -33,6 +33,18 @@ class TexelGrid {
     if (!(bits_[word] & bit)) return -1;
     return first_[word] + std::popcount(bits_[word] & (bit - 1));
   }
+  // Calls f(texel, x, y) for each covered pixel of rows [y0, y1), in row-major order: the texels
+  // with their pixels, without reading their records.
+  template <class F>
+  void for_each(int y0, int y1, F&& f) const {
+    for (int y = y0; y < y1; ++y)
+      for (std::size_t w = 0; w < words_per_row_; ++w) {
+        const std::size_t word = std::size_t(y) * words_per_row_ + w;
+        std::size_t t = std::size_t(first_[word]);
+        for (std::uint64_t bits = bits_[word]; bits != 0; bits &= bits - 1)
+          f(t++, int(w * 64) + std::countr_zero(bits), y);
+      }
+  }
 
  private:
   std::size_t words_per_row_ = 0;

@@ -8,10 +8,15 @@
 #include <cstdio>
 #include <string>
 
+#include "methods/backprojection/backprojection_bake.h"
+#include "occluders/ray_scene.h"
+#include "occluders/shaft_culling.h"
 #include "pipeline/bake.h"
+#include "pipeline/receiver_stages.h"
 #include "support/closed_forms.h"
 #include "support/image_errors.h"
 #include "support/test_scenes.h"
+#include "texels/texel_space.h"
 
 namespace sb {
 namespace {
@@ -62,6 +67,42 @@ TEST(BackprojectionBake, SameBytesForAnyThreadCountAndRun) {
   for (std::size_t r = 0; r < a->receivers.size(); ++r) {
     EXPECT_EQ(a->receivers[r].image.pixels, b->receivers[r].image.pixels) << r;
     EXPECT_EQ(b->receivers[r].image.pixels, c->receivers[r].image.pixels) << r;
+  }
+}
+
+// The tiles' shaft tests take a flat block's box from its summary (TexelBlock) without reading
+// its texels: the same image and routes as from the texels, on the courtyard's ground under the
+// sun (every block flat) and on the level's curved furniture beside flat floors.
+TEST(BackprojectionBake, BlockSummariesGiveTheSameBakeAsTheTexels) {
+  for (const auto& [name, file] : {std::pair<std::string, std::string>{"outdoor", "scene_sun.toml"},
+                                   {"level", "scene.toml"}}) {
+    const Scene scene = scene_of(name, 256, file);
+    auto meshes = load_meshes(scene, nullptr);
+    ASSERT_TRUE(meshes) << meshes.error().message;
+    auto lights = make_lights(placed_lights(scene, *meshes), scene.file);
+    ASSERT_TRUE(lights) << lights.error().message;
+    const std::vector<const Mesh*> blockers = blocker_meshes(scene, *meshes);
+    auto rays = RayScene::build(blockers);
+    ASSERT_TRUE(rays) << rays.error().message;
+    const ShaftCuller culler(blockers);
+    BackprojectionInputs in;
+    in.lights = &*lights;
+    in.culler = &culler;
+    in.rays = &*rays;
+    int uniform_blocks = 0;
+    for (std::size_t i = 0; i < meshes->size(); ++i) {
+      if (!scene.objects[i].receiver) continue;
+      const TexelSpace space = rasterise_texels((*meshes)[i], 256, 256);
+      TexelSpace without = rasterise_texels((*meshes)[i], 256, 256);
+      for (const TexelBlock& b : space.blocks) uniform_blocks += b.uniform;
+      without.blocks.clear();
+      RouteCounts with_routes, without_routes;
+      const MixedImages a = bake_backprojection(space, in, &with_routes);
+      const MixedImages b = bake_backprojection(without, in, &without_routes);
+      EXPECT_EQ(a.image.pixels, b.image.pixels) << name << " " << scene.objects[i].name;
+      EXPECT_EQ(with_routes.pairs, without_routes.pairs) << name << " " << scene.objects[i].name;
+    }
+    EXPECT_GT(uniform_blocks, 100) << name;
   }
 }
 
