@@ -1,7 +1,8 @@
 // The `backprojection` method's bake of one receiver (backprojection_bake.h). Per light, as a
 // list of stages:
 //   1. tile shafts: each tile of 8 × 8 texels tested as one box (ShaftCuller::tile_candidates):
-//      clear, or the triangles its texels must look at;
+//      clear, or the triangles its texels must look at, or an umbra (one of them hides all of
+//      the light from the whole box);
 //   2. refinement (texel_refinement.cpp): at the samples it asks for, the exact estimate
 //      (LightPairs::evaluate: the texel's own shaft polygons, back-projected onto the light), and
 //      interpolation inside the cells it vouches for;
@@ -27,8 +28,11 @@ namespace sb {
 namespace {
 
 // Stage 1: every tile's shaft, as one box of its texels' ray origins.
+// With `umbrae`, a listed tile that one of its candidates hides all of the light from is an
+// umbra: the triangle hides it from the eight corners of the tile's box of ray origins, so from
+// every one of them (its umbra is convex).
 TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const ShaftCuller& culler,
-                       const Light& light, double offset, std::size_t max) {
+                       const Light& light, double offset, std::size_t max, bool umbrae) {
   static_assert(TileShafts::kTile == TexelBlock::kSide, "a tile is a block of the texel space");
   TileShafts tiles;
   constexpr int k = TileShafts::kTile;
@@ -55,6 +59,20 @@ TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const Sha
     } else {
       tiles.kind[i] = TileShafts::Kind::listed;
       std::sort(list.begin(), list.end());
+      if (!umbrae) return;
+      const Bounds3& o = boxes[i];
+      for (std::uint32_t c : list) {
+        bool hides = true;
+        for (int k = 0; k < 8 && hides; ++k)
+          hides = triangle_hides_light(
+              light, culler.triangle_corners(c),
+              Vec3((k & 1 ? o.hi : o.lo).x(), (k & 2 ? o.hi : o.lo).y(), (k & 4 ? o.hi : o.lo).z()),
+              offset);
+        if (hides) {
+          tiles.kind[i] = TileShafts::Kind::umbra;
+          return;
+        }
+      }
     }
   };
   tbb::parallel_for(tbb::blocked_range<int>(0, (tiles.tiles_y + g - 1) / g), [&](const auto& r) {
@@ -296,12 +314,28 @@ class LightPairs final : public PairSource {
         tiles_(tiles),
         offset_(in.rays->surface_offset()),
         estimator_(light, in.light_rows, offset_),
-        prepared_(tiles.kind.size()) {
+        prepared_(tiles.kind.size()),
+        ready_(tiles.kind.size(), 0) {
+    // The listed tiles' blockers, and those of the umbrae that hold the corners of a listed (or
+    // unlisted) tile's cells: right of, below or below-right of one, whose texels the refinement
+    // evaluates as those cells' samples.
+    const auto searched = [&](int tx, int ty) {
+      if (tx < 0 || ty < 0) return false;
+      const TileShafts::Kind k = tiles.kind[std::size_t(ty) * std::size_t(tiles.tiles_x) + tx];
+      return k == TileShafts::Kind::listed || k == TileShafts::Kind::all;
+    };
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tiles.kind.size(), 8), [&](const auto& r) {
-      for (std::size_t i = r.begin(); i != r.end(); ++i)
-        if (tiles.kind[i] == TileShafts::Kind::listed)
+      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        const int tx = int(i % std::size_t(tiles.tiles_x)),
+                  ty = int(i / std::size_t(tiles.tiles_x));
+        if (tiles.kind[i] == TileShafts::Kind::listed ||
+            (tiles.kind[i] == TileShafts::Kind::umbra &&
+             (searched(tx - 1, ty) || searched(tx, ty - 1) || searched(tx - 1, ty - 1)))) {
           prepared_[i] =
               tile_blockers(*in.culler, light, tiles.candidates[i], tiles.origins[i], offset_);
+          ready_[i] = 1;
+        }
+      }
     });
   }
 
@@ -359,7 +393,7 @@ class LightPairs final : public PairSource {
     const std::size_t tile = tiles_.tile_of(tx.x, tx.y);
     const TileBlockers& prepared = prepared_[tile];
     PenumbraSample sample;
-    if (tiles_.kind[tile] == TileShafts::Kind::listed) {
+    if (ready_[tile]) {
       sample = estimator_.visibility(
           p, n, origin, Blockers{&prepared.polygons, &prepared.solids, &prepared.outlines},
           form_factor, &out.triangles);
@@ -512,7 +546,8 @@ class LightPairs final : public PairSource {
   const TileShafts& tiles_;
   double offset_;
   PenumbraEstimator estimator_;
-  std::vector<TileBlockers> prepared_;  // per listed tile
+  std::vector<TileBlockers> prepared_;  // per tile: a listed one's, and some umbrae's (above)
+  std::vector<std::uint8_t> ready_;     // per tile: 1 where prepared_ holds its blockers
 };
 
 // A light baked by rays alone: clear tiles and texels are 1, the rest the reference's own
@@ -523,7 +558,8 @@ void bake_light_by_rays(const TexelSpace& space, const TexelGrid& grid,
                         RouteCounts& counts) {
   const Light& light = (*in.lights)[l];
   const double offset = in.rays->surface_offset();
-  const TileShafts tiles = tile_shafts(space, grid, *in.culler, light, offset, kTileCandidates);
+  const TileShafts tiles =
+      tile_shafts(space, grid, *in.culler, light, offset, kTileCandidates, /*umbrae=*/false);
   // Counted: the kept rows' texels (a tile's halo is not).
   const auto kept = kept_texels(space);
   const std::size_t kept0 = kept.first, kept1 = kept.second;
@@ -580,7 +616,8 @@ LightField light_field(const TexelSpace& space, const TexelGrid& grid,
                        const BackprojectionInputs& in, std::size_t l) {
   const Light& light = (*in.lights)[l];
   const TileShafts tiles =
-      tile_shafts(space, grid, *in.culler, light, in.rays->surface_offset(), kTileCandidates);
+      tile_shafts(space, grid, *in.culler, light, in.rays->surface_offset(), kTileCandidates,
+                  /*umbrae=*/true);
   const LightPairs pairs(space, light, in, tiles);
   return refine_light(space, grid, tiles, pairs, in.refinement);
 }

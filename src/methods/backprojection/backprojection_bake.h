@@ -35,7 +35,7 @@ struct BackprojectionInputs {
 
 // (light, texel) pairs by route (texel_routes.h), and the rays traced.
 struct RouteCounts {
-  std::array<std::int64_t, 6> pairs{};  // indexed by TexelRoute
+  std::array<std::int64_t, 7> pairs{};  // indexed by TexelRoute
   std::int64_t rays = 0;
   std::int64_t& operator[](TexelRoute r) { return pairs[std::size_t(r)]; }
   std::int64_t operator[](TexelRoute r) const { return pairs[std::size_t(r)]; }

@@ -2,9 +2,11 @@
 //
 // A cell is a square of S × S texels of the lightmap (S = 8, 4, 2) that owns the texels
 // [x0, x0 + S) × [y0, y0 + S); its samples are its four corners (lattice points of spacing S,
-// shared with its neighbours) and its centre. Cells start as the non-clear shaft tiles, level by
-// level: the samples of every cell of a level are evaluated exactly (in parallel, each once),
-// then each cell either interpolates the texels it owns or splits into four. A cell interpolates
+// shared with its neighbours) and its centre. Cells start as the shaft tiles that are neither
+// clear nor an umbra (valued 1 and 0 without samples; an umbra's texels that are a cell's corners
+// are evaluated as its samples), level by level: the samples of every cell of a level are
+// evaluated exactly (in parallel, each once), then each cell either interpolates the texels it
+// owns or splits into four. A cell interpolates
 // only when
 //   1. its five samples are all valued (covered, reached by the light);
 //   2. the centre's exact V is within `tolerance` of the mean of the corners, the bilinear
@@ -101,14 +103,17 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
   std::vector<PairSample> samples;
   FreshVector<std::int32_t> sample_of(n);
   // Every array's first write, in one pass through the grid (the texel records are many times
-  // larger): the clear tiles' reached texels are clear and valued, the rest unknown.
+  // larger): the clear tiles' reached texels are clear (1) and valued, the umbrae's umbra (0) and
+  // valued, the rest unknown.
   tbb::parallel_for(tbb::blocked_range<int>(0, tiles.tiles_y), [&](const auto& r) {
     const int y1 = std::min(space.height, r.end() * TileShafts::kTile);
     grid.for_each(r.begin() * TileShafts::kTile, y1, [&](std::size_t t, int x, int y) {
-      const bool clear = reached[t] && tiles.kind[tiles.tile_of(x, y)] == TileShafts::Kind::clear;
-      field.visibility[t] = 1.0f;
-      field.route[t] = clear ? TexelRoute::clear : TexelRoute::none;
-      state[t] = clear ? kValued : kUnknown;
+      const TileShafts::Kind kind = tiles.kind[tiles.tile_of(x, y)];
+      const bool clear = reached[t] && kind == TileShafts::Kind::clear;
+      const bool umbra = reached[t] && kind == TileShafts::Kind::umbra;
+      field.visibility[t] = umbra ? 0.0f : 1.0f;
+      field.route[t] = clear ? TexelRoute::clear : umbra ? TexelRoute::umbra : TexelRoute::none;
+      state[t] = clear || umbra ? kValued : kUnknown;
       sample_of[t] = -1;
     });
   });
@@ -275,8 +280,11 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
       for (int k = 0; k < 5; ++k) {
         const std::int32_t t = grid.texel(xs[k], ys[k]);
         if (t < 0 || !reached[std::size_t(t)] || state[std::size_t(t)] == kQueued) continue;
+        // Valued already, but for what a sample must hold beside V: interpolated texels, and an
+        // umbra tile's (a neighbouring cell's corners), are evaluated.
         if (state[std::size_t(t)] == kValued &&
-            field.route[std::size_t(t)] != TexelRoute::interpolated)
+            field.route[std::size_t(t)] != TexelRoute::interpolated &&
+            field.route[std::size_t(t)] != TexelRoute::umbra)
           continue;
         state[std::size_t(t)] = kQueued;
         queue.push_back(std::size_t(t));

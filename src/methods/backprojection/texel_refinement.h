@@ -62,7 +62,8 @@ struct TileShafts {
     empty,   // no covered texel the light reaches
     clear,   // nothing can block the light from any of its texels
     listed,  // `candidates` holds every triangle that may
-    all      // too many to list, or the light reaches only part of it: each texel searches all
+    all,     // too many to list, or the light reaches only part of it: each texel searches all
+    umbra    // one of `candidates` hides all of the light from every texel: V = 0
   };
   int tiles_x = 0, tiles_y = 0;
   std::vector<Kind> kind;

@@ -6,6 +6,10 @@
 //   clear         The shaft test (occluders/shaft_culling.cpp) finds no blocker triangle between
 //                 the texel and the light, for its tile of 8 × 8 texels or for the texel alone:
 //                 V = 1 exactly, nothing else is computed.
+//   umbra         The shaft test's other sure answer: one of its tile's candidate triangles hides
+//                 all of the light from the eight corners of the tile's box of ray origins, so
+//                 from every texel of it (a triangle's umbra is convex): V = 0 exactly, nothing
+//                 else is computed.
 //   convolved     The convolution (methods/convolution) where it is exact: a planar receiver
 //                 parallel to the light and blockers in planes parallel to both, so its penumbra
 //                 error bound is zero and its value stands in the penumbra too.
@@ -32,15 +36,16 @@ namespace sb {
 enum class TexelRoute : std::uint8_t {
   none,  // the light does not reach the texel (H0 = 0), or the texel is not covered
   clear,
+  umbra,
   convolved,
   exact,
   interpolated,
   traced
 };
 
-constexpr std::array<TexelRoute, 5> kTexelRoutes = {TexelRoute::clear, TexelRoute::convolved,
-                                                    TexelRoute::exact, TexelRoute::interpolated,
-                                                    TexelRoute::traced};
+constexpr std::array<TexelRoute, 6> kTexelRoutes = {TexelRoute::clear,        TexelRoute::umbra,
+                                                    TexelRoute::convolved,    TexelRoute::exact,
+                                                    TexelRoute::interpolated, TexelRoute::traced};
 
 constexpr std::string_view to_string(TexelRoute r) {
   switch (r) {
@@ -48,6 +53,8 @@ constexpr std::string_view to_string(TexelRoute r) {
       return "none";
     case TexelRoute::clear:
       return "clear";
+    case TexelRoute::umbra:
+      return "umbra";
     case TexelRoute::convolved:
       return "convolved";
     case TexelRoute::exact:

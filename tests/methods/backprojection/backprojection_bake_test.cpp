@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <optional>
+#include <stdexcept>
 #include <string>
 
 #include "methods/backprojection/backprojection_bake.h"
@@ -70,6 +72,33 @@ TEST(BackprojectionBake, SameBytesForAnyThreadCountAndRun) {
   }
 }
 
+// A scene's meshes, lights and what the method reads built as the bake builds them, for tests
+// that call bake_backprojection on one receiver's texel space.
+struct Prepared {
+  std::vector<Mesh> meshes;
+  std::vector<Light> lights;
+  std::vector<const Mesh*> blockers;
+  std::optional<RayScene> rays;
+  std::optional<ShaftCuller> culler;
+  BackprojectionInputs in;
+  explicit Prepared(const Scene& scene) {
+    auto loaded = load_meshes(scene, nullptr);
+    if (!loaded) throw std::runtime_error(loaded.error().message);
+    meshes = std::move(*loaded);
+    auto made = make_lights(placed_lights(scene, meshes), scene.file);
+    if (!made) throw std::runtime_error(made.error().message);
+    lights = std::move(*made);
+    blockers = blocker_meshes(scene, meshes);
+    auto built = RayScene::build(blockers);
+    if (!built) throw std::runtime_error(built.error().message);
+    rays.emplace(std::move(*built));
+    culler.emplace(blockers);
+    in.lights = &lights;
+    in.culler = &*culler;
+    in.rays = &*rays;
+  }
+};
+
 // The tiles' shaft tests take a flat block's box from its summary (TexelBlock) without reading
 // its texels: the same image and routes as from the texels, on the courtyard's ground under the
 // sun (every block flat) and on the level's curved furniture beside flat floors.
@@ -77,33 +106,48 @@ TEST(BackprojectionBake, BlockSummariesGiveTheSameBakeAsTheTexels) {
   for (const auto& [name, file] : {std::pair<std::string, std::string>{"outdoor", "scene_sun.toml"},
                                    {"level", "scene.toml"}}) {
     const Scene scene = scene_of(name, 256, file);
-    auto meshes = load_meshes(scene, nullptr);
-    ASSERT_TRUE(meshes) << meshes.error().message;
-    auto lights = make_lights(placed_lights(scene, *meshes), scene.file);
-    ASSERT_TRUE(lights) << lights.error().message;
-    const std::vector<const Mesh*> blockers = blocker_meshes(scene, *meshes);
-    auto rays = RayScene::build(blockers);
-    ASSERT_TRUE(rays) << rays.error().message;
-    const ShaftCuller culler(blockers);
-    BackprojectionInputs in;
-    in.lights = &*lights;
-    in.culler = &culler;
-    in.rays = &*rays;
+    const Prepared p(scene);
     int uniform_blocks = 0;
-    for (std::size_t i = 0; i < meshes->size(); ++i) {
+    for (std::size_t i = 0; i < p.meshes.size(); ++i) {
       if (!scene.objects[i].receiver) continue;
-      const TexelSpace space = rasterise_texels((*meshes)[i], 256, 256);
-      TexelSpace without = rasterise_texels((*meshes)[i], 256, 256);
+      const TexelSpace space = rasterise_texels(p.meshes[i], 256, 256);
+      TexelSpace without = rasterise_texels(p.meshes[i], 256, 256);
       for (const TexelBlock& b : space.blocks) uniform_blocks += b.uniform;
       without.blocks.clear();
       RouteCounts with_routes, without_routes;
-      const MixedImages a = bake_backprojection(space, in, &with_routes);
-      const MixedImages b = bake_backprojection(without, in, &without_routes);
+      const MixedImages a = bake_backprojection(space, p.in, &with_routes);
+      const MixedImages b = bake_backprojection(without, p.in, &without_routes);
       EXPECT_EQ(a.image.pixels, b.image.pixels) << name << " " << scene.objects[i].name;
       EXPECT_EQ(with_routes.pairs, without_routes.pairs) << name << " " << scene.objects[i].name;
     }
     EXPECT_GT(uniform_blocks, 100) << name;
   }
+}
+
+// The umbra route (texel_routes.h): on the courtyard's ground under the sun, the tiles it values
+// 0 without an estimate are 0 in the reference too, every ray of every texel blocked.
+TEST(BackprojectionBake, UmbraTilesAreDarkInTheReference) {
+  Scene scene = scene_of("outdoor", 512, "scene_sun.toml");
+  const Prepared p(scene);
+  std::size_t ground = 0;
+  while (!scene.objects[ground].receiver) ++ground;
+  const TexelSpace space = rasterise_texels(p.meshes[ground], 512, 512);
+  const LightField field = backprojection_light(space, p.in, 0);
+  scene.bake.method = "reference";
+  scene.bake.samples = 64;
+  auto reference = bake(scene);
+  ASSERT_TRUE(reference) << reference.error().message;
+  const Image& truth = reference->receivers[0].image;
+  int umbra = 0;
+  for (std::size_t t = 0; t < space.texels.size(); ++t) {
+    if (field.route[t] != TexelRoute::umbra) continue;
+    ++umbra;
+    EXPECT_EQ(field.visibility[t], 0.0f);
+    EXPECT_EQ(truth.at(space.texels[t].x, space.texels[t].y)[0], 0.0f)
+        << space.texels[t].x << ", " << space.texels[t].y;
+  }
+  std::printf("umbra route: %d of %zu texels\n", umbra, space.texels.size());
+  EXPECT_GT(umbra, int(space.texels.size() / 100));
 }
 
 TEST(BackprojectionBake, CountsEveryPairByItsRoute) {
@@ -112,8 +156,8 @@ TEST(BackprojectionBake, CountsEveryPairByItsRoute) {
   ASSERT_TRUE(result) << result.error().message;
   for (const ReceiverBake& r : result->receivers) {
     double sum = 0;
-    for (const char* route : {"clear_fraction", "convolved_fraction", "exact_fraction",
-                              "interpolated_fraction", "traced_fraction"})
+    for (const char* route : {"clear_fraction", "umbra_fraction", "convolved_fraction",
+                              "exact_fraction", "interpolated_fraction", "traced_fraction"})
       sum += stat(r, route);
     EXPECT_NEAR(sum, 1.0, 1e-9) << r.name;
   }
