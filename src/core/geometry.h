@@ -28,6 +28,10 @@ struct Bounds3 {
   }
   bool empty() const { return (hi.array() < lo.array()).any(); }
   Vec3 centre() const { return 0.5 * (lo + hi); }
+  // Corner k of 8: bit 0 picks hi's x, bit 1 its y, bit 2 its z.
+  Vec3 corner(int k) const {
+    return Vec3((k & 1 ? hi : lo).x(), (k & 2 ? hi : lo).y(), (k & 4 ? hi : lo).z());
+  }
   double diagonal() const { return empty() ? 0.0 : (hi - lo).norm(); }
 };
 

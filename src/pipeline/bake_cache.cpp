@@ -104,8 +104,7 @@ bool may_reach(const Light& light, const Bounds3& box) {
       return true;
   }
   for (int c = 0; c < 8; ++c) {
-    const Vec3 p((c & 1 ? box.hi : box.lo).x(), (c & 2 ? box.hi : box.lo).y(),
-                 (c & 4 ? box.hi : box.lo).z());
+    const Vec3 p = box.corner(c);
     if (light.normal().dot(p - light.centre()) > 0) return true;
   }
   return false;

@@ -19,7 +19,6 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <numbers>
 
 #include "core/image_io.h"
@@ -362,27 +361,35 @@ double Light::spot_factor(const Vec3& y) const {
   return t * t;
 }
 
+Light::Reach Light::flat_reach(const Vec3& y, const Vec3& n) const {
+  const Vec3 c = desc_.position - y;
+  Reach r;
+  r.front = -c.dot(desc_.normal);
+  if (desc_.shape == LightShape::rectangle) {
+    // The horizon clips a positive area off the rectangle as soon as one corner is above it.
+    const double hw = 0.5 * desc_.width * std::abs(n.dot(right_));
+    const double hh = 0.5 * desc_.height * std::abs(n.dot(up_));
+    r.above = n.dot(c) + hw + hh;
+  } else if (desc_.shape == LightShape::disk) {
+    r.above = n.dot(c) + desc_.radius * (n - n.dot(desc_.normal) * desc_.normal).norm();
+  } else {
+    r.above = -std::numeric_limits<double>::infinity();
+    for (const Vec3& corner : desc_.corners) r.above = std::max(r.above, n.dot(corner - y));
+  }
+  return r;
+}
+
 bool Light::reaches(const Vec3& y, const Vec3& n) const {
   if (!(spot_factor(y) > 0)) return false;
-  const Vec3 c = desc_.position - y;
   switch (desc_.shape) {
-    case LightShape::rectangle: {
-      if (c.dot(desc_.normal) >= 0) return false;
-      // The horizon clips a positive area off the rectangle as soon as one corner is above it.
-      const double hw = 0.5 * desc_.width * std::abs(n.dot(right_));
-      const double hh = 0.5 * desc_.height * std::abs(n.dot(up_));
-      return n.dot(c) + hw + hh > 0;
+    case LightShape::rectangle:
+    case LightShape::polygon:
+    case LightShape::disk: {
+      const Reach r = flat_reach(y, n);
+      return r.front > 0 && r.above > 0;
     }
-    case LightShape::polygon: {
-      if (c.dot(desc_.normal) >= 0) return false;
-      double highest = -std::numeric_limits<double>::infinity();
-      for (const Vec3& corner : desc_.corners) highest = std::max(highest, n.dot(corner - y));
-      return highest > 0;
-    }
-    case LightShape::disk:
-      return c.dot(desc_.normal) < 0 &&
-             n.dot(c) + desc_.radius * (n - n.dot(desc_.normal) * desc_.normal).norm() > 0;
     case LightShape::sphere: {
+      const Vec3 c = desc_.position - y;
       const double d = c.norm(), r = desc_.radius;
       if (d <= r) return false;
       // The silhouette disk, as in form_factor.
@@ -403,27 +410,13 @@ bool Light::reaches_all(const Bounds3& ys, const Vec3& n) const {
   if (desc_.shape != LightShape::rectangle && desc_.shape != LightShape::disk &&
       desc_.shape != LightShape::polygon)
     return false;
-  // What the centre's side and the horizon's part take beside n·c (reaches, above): constant
-  // for one normal.
-  double across = 0;
-  if (desc_.shape == LightShape::rectangle) {
-    across =
-        0.5 * desc_.width * std::abs(n.dot(right_)) + 0.5 * desc_.height * std::abs(n.dot(up_));
-  } else if (desc_.shape == LightShape::disk) {
-    across = desc_.radius * (n - n.dot(desc_.normal) * desc_.normal).norm();
-  }
+  // For one normal both of flat_reach's terms are linear in y: positive at the box's corners
+  // (by a margin against rounding), they are positive throughout.
   for (int k = 0; k < 8; ++k) {
-    const Vec3 y((k & 1 ? ys.hi : ys.lo).x(), (k & 2 ? ys.hi : ys.lo).y(),
-                 (k & 4 ? ys.hi : ys.lo).z());
-    const Vec3 c = desc_.position - y;
-    const double margin = 1e-9 * (c.norm() + across + ys.diagonal());
-    if (!(c.dot(desc_.normal) < -margin)) return false;
-    double height = n.dot(c) + across;
-    if (desc_.shape == LightShape::polygon) {
-      height = -std::numeric_limits<double>::infinity();
-      for (const Vec3& corner : desc_.corners) height = std::max(height, n.dot(corner - y));
-    }
-    if (!(height > margin)) return false;
+    const Vec3 y = ys.corner(k);
+    const Reach r = flat_reach(y, n);
+    const double margin = 1e-9 * ((desc_.position - y).norm() + std::abs(r.above) + ys.diagonal());
+    if (!(r.front > margin && r.above > margin)) return false;
   }
   return true;
 }
@@ -667,70 +660,6 @@ Expected<std::vector<Light>> make_lights(const std::vector<LightDesc>& descs,
 
 std::size_t output_count(const std::vector<Light>& lights) {
   return lights.empty() ? 0 : std::size_t(lights.back().output()) + 1;
-}
-
-std::vector<LightDesc> mesh_light_parts(const LightDesc& mesh) {
-  std::vector<LightDesc> out;
-  const double total = Light(mesh).area();
-  if (!(total > 0)) return out;
-  const std::vector<Vec3>& c = mesh.corners;
-  const std::size_t triangles = c.size() / 3;
-  const auto corner = [&](std::size_t t, int k) -> const Vec3& {
-    return c[3 * t + std::size_t(k % 3)];
-  };
-  std::vector<Vec3> normal(triangles);
-  std::vector<double> area(triangles);
-  // Each triangle's edges by their ends (as they run in it), for the triangle across each.
-  std::map<std::array<double, 6>, std::pair<std::size_t, int>> edges;
-  const auto edge_key = [](const Vec3& a, const Vec3& b) {
-    return std::array<double, 6>{a.x(), a.y(), a.z(), b.x(), b.y(), b.z()};
-  };
-  for (std::size_t t = 0; t < triangles; ++t) {
-    const Vec3 cross = (corner(t, 1) - corner(t, 0)).cross(corner(t, 2) - corner(t, 0));
-    area[t] = 0.5 * cross.norm();
-    normal[t] = area[t] > 0 ? Vec3(cross.normalized()) : Vec3::Zero();
-    for (int k = 0; k < 3; ++k)
-      edges.emplace(edge_key(corner(t, k), corner(t, k + 1)), std::pair{t, k});
-  }
-  std::vector<std::uint8_t> taken(triangles, 0);
-  const auto add = [&](std::vector<Vec3> corners, double part_area) {
-    LightDesc part = mesh;
-    part.shape = LightShape::polygon;
-    part.name = mesh.name + "#" + std::to_string(out.size());
-    part.corners = std::move(corners);
-    part.power = mesh.power * part_area / total;
-    out.push_back(std::move(part));
-  };
-  for (std::size_t t = 0; t < triangles; ++t) {
-    if (taken[t] || !(area[t] > 0)) continue;  // a degenerate triangle emits nothing
-    taken[t] = 1;
-    bool paired = false;
-    for (int k = 0; k < 3 && !paired; ++k) {
-      // The triangle (p, q, r) and the one across p–q, (q, p, s): the quad p, s, q, r when the
-      // two lie in one plane, face the same way and make a convex outline.
-      const Vec3 &p = corner(t, k), &q = corner(t, k + 1), &r = corner(t, k + 2);
-      const auto across = edges.find(edge_key(q, p));
-      if (across == edges.end()) continue;
-      const auto [u, m] = across->second;
-      if (u == t || taken[u] || !(area[u] > 0) || normal[t].dot(normal[u]) < 1 - 1e-9) continue;
-      const Vec3& s_corner = corner(u, m + 2);
-      if (std::abs(normal[t].dot(s_corner - p)) > 1e-6 * (q - p).norm()) continue;
-      const std::vector<Vec3> quad = {p, s_corner, q, r};
-      bool convex = true;
-      for (int i = 0; i < 4 && convex; ++i) {
-        const Vec3& a = quad[std::size_t(i)];
-        const Vec3& b = quad[std::size_t((i + 1) % 4)];
-        const Vec3& d = quad[std::size_t((i + 2) % 4)];
-        convex = (b - a).cross(d - b).dot(normal[t]) > 0;
-      }
-      if (!convex) continue;
-      taken[u] = 1;
-      paired = true;
-      add(quad, area[t] + area[u]);
-    }
-    if (!paired) add({corner(t, 0), corner(t, 1), corner(t, 2)}, area[t]);
-  }
-  return out;
 }
 
 }  // namespace sb

@@ -139,6 +139,14 @@ class Light {
   bool partly_below_horizon(const Vec3& y, const Vec3& n) const;
 
  private:
+  // A rectangle's, disk's or polygon's reach of point y with normal n, as reaches weighs it: how
+  // far y lies in front of the light's plane (> 0: the light faces it) and how far the light's
+  // highest point lies above y's horizon (> 0: some of it is above).
+  struct Reach {
+    double front = 0, above = 0;
+  };
+  Reach flat_reach(const Vec3& y, const Vec3& n) const;
+
   LightDesc desc_;
   Vec3 right_, up_;
   int output_ = 0;

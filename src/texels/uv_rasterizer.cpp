@@ -420,11 +420,12 @@ TexelSpace rasterise_texels(const Mesh& mesh, int width, int height, RowRange ro
   space.blocks_x = (width + kBlock - 1) / kBlock;
   space.blocks.assign(std::size_t(space.blocks_x) * std::size_t((height + kBlock - 1) / kBlock),
                       TexelBlock());
-  const auto add_to_block = [&](const Texel& t, const Vec3f& lift) {
+  // Texel i, whose shadow origin is its position lifted by `lift`, into its block's summary.
+  const auto add_to_block = [&](std::size_t i, const Vec3f& lift) {
+    const Texel& t = space.texels[i];
     TexelBlock& b = space.blocks[std::size_t(t.y / kBlock) * std::size_t(space.blocks_x) +
                                  std::size_t(t.x / kBlock)];
-    const Vec3f& n = space.face_normals[std::size_t(t.face)];
-    const Vec3f geometric = n.dot(t.normal) < 0 ? Vec3f(-n) : n;
+    const Vec3f geometric = space.geometric_normal(i);
     const bool flat = lift == Vec3f::Zero();
     if (b.empty()) {
       b.lo = b.hi = t.position;
@@ -461,7 +462,7 @@ TexelSpace rasterise_texels(const Mesh& mesh, int width, int height, RowRange ro
             Vec3f lift = Vec3f::Zero();
             space.texels[out] = make_texel(surfaces[std::size_t(face)], face, x, y, bary, lift);
             if (lifted) space.lifts[out] = lift;
-            add_to_block(space.texels[out], lifted ? lift : Vec3f::Zero());
+            add_to_block(out, lift);  // make_texel's lift is 0 on a flat face
             ++out;
             space.covered[row_offset + std::size_t(x)] = 1;
           }

@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <atomic>
 #include <limits>
+#include <span>
 
 #include "methods/backprojection/penumbra_estimator.h"
 #include "occluders/blocker_solids.h"
@@ -26,6 +27,15 @@
 namespace sb {
 
 namespace {
+
+// Whether the triangle `corners` hides all of the light from every one of `points`, the first
+// likeliest to fail first (triangle_hides_light).
+bool hides_from_all(const Light& light, const Vec3* corners, std::span<const Vec3> points,
+                    double offset) {
+  for (const Vec3& p : points)
+    if (!triangle_hides_light(light, corners, p, offset)) return false;
+  return true;
+}
 
 // Stage 1: every tile's shaft, as one box of its texels' ray origins.
 // With `umbrae`, a listed tile that one of its candidates hides all of the light from is an
@@ -60,19 +70,13 @@ TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const Sha
       tiles.kind[i] = TileShafts::Kind::listed;
       std::sort(list.begin(), list.end());
       if (!umbrae) return;
-      const Bounds3& o = boxes[i];
-      for (std::uint32_t c : list) {
-        bool hides = true;
-        for (int k = 0; k < 8 && hides; ++k)
-          hides = triangle_hides_light(
-              light, culler.triangle_corners(c),
-              Vec3((k & 1 ? o.hi : o.lo).x(), (k & 2 ? o.hi : o.lo).y(), (k & 4 ? o.hi : o.lo).z()),
-              offset);
-        if (hides) {
+      std::array<Vec3, 8> corners;
+      for (int k = 0; k < 8; ++k) corners[std::size_t(k)] = boxes[i].corner(k);
+      for (std::uint32_t c : list)
+        if (hides_from_all(light, culler.triangle_corners(c), corners, offset)) {
           tiles.kind[i] = TileShafts::Kind::umbra;
           return;
         }
-      }
     }
   };
   tbb::parallel_for(tbb::blocked_range<int>(0, (tiles.tiles_y + g - 1) / g), [&](const auto& r) {
@@ -215,14 +219,13 @@ TileBlockers tile_blockers(const ShaftCuller& culler, const Light& light,
   // can take: with many faces in the tile, they go through the outline of their union instead.
   double h_top = std::numeric_limits<double>::infinity();
   for (int c = 0; c < 8; ++c) {
-    const Vec3 p((c & 1 ? origins.hi : origins.lo).x(), (c & 2 ? origins.hi : origins.lo).y(),
-                 (c & 4 ? origins.hi : origins.lo).z());
+    const Vec3 p = origins.corner(c);
     h_top = std::min(h_top, light.normal().dot(p - light.centre()) * (1 - 1e-9));
   }
   const auto within_slab = [&](const Bounds3& b) {
     if (light.shape() == LightShape::sphere) return true;  // decided per texel
     for (int c = 0; c < 8; ++c) {
-      const Vec3 p((c & 1 ? b.hi : b.lo).x(), (c & 2 ? b.hi : b.lo).y(), (c & 4 ? b.hi : b.lo).z());
+      const Vec3 p = b.corner(c);
       const double height = light.normal().dot(p - light.centre());
       if (height < offset || height > h_top) return false;
     }
@@ -261,8 +264,7 @@ TileBlockers tile_blockers(const ShaftCuller& culler, const Light& light,
     if (light.shape() != LightShape::sphere) {
       double h_lo = std::numeric_limits<double>::infinity(), h_hi = -h_lo;
       for (int c = 0; c < 8; ++c) {
-        const Vec3 p((c & 1 ? origins.hi : origins.lo).x(), (c & 2 ? origins.hi : origins.lo).y(),
-                     (c & 4 ? origins.hi : origins.lo).z());
+        const Vec3 p = origins.corner(c);
         const double h = light.normal().dot(p - light.centre());
         h_lo = std::min(h_lo, h * (1 - 1e-9)), h_hi = std::max(h_hi, h);
       }
@@ -503,17 +505,15 @@ class LightPairs final : public PairSource {
     const Texel& first = space_.texels[samples[0]];
     const std::size_t tile = tiles_.tile_of(first.x, first.y);
     if (tiles_.kind[tile] != TileShafts::Kind::listed) return false;
+    // The centre (the last sample) first.
     std::array<Vec3, 5> origins;
-    for (std::size_t k = 0; k < 5; ++k) origins[k] = space_.ray_origin(samples[k], offset_);
+    for (std::size_t k = 0; k < 5; ++k) origins[k] = space_.ray_origin(samples[4 - k], offset_);
     // The tile's candidates of what the samples saw (a triangle hiding all of the light from
-    // one of them is among them), each checked from every sample, the centre first.
+    // one of them is among them).
     for (std::uint32_t i : tiles_.candidates[tile]) {
-      if (!std::binary_search(seen.begin(), seen.end(), in_.culler->blocker_key(i))) continue;
-      const Vec3* corners = in_.culler->triangle_corners(i);
-      bool hides = true;
-      for (std::size_t k = 5; k-- > 0 && hides;)
-        hides = triangle_hides_light(light_, corners, origins[k], offset_);
-      if (hides) return true;
+      if (std::binary_search(seen.begin(), seen.end(), in_.culler->blocker_key(i)) &&
+          hides_from_all(light_, in_.culler->triangle_corners(i), origins, offset_))
+        return true;
     }
     return false;
   }

@@ -328,9 +328,7 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
     // tangent cone meets the ball at once, however low the ball's bottom).
     bool box_within = true;
     for (int k = 0; k < 8 && box_within; ++k) {
-      const Vec3 c((k & 1 ? solid.bounds.hi : solid.bounds.lo).x(),
-                   (k & 2 ? solid.bounds.hi : solid.bounds.lo).y(),
-                   (k & 4 ? solid.bounds.hi : solid.bounds.lo).z());
+      const Vec3 c = solid.bounds.corner(k);
       const double height = f.normal.dot(c - f.centre);
       box_within = height >= f.clip_height && height <= h_top;
     }

@@ -158,8 +158,7 @@ BlockerOutline prepare_outline(const ShaftCuller& culler, const Light& light,
   const Vec3& n = light.normal();
   double h_top = kInfinity;
   for (int k = 0; k < 8; ++k) {
-    const Vec3 c((k & 1 ? origins.hi : origins.lo).x(), (k & 2 ? origins.hi : origins.lo).y(),
-                 (k & 4 ? origins.hi : origins.lo).z());
+    const Vec3 c = origins.corner(k);
     h_top = std::min(h_top, n.dot(c - light.centre()) * (1 - 1e-9));
   }
   const Vec3 centre = origins.centre(), half = 0.5 * (origins.hi - origins.lo);
