@@ -468,12 +468,13 @@ ShaftCuller& ShaftCuller::operator=(ShaftCuller&&) noexcept = default;
 ShaftCuller::~ShaftCuller() = default;
 
 bool ShaftCuller::tile_candidates(const Bounds3& origins, const Light& light, std::size_t max,
-                                  std::vector<std::uint32_t>& candidates) const {
+                                  std::vector<std::uint32_t>& candidates,
+                                  const std::vector<std::uint32_t>* among) const {
   candidates.clear();
   Box apex;
   apex.lo = origins.lo;
   apex.hi = origins.hi;
-  if (!impl_->query(apex, nullptr, nullptr, light, &candidates, nullptr, max)) return false;
+  if (!impl_->query(apex, nullptr, nullptr, light, &candidates, among, max)) return false;
   if (!candidates.empty() && candidates[0] == Impl::kAll) candidates.clear();
   return true;
 }

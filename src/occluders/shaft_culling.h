@@ -51,9 +51,11 @@ class ShaftCuller {
   // some point of `origins` (the box of the tile's ray origins). False when none may: every texel
   // of the tile is clear of the light. True with `candidates` listing them, or with `candidates`
   // empty when more than `max` may, or the light reaches only part of the box: then each texel
-  // searches the whole hierarchy.
+  // searches the whole hierarchy. With `among` (the candidates of a box holding `origins`), only
+  // those are tested: a triangle in this box's shaft is in the larger box's, so it is among them.
   bool tile_candidates(const Bounds3& origins, const Light& light, std::size_t max,
-                       std::vector<std::uint32_t>& candidates) const;
+                       std::vector<std::uint32_t>& candidates,
+                       const std::vector<std::uint32_t>* among = nullptr) const;
 
   // Every blocker triangle in the shaft from the ray origin `origin` (above the surface point
   // `surface`, shading normal `normal`) to `light`, clipped to that shaft, into `out`; among

@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,27 +33,47 @@ struct Counts {
   std::int64_t lit = 0, clear = 0, wrong = 0;
 };
 
+// A corpus scene's meshes, blockers, lights and culler.
+struct Loaded {
+  std::optional<Scene> scene;
+  std::vector<Mesh> meshes;
+  std::vector<const Mesh*> blockers;
+  std::unique_ptr<RayScene> rays;
+  std::vector<Light> lights;
+  std::unique_ptr<ShaftCuller> culler;
+  explicit Loaded(const std::string& name) {
+    auto loaded = load_scene(std::string(SB_SOURCE_DIR) + "/scenes/" + name);
+    EXPECT_TRUE(loaded) << loaded.error().message;
+    scene = std::move(*loaded);
+    for (const auto& obj : scene->objects) {
+      auto m = import_mesh(obj, scene->file);
+      EXPECT_TRUE(m) << m.error().message;
+      meshes.push_back(std::move(*m));
+    }
+    for (std::size_t i = 0; i < meshes.size(); ++i)
+      if (scene->objects[i].blocker) blockers.push_back(&meshes[i]);
+    auto built = RayScene::build(blockers);
+    EXPECT_TRUE(built);
+    rays = std::make_unique<RayScene>(std::move(*built));
+    auto made = make_lights(scene->lights, scene->file);
+    EXPECT_TRUE(made);
+    lights = std::move(*made);
+    culler = std::make_unique<ShaftCuller>(blockers);
+  }
+};
+
 // Per light and receiver texel the light reaches: how many are clear, and how many of those a
 // shadow ray (of `samples` stratified ones) finds blocked.
 Counts check_scene(const std::string& name, int resolution, int samples) {
-  auto scene = load_scene(std::string(SB_SOURCE_DIR) + "/scenes/" + name);
-  EXPECT_TRUE(scene) << scene.error().message;
-  std::vector<Mesh> meshes;
-  std::vector<const Mesh*> blockers;
-  for (const auto& obj : scene->objects) {
-    auto m = import_mesh(obj, scene->file);
-    EXPECT_TRUE(m) << m.error().message;
-    meshes.push_back(std::move(*m));
-  }
-  for (std::size_t i = 0; i < meshes.size(); ++i)
-    if (scene->objects[i].blocker) blockers.push_back(&meshes[i]);
-  auto rays = RayScene::build(blockers);
-  auto lights = make_lights(scene->lights, scene->file);
-  const ShaftCuller culler(blockers);
+  const Loaded in(name);
+  const std::vector<Mesh>& meshes = in.meshes;
+  const RayScene* rays = in.rays.get();
+  const std::vector<Light>* lights = &in.lights;
+  const ShaftCuller& culler = *in.culler;
   const double offset = rays->surface_offset();
   Counts counts;
   for (std::size_t r = 0; r < meshes.size(); ++r) {
-    if (!scene->objects[r].receiver) continue;
+    if (!in.scene->objects[r].receiver) continue;
     const TexelSpace space = rasterise_texels(meshes[r], resolution, resolution);
     for (std::size_t l = 0; l < lights->size(); ++l) {
       const Light& light = (*lights)[l];
@@ -91,6 +113,73 @@ TEST_P(ShaftCulling, ClearTexelsHaveNoBlockedRay) {
   EXPECT_GT(double(c.clear) / double(c.lit), 0.3) << c.clear << " of " << c.lit;
   std::printf("%s: %lld of %lld lit (light, texel) pairs clear\n", GetParam().c_str(),
               (long long)c.clear, (long long)c.lit);
+}
+
+// A tile's candidates found among those of a box holding it (its group of tiles, as the
+// backprojection bake asks) are some of those the whole hierarchy gives (the two boxes' tests are
+// conservative each in its own way, so a triangle outside the tile's shaft may be in one list and
+// not the other), and they hold every triangle in the shaft of any texel of the tile: what the
+// bake's evaluations search among. Every tile of 8 × 8 texels in every group of 4 × 4, for every
+// light of the scene.
+TEST_P(ShaftCulling, TileCandidatesAmongALargerBoxsHoldTheirTexelsBlockers) {
+  const Loaded in(GetParam());
+  const double offset = in.rays->surface_offset();
+  std::int64_t listed = 0, texels = 0;
+  for (std::size_t r = 0; r < in.meshes.size(); ++r) {
+    if (!in.scene->objects[r].receiver) continue;
+    const TexelSpace space = rasterise_texels(in.meshes[r], 128, 128);
+    constexpr int kTile = 8, kGroup = 4;
+    const int tiles_x = 128 / kTile;
+    std::vector<Bounds3> boxes(std::size_t(tiles_x * tiles_x));
+    std::vector<std::vector<std::size_t>> texels_of(boxes.size());
+    for (std::size_t i = 0; i < space.texels.size(); ++i) {
+      const Texel& t = space.texels[i];
+      const std::size_t tile = std::size_t(t.y / kTile * tiles_x + t.x / kTile);
+      boxes[tile].extend(space.ray_origin(i, offset));
+      texels_of[tile].push_back(i);
+    }
+    for (const Light& light : in.lights)
+      for (int gy = 0; gy < tiles_x; gy += kGroup)
+        for (int gx = 0; gx < tiles_x; gx += kGroup) {
+          Bounds3 joint;
+          for (int ty = gy; ty < gy + kGroup; ++ty)
+            for (int tx = gx; tx < gx + kGroup; ++tx)
+              if (!boxes[std::size_t(ty * tiles_x + tx)].empty())
+                joint.extend(boxes[std::size_t(ty * tiles_x + tx)]);
+          std::vector<std::uint32_t> group, own, among;
+          if (joint.empty() || !in.culler->tile_candidates(joint, light, 1 << 16, group) ||
+              group.empty())
+            continue;
+          for (int ty = gy; ty < gy + kGroup; ++ty)
+            for (int tx = gx; tx < gx + kGroup; ++tx) {
+              const std::size_t tile = std::size_t(ty * tiles_x + tx);
+              if (boxes[tile].empty()) continue;
+              const bool any = in.culler->tile_candidates(boxes[tile], light, 1 << 16, own);
+              // Clear among the group's: no texel of the tile has a blocker (checked below).
+              if (!in.culler->tile_candidates(boxes[tile], light, 1 << 16, among, &group))
+                among.clear();
+              EXPECT_TRUE(any || among.empty());
+              std::sort(own.begin(), own.end());
+              std::sort(among.begin(), among.end());
+              EXPECT_TRUE(std::includes(own.begin(), own.end(), among.begin(), among.end()))
+                  << "tile " << tx << ", " << ty;
+              listed += !among.empty();
+              std::vector<ShaftPolygon> polygons;
+              for (std::size_t i : texels_of[tile]) {
+                const Texel& t = space.texels[i];
+                in.culler->shaft_polygons(space.ray_origin(i, offset), t.position.cast<double>(),
+                                          t.normal.cast<double>(), light, nullptr, 1 << 16,
+                                          polygons);
+                ++texels;
+                for (const ShaftPolygon& p : polygons)
+                  EXPECT_TRUE(std::binary_search(among.begin(), among.end(), p.triangle))
+                      << "texel " << t.x << ", " << t.y << ": triangle " << p.triangle;
+              }
+            }
+        }
+  }
+  EXPECT_GT(listed, 0) << "no tile listed candidates";
+  std::printf("%lld texels of %lld listed tiles checked\n", (long long)texels, (long long)listed);
 }
 
 INSTANTIATE_TEST_SUITE_P(Corpus, ShaftCulling,

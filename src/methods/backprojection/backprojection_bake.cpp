@@ -60,9 +60,9 @@ TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const Sha
   // ground) takes its box from the block, shifted as each ray origin is (the same box: rounding
   // is monotonic), and its texels' records are not read.
   constexpr int g = TileShafts::kGroup;
-  const auto test = [&](std::size_t i) {
+  const auto test = [&](std::size_t i, const std::vector<std::uint32_t>* among) {
     std::vector<std::uint32_t>& list = tiles.candidates[i];
-    if (!culler.tile_candidates(boxes[i], light, max, list)) {
+    if (!culler.tile_candidates(boxes[i], light, max, list, among)) {
       tiles.kind[i] = TileShafts::Kind::clear;
     } else if (list.empty()) {
       tiles.kind[i] = TileShafts::Kind::all;
@@ -107,7 +107,9 @@ TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const Sha
       if (tiles.reached[t]) boxes[tile].extend(space.ray_origin(t, offset));
     });
     // A group of g × g tiles whose joint box's shaft is clear is clear throughout (each tile's
-    // shaft lies inside it); otherwise its tiles are tested one by one.
+    // shaft lies inside it); otherwise its tiles are tested one by one, among the group's
+    // candidates where it listed them (a tile's shaft lies inside the group's, so every triangle
+    // in it is among them) rather than down the whole hierarchy again.
     thread_local std::vector<std::uint32_t> group_list;
     for (int gy = ty0; gy < ty1; gy += g)
       for (int gx = 0; gx < tiles.tiles_x; gx += g) {
@@ -130,7 +132,7 @@ TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const Sha
             if (clear)
               tiles.kind[i] = TileShafts::Kind::clear;
             else
-              test(i);
+              test(i, filled > 1 && !group_list.empty() ? &group_list : nullptr);
           }
       }
   });
