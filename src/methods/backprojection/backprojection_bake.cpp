@@ -653,9 +653,9 @@ MixedImages bake_backprojection(const TexelSpace& space, const BackprojectionInp
                       [&](const tbb::blocked_range<int>& rows) {
                         RouteCounts& c = local.local();
                         grid.for_each(rows.begin(), rows.end(), [&](std::size_t t, int x, int y) {
-                          const TexelRoute route = field.route[t];
+                          const TexelRoute route = field.route_at(x, y);
                           if (route == TexelRoute::none) return;
-                          mix.set(l, t, x, y, Vec3::Constant(double(field.visibility[t])));
+                          mix.set(l, t, x, y, Vec3::Constant(double(field.visibility_at(x, y))));
                           if (t < kept0 || t >= kept1) return;
                           ++c[route];
                           if (route == TexelRoute::traced)

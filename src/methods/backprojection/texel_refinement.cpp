@@ -92,73 +92,134 @@ TexelGrid::TexelGrid(const TexelSpace& space)
 
 LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const TileShafts& tiles,
                         const PairSource& source, const RefinementSettings& settings) {
-  const std::size_t n = space.texels.size();
+  constexpr int kTile = TileShafts::kTile;
+  const FreshVector<std::uint8_t>& reached = tiles.reached;
+  const std::size_t tile_count = tiles.kind.size();
+  using Kind = TileShafts::Kind;
+  const auto kind_at = [&](int tx, int ty) {
+    return tx < 0 || ty < 0 ? Kind::empty
+                            : tiles.kind[std::size_t(ty) * std::size_t(tiles.tiles_x) + tx];
+  };
+  const auto cells_in = [&](int tx, int ty) {
+    const Kind kind = kind_at(tx, ty);
+    return kind == Kind::listed || kind == Kind::all;
+  };
+  // The tiles the light reaches in part: a covered texel of theirs is not reached.
+  std::vector<std::uint8_t> partly(tile_count, 0);
+  tbb::parallel_for(tbb::blocked_range<int>(0, tiles.tiles_y), [&](const auto& r) {
+    grid.for_each(r.begin() * kTile, std::min(space.height, r.end() * kTile),
+                  [&](std::size_t t, int x, int y) {
+                    if (!reached[t]) partly[tiles.tile_of(x, y)] = 1;
+                  });
+  });
+  // Which tiles hold their texels' own values (LightField): the cells' tiles, the umbrae right
+  // of, below or below-right of one (their texels are its cells' corners, evaluated), and the
+  // clear and umbra tiles the light reaches in part.
   LightField field;
+  field.tiles_x = tiles.tiles_x;
+  field.slot.assign(tile_count, -1);
+  field.tile_route.assign(tile_count, TexelRoute::none);
+  std::vector<std::size_t> slotted;  // the tiles with a place, in order of it
+  for (int ty = 0; ty < tiles.tiles_y; ++ty)
+    for (int tx = 0; tx < tiles.tiles_x; ++tx) {
+      const std::size_t i = std::size_t(ty) * std::size_t(tiles.tiles_x) + tx;
+      const Kind kind = tiles.kind[i];
+      const bool corners = kind == Kind::umbra && (cells_in(tx - 1, ty) || cells_in(tx, ty - 1) ||
+                                                   cells_in(tx - 1, ty - 1));
+      if (cells_in(tx, ty) || corners || (kind != Kind::empty && partly[i])) {
+        field.slot[i] = std::int32_t(slotted.size());
+        slotted.push_back(i);
+      } else {
+        field.tile_route[i] = kind == Kind::clear   ? TexelRoute::clear
+                              : kind == Kind::umbra ? TexelRoute::umbra
+                                                    : TexelRoute::none;
+      }
+    }
+  const std::size_t n = slotted.size() * std::size_t(kTile * kTile);
   field.visibility.resize(n);
   field.route.resize(n);
-  const FreshVector<std::uint8_t>& reached = tiles.reached;
   FreshVector<std::uint8_t> state(n);
   // The evaluated texels' samples, in order of evaluation (a level's at a time), and each
   // texel's: what the cells' checks read beyond V.
   std::vector<PairSample> samples;
   FreshVector<std::int32_t> sample_of(n);
-  // Every array's first write, in one pass through the grid (the texel records are many times
-  // larger): the clear tiles' reached texels are clear (1) and valued, the umbrae's umbra (0) and
-  // valued, the rest unknown.
-  tbb::parallel_for(tbb::blocked_range<int>(0, tiles.tiles_y), [&](const auto& r) {
-    const int y1 = std::min(space.height, r.end() * TileShafts::kTile);
-    grid.for_each(r.begin() * TileShafts::kTile, y1, [&](std::size_t t, int x, int y) {
-      const TileShafts::Kind kind = tiles.kind[tiles.tile_of(x, y)];
-      const bool clear = reached[t] && kind == TileShafts::Kind::clear;
-      const bool umbra = reached[t] && kind == TileShafts::Kind::umbra;
-      field.visibility[t] = umbra ? 0.0f : 1.0f;
-      field.route[t] = clear ? TexelRoute::clear : umbra ? TexelRoute::umbra : TexelRoute::none;
-      state[t] = clear || umbra ? kValued : kUnknown;
-      sample_of[t] = -1;
-    });
+  // Every array's first write, tile by tile: the clear tiles' reached texels are clear (1) and
+  // valued, the umbrae's umbra (0) and valued, the rest unknown.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, slotted.size(), 64), [&](const auto& r) {
+    for (std::size_t s = r.begin(); s != r.end(); ++s) {
+      const std::size_t tile = slotted[s];
+      const Kind kind = tiles.kind[tile];
+      const int x0 = int(tile % std::size_t(tiles.tiles_x)) * kTile;
+      const int y0 = int(tile / std::size_t(tiles.tiles_x)) * kTile;
+      for (int j = 0; j < kTile * kTile; ++j) {
+        const std::int32_t t = grid.texel(x0 + j % kTile, y0 + j / kTile);
+        const bool lit = t >= 0 && reached[std::size_t(t)];
+        const bool clear = lit && kind == Kind::clear, umbra = lit && kind == Kind::umbra;
+        const std::size_t i = s * std::size_t(kTile * kTile) + std::size_t(j);
+        field.visibility[i] = umbra ? 0.0f : 1.0f;
+        field.route[i] = clear ? TexelRoute::clear : umbra ? TexelRoute::umbra : TexelRoute::none;
+        state[i] = clear || umbra ? kValued : kUnknown;
+        sample_of[i] = -1;
+      }
+    }
   });
+  // A texel's place in the arrays: every texel a cell's checks read has one (the cells' own, and
+  // their corners but clear ones, which are valued and hold what `none` below holds, and the
+  // uncovered or unreached ones, which no check reads past `reached`).
+  const auto place = [&](int x, int y) { return field.index(x, y); };
 
-  const auto evaluate_all = [&](const std::vector<std::size_t>& queue) {
+  struct Queued {
+    std::size_t texel, place;
+  };
+  const auto evaluate_all = [&](const std::vector<Queued>& queue) {
     const std::size_t first = samples.size();
     samples.resize(first + queue.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queue.size(), 8), [&](const auto& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i) {
-        const std::size_t t = queue[i];
+        const auto [t, at] = queue[i];
         PairSample& sample = samples[first + i];
         source.evaluate(t, sample);
-        field.visibility[t] = sample.visibility;
-        field.route[t] = sample.route;
-        sample_of[t] = std::int32_t(first + i);
-        state[t] = kValued;
+        field.visibility[at] = sample.visibility;
+        field.route[at] = sample.route;
+        sample_of[at] = std::int32_t(first + i);
+        state[at] = kValued;
       }
     });
   };
   const PairSample none;  // what a texel valued without evaluation (clear tile) holds
-  const auto sample_at = [&](std::size_t t) -> const PairSample& {
-    return sample_of[t] < 0 ? none : samples[std::size_t(sample_of[t])];
+  const auto sample_at = [&](std::int64_t at) -> const PairSample& {
+    return at < 0 || sample_of[std::size_t(at)] < 0
+               ? none
+               : samples[std::size_t(sample_of[std::size_t(at)])];
   };
+  // Whether a covered texel the light reaches is valued (one without a place is: a clear tile's).
+  const auto valued = [&](std::int64_t at) { return at < 0 || state[std::size_t(at)] == kValued; };
+  const auto visibility = [&](int x, int y) { return double(field.visibility_at(x, y)); };
 
   // The first cells: the tiles that are neither clear nor empty.
   std::vector<Cell> cells;
-  const int top = std::min(settings.max_cell, TileShafts::kTile);
+  const int top = std::min(settings.max_cell, kTile);
   for (int ty = 0; ty < tiles.tiles_y; ++ty)
     for (int tx = 0; tx < tiles.tiles_x; ++tx) {
-      const TileShafts::Kind k = tiles.kind[std::size_t(ty) * std::size_t(tiles.tiles_x) + tx];
-      if (k != TileShafts::Kind::listed && k != TileShafts::Kind::all) continue;
-      for (int y = 0; y < TileShafts::kTile; y += top)
-        for (int x = 0; x < TileShafts::kTile; x += top)
-          cells.push_back({tx * TileShafts::kTile + x, ty * TileShafts::kTile + y, top});
+      if (!cells_in(tx, ty)) continue;
+      for (int y = 0; y < kTile; y += top)
+        for (int x = 0; x < kTile; x += top) cells.push_back({tx * kTile + x, ty * kTile + y, top});
     }
 
   // Whether cell c may interpolate the texels it owns (the file's opening comment, 1–4).
   const auto passes = [&](const Cell& c) {
     const int s = c.size, h = s / 2;
-    const std::array<std::int32_t, 5> at = {
-        grid.texel(c.x0, c.y0), grid.texel(c.x0 + s, c.y0), grid.texel(c.x0, c.y0 + s),
-        grid.texel(c.x0 + s, c.y0 + s), grid.texel(c.x0 + h, c.y0 + h)};
-    for (std::int32_t t : at)
-      if (t < 0 || !reached[std::size_t(t)] || state[std::size_t(t)] != kValued) return false;
-    const auto v = [&](int k) { return double(field.visibility[std::size_t(at[std::size_t(k)])]); };
+    const std::array<int, 5> xs = {c.x0, c.x0 + s, c.x0, c.x0 + s, c.x0 + h};
+    const std::array<int, 5> ys = {c.y0, c.y0, c.y0 + s, c.y0 + s, c.y0 + h};
+    std::array<std::int32_t, 5> at;
+    std::array<std::int64_t, 5> places;
+    for (std::size_t k = 0; k < 5; ++k) {
+      at[k] = grid.texel(xs[k], ys[k]);
+      if (at[k] < 0 || !reached[std::size_t(at[k])]) return false;
+      places[k] = place(xs[k], ys[k]);
+      if (!valued(places[k])) return false;
+    }
+    const auto v = [&](int k) { return visibility(xs[std::size_t(k)], ys[std::size_t(k)]); };
     if (std::abs(v(4) - 0.25 * (v(0) + v(1) + v(2) + v(3))) > settings.tolerance) return false;
     // One smooth piece of surface.
     const auto pos = [&](int k) {
@@ -194,10 +255,10 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
     // In the umbra of one convex solid (or one polygon) at all five samples: so is every point
     // between them (a convex blocker's umbra under a convex light is convex), whatever the
     // distance.
-    const std::uint32_t umbra = sample_at(std::size_t(at[0])).umbra;
+    const std::uint32_t umbra = sample_at(places[0]).umbra;
     bool one_umbra = umbra != none.umbra;
-    for (int k = 1; k < 5; ++k)
-      one_umbra = one_umbra && sample_at(std::size_t(at[std::size_t(k)])).umbra == umbra;
+    for (std::size_t k = 1; k < 5; ++k)
+      one_umbra = one_umbra && sample_at(places[k]).umbra == umbra;
     if (one_umbra) return true;
     // Every blocker the samples saw, far enough away for penumbrae at least feature_cells wide:
     // a texel of the cell lies at most its diagonal nearer to a blocker than the sample that saw
@@ -205,11 +266,10 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
     std::vector<std::uint32_t> seen;
     double width = std::numeric_limits<double>::infinity();
     double distance = std::numeric_limits<double>::infinity();
-    for (int k = 0; k < 5; ++k) {
-      const std::size_t t = std::size_t(at[std::size_t(k)]);
-      const PairSample& sample = sample_at(t);
+    for (std::size_t k = 0; k < 5; ++k) {
+      const PairSample& sample = sample_at(places[k]);
       seen.insert(seen.end(), sample.triangles.begin(), sample.triangles.end());
-      width = std::min(width, source.angular_width(t));
+      width = std::min(width, source.angular_width(std::size_t(at[k])));
       distance = std::min(distance, double(sample.nearest));
     }
     std::sort(seen.begin(), seen.end());
@@ -219,7 +279,7 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
     // whatever the distance, as above.
     if (v(0) == 0 && v(1) == 0 && v(2) == 0 && v(3) == 0 && v(4) == 0) {
       std::array<std::size_t, 5> points;
-      for (int k = 0; k < 5; ++k) points[std::size_t(k)] = std::size_t(at[std::size_t(k)]);
+      for (std::size_t k = 0; k < 5; ++k) points[k] = std::size_t(at[k]);
       if (source.one_triangle_hides(points, seen)) return true;
     }
     if (std::isfinite(distance) &&
@@ -227,8 +287,8 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
       return false;
     // A sample traced past the estimator's budget lists nothing: the distance bound above is
     // all there is to go on.
-    for (int k = 0; k < 5; ++k)
-      if (!sample_at(std::size_t(at[std::size_t(k)])).listed) return true;
+    for (std::size_t k = 0; k < 5; ++k)
+      if (!sample_at(places[k]).listed) return true;
     thread_local std::vector<std::size_t> inside;
     inside.clear();
     for (int y = c.y0; y < c.y0 + s; ++y)
@@ -242,15 +302,14 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
   // Linear over the four triangles the centre makes with the cell's sides.
   const auto interpolate = [&](const Cell& c) {
     const int s = c.size, h = s / 2;
-    const double v00 = field.visibility[std::size_t(grid.texel(c.x0, c.y0))];
-    const double v10 = field.visibility[std::size_t(grid.texel(c.x0 + s, c.y0))];
-    const double v01 = field.visibility[std::size_t(grid.texel(c.x0, c.y0 + s))];
-    const double v11 = field.visibility[std::size_t(grid.texel(c.x0 + s, c.y0 + s))];
-    const double vc = field.visibility[std::size_t(grid.texel(c.x0 + h, c.y0 + h))];
+    const double v00 = visibility(c.x0, c.y0), v10 = visibility(c.x0 + s, c.y0);
+    const double v01 = visibility(c.x0, c.y0 + s), v11 = visibility(c.x0 + s, c.y0 + s);
+    const double vc = visibility(c.x0 + h, c.y0 + h);
     for (int y = c.y0; y < c.y0 + s; ++y)
       for (int x = c.x0; x < c.x0 + s; ++x) {
         const std::int32_t t = grid.texel(x, y);
-        if (t < 0 || !reached[std::size_t(t)] || state[std::size_t(t)] == kValued) continue;
+        const std::size_t at = std::size_t(place(x, y));  // the cell's own: its tile has one
+        if (t < 0 || !reached[std::size_t(t)] || state[at] == kValued) continue;
         const double u = double(x - c.x0) / s, w = double(y - c.y0) / s;
         // (a, b, corner_a, corner_b): the triangle's coordinates and its two corners, so that
         // V = 2b·vc + (a − b)·corner_b + (1 − a − b)·corner_a.
@@ -265,29 +324,32 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
           a = 1 - w, b = u, ca = v01, cb = v00;
         }
         const double v = 2 * b * vc + (a - b) * cb + (1 - a - b) * ca;
-        field.visibility[std::size_t(t)] = float(std::clamp(v, 0.0, 1.0));
-        field.route[std::size_t(t)] = TexelRoute::interpolated;
+        field.visibility[at] = float(std::clamp(v, 0.0, 1.0));
+        field.route[at] = TexelRoute::interpolated;
       }
   };
 
   for (int s = top; s >= 2 && !cells.empty(); s /= 2) {
     // Their samples, each evaluated once; an interpolated one is evaluated now, being a corner.
-    std::vector<std::size_t> queue;
+    std::vector<Queued> queue;
     for (const Cell& c : cells) {
       const int h = c.size / 2;
       const int xs[5] = {c.x0, c.x0 + c.size, c.x0, c.x0 + c.size, c.x0 + h};
       const int ys[5] = {c.y0, c.y0, c.y0 + c.size, c.y0 + c.size, c.y0 + h};
       for (int k = 0; k < 5; ++k) {
         const std::int32_t t = grid.texel(xs[k], ys[k]);
-        if (t < 0 || !reached[std::size_t(t)] || state[std::size_t(t)] == kQueued) continue;
+        if (t < 0 || !reached[std::size_t(t)]) continue;
+        const std::int64_t at = place(xs[k], ys[k]);
+        if (at < 0) continue;  // a clear tile's: valued, and holding what a sample would
+        const std::size_t i = std::size_t(at);
+        if (state[i] == kQueued) continue;
         // Valued already, but for what a sample must hold beside V: interpolated texels, and an
         // umbra tile's (a neighbouring cell's corners), are evaluated.
-        if (state[std::size_t(t)] == kValued &&
-            field.route[std::size_t(t)] != TexelRoute::interpolated &&
-            field.route[std::size_t(t)] != TexelRoute::umbra)
+        if (state[i] == kValued && field.route[i] != TexelRoute::interpolated &&
+            field.route[i] != TexelRoute::umbra)
           continue;
-        state[std::size_t(t)] = kQueued;
-        queue.push_back(std::size_t(t));
+        state[i] = kQueued;
+        queue.push_back({std::size_t(t), i});
       }
     }
     evaluate_all(queue);
@@ -306,7 +368,7 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
       const Cell& c = cells[i];
       if (c.size == 2) continue;  // its texels are evaluated one by one, below
       const int h = c.size / 2;
-      for (int k = 0; k < 4; ++k) next.push_back({c.x0 + (k & 1) * h, c.y0 + (k >> 1) * h, h});
+      for (int q = 0; q < 4; ++q) next.push_back({c.x0 + (q & 1) * h, c.y0 + (q >> 1) * h, h});
     }
     // Mark what the cells that passed interpolated as valued, for the next level's checks.
     for (std::size_t i = 0; i < cells.size(); ++i) {
@@ -314,19 +376,26 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
       const Cell& c = cells[i];
       for (int y = c.y0; y < c.y0 + c.size; ++y)
         for (int x = c.x0; x < c.x0 + c.size; ++x) {
-          const std::int32_t t = grid.texel(x, y);
-          if (t >= 0 && field.route[std::size_t(t)] == TexelRoute::interpolated)
-            state[std::size_t(t)] = kValued;
+          const std::size_t at = std::size_t(place(x, y));
+          if (field.route[at] == TexelRoute::interpolated) state[at] = kValued;
         }
     }
     cells = std::move(next);
   }
 
   // Every texel the light reaches that no cell valued (cells of 2 that failed; tiles of a
-  // lightmap too small for one cell): evaluated.
-  std::vector<std::size_t> rest;
-  for (std::size_t t = 0; t < n; ++t)
-    if (reached[t] && state[t] != kValued) rest.push_back(t);
+  // lightmap too small for one cell): evaluated, in the order of the tiles' places.
+  std::vector<Queued> rest;
+  for (std::size_t s = 0; s < slotted.size(); ++s) {
+    const int x0 = int(slotted[s] % std::size_t(tiles.tiles_x)) * kTile;
+    const int y0 = int(slotted[s] / std::size_t(tiles.tiles_x)) * kTile;
+    for (int j = 0; j < kTile * kTile; ++j) {
+      const std::int32_t t = grid.texel(x0 + j % kTile, y0 + j / kTile);
+      const std::size_t at = s * std::size_t(kTile * kTile) + std::size_t(j);
+      if (t >= 0 && reached[std::size_t(t)] && state[at] != kValued)
+        rest.push_back({std::size_t(t), at});
+    }
+  }
   evaluate_all(rest);
   return field;
 }

@@ -139,12 +139,11 @@ TEST(BackprojectionBake, UmbraTilesAreDarkInTheReference) {
   ASSERT_TRUE(reference) << reference.error().message;
   const Image& truth = reference->receivers[0].image;
   int umbra = 0;
-  for (std::size_t t = 0; t < space.texels.size(); ++t) {
-    if (field.route[t] != TexelRoute::umbra) continue;
+  for (const Texel& t : space.texels) {
+    if (field.route_at(t.x, t.y) != TexelRoute::umbra) continue;
     ++umbra;
-    EXPECT_EQ(field.visibility[t], 0.0f);
-    EXPECT_EQ(truth.at(space.texels[t].x, space.texels[t].y)[0], 0.0f)
-        << space.texels[t].x << ", " << space.texels[t].y;
+    EXPECT_EQ(field.visibility_at(t.x, t.y), 0.0f);
+    EXPECT_EQ(truth.at(t.x, t.y)[0], 0.0f) << t.x << ", " << t.y;
   }
   std::printf("umbra route: %d of %zu texels\n", umbra, space.texels.size());
   EXPECT_GT(umbra, int(space.texels.size() / 100));

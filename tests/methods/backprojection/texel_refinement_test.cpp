@@ -97,9 +97,11 @@ Outcome refine(const TexelSpace& space, FieldSource& source,
   Outcome o;
   o.evaluations = source.evaluations;
   for (std::size_t t = 0; t < space.texels.size(); ++t) {
-    o.max_error = std::max(
-        o.max_error, std::abs(field.visibility[t] - truth(space.texels[t].x, space.texels[t].y)));
-    o.interpolated += field.route[t] == TexelRoute::interpolated;
+    o.max_error =
+        std::max(o.max_error, std::abs(field.visibility_at(space.texels[t].x, space.texels[t].y) -
+                                       truth(space.texels[t].x, space.texels[t].y)));
+    o.interpolated +=
+        field.route_at(space.texels[t].x, space.texels[t].y) == TexelRoute::interpolated;
   }
   return o;
 }
@@ -178,7 +180,8 @@ TEST(TexelRefinement, InterpolatesInsideOneTrianglesUmbra) {
   const LightField field = refine_light(space, TexelGrid(space), listed_tiles(), one, {});
   for (std::size_t t = 0; t < space.texels.size(); ++t) {
     if (space.texels[t].x >= 32) {
-      EXPECT_NE(field.route[t], TexelRoute::interpolated) << space.texels[t].x;
+      EXPECT_NE(field.route_at(space.texels[t].x, space.texels[t].y), TexelRoute::interpolated)
+          << space.texels[t].x;
     }
   }
 }
@@ -196,9 +199,67 @@ TEST(TexelRefinement, DoesNotInterpolateAcrossAChartBorder) {
   const LightField field = refine_light(space, TexelGrid(space), listed_tiles(), again, {});
   for (std::size_t t = 0; t < space.texels.size(); ++t) {
     if (space.texels[t].x == 27) {
-      EXPECT_NE(field.route[t], TexelRoute::interpolated) << space.texels[t].y;
+      EXPECT_NE(field.route_at(space.texels[t].x, space.texels[t].y), TexelRoute::interpolated)
+          << space.texels[t].y;
     }
   }
+}
+
+}  // namespace
+}  // namespace sb
+
+namespace sb {
+namespace {
+
+// The field's storage by tile (LightField): a clear or umbra tile the light reaches all of holds
+// one value, a tile it reaches in part and the cells' tiles hold their texels' own, and an umbra
+// right of a cells' tile has its corners evaluated; every texel reads what the refinement gave it.
+TEST(TexelRefinement, TilesWithoutPlacesHoldTheirKindsValue) {
+  const TexelSpace space = flat_space();
+  using Kind = TileShafts::Kind;
+  constexpr int k = TileShafts::kTile;
+  TileShafts tiles = listed_tiles();
+  const auto at = [&](int tx, int ty) { return std::size_t(ty * tiles.tiles_x + tx); };
+  for (int ty = 0; ty < tiles.tiles_y; ++ty)
+    for (int tx = 0; tx < tiles.tiles_x; ++tx) tiles.kind[at(tx, ty)] = Kind::clear;
+  tiles.kind[at(2, 2)] = Kind::listed;  // cells, whose right, lower and lower-right tiles...
+  tiles.kind[at(3, 2)] = Kind::umbra;   // ... hold their corners
+  tiles.kind[at(6, 6)] = Kind::umbra;   // alone: one value
+  tiles.kind[at(0, 7)] = Kind::empty;
+  for (int y = 0; y < k; ++y)  // the light reaches only the left half of tile (5, 0)
+    for (int x = 5 * k + k / 2; x < 6 * k; ++x) tiles.reached[std::size_t(y * kSide + x)] = 0;
+  for (int y = 7 * k; y < 8 * k; ++y)  // nor any of the empty tile
+    for (int x = 0; x < k; ++x) tiles.reached[std::size_t(y * kSide + x)] = 0;
+  // A field with a kink inside the cells' tile, whose corners in the umbra are evaluated.
+  const auto field_at = [](int x, int) { return x < 20 ? 1.0 : 0.25; };
+  FieldSource source(space, field_at);
+  const LightField field = refine_light(space, TexelGrid(space), tiles, source, {});
+  EXPECT_LT(field.visibility.size(), space.texels.size() / 4) << "only some tiles have places";
+  int corners = 0;
+  for (const Texel& t : space.texels) {
+    const Kind kind = tiles.kind[at(t.x / k, t.y / k)];
+    const bool reached = tiles.reached[std::size_t(t.y * kSide + t.x)] != 0;
+    const TexelRoute route = field.route_at(t.x, t.y);
+    const float v = field.visibility_at(t.x, t.y);
+    if (!reached) {
+      EXPECT_EQ(route, TexelRoute::none) << t.x << ", " << t.y;
+    } else if (kind == Kind::clear) {
+      EXPECT_EQ(route, TexelRoute::clear) << t.x << ", " << t.y;
+      EXPECT_EQ(v, 1.0f);
+    } else if (kind == Kind::listed) {
+      EXPECT_TRUE(route == TexelRoute::exact || route == TexelRoute::interpolated);
+      EXPECT_NEAR(v, field_at(t.x, t.y), 1e-6) << t.x << ", " << t.y;
+    } else if (route == TexelRoute::exact) {  // a corner of the cells: their right column
+      EXPECT_EQ(t.x, 3 * k);
+      EXPECT_EQ(t.y / k, 2);
+      EXPECT_EQ(v, 0.25f);
+      ++corners;
+    } else {
+      EXPECT_EQ(route, TexelRoute::umbra) << t.x << ", " << t.y;
+      EXPECT_EQ(v, 0.0f);
+    }
+  }
+  EXPECT_GT(corners, 0) << "the umbra's texels the cells take as corners are evaluated";
 }
 
 }  // namespace
