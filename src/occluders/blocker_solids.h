@@ -25,6 +25,14 @@ struct BlockerSolid {
   std::vector<std::array<int, 3>> faces;
   std::vector<Vec3> normals;
   std::vector<std::array<int, 4>> edges;
+  // A ball inside the solid (inner_radius > 0; 0 where none was found): no triangle of it
+  // nearer to the centre than the radius, the centre inside (its winding number 1). A segment
+  // from a point outside the solid to the ball crosses the solid's surface, so wherever the ball
+  // hides a light, the solid does, and the ball is convex (one of its umbrae holds every point
+  // between its points): what proves a lumpy tree crown's umbra (blocker_solids.cpp). Every
+  // corner lies within outer_radius of the centre: a point farther away is outside the solid.
+  Vec3 inner_centre = Vec3::Zero();
+  double inner_radius = 0, outer_radius = 0;
 };
 
 struct BlockerSolids {

@@ -106,8 +106,10 @@ struct ShaftCuller::Impl {
   struct MeshInfo {
     Bounds3 bounds;
     std::size_t count = 0;
+    std::vector<std::uint32_t> balls;  // its solids with an inner ball, as keys
   };
-  std::vector<MeshInfo> meshes;  // per blocker mesh
+  std::vector<std::uint32_t> ball_key;  // per solid: kSolidKey | it, where it has a ball
+  std::vector<MeshInfo> meshes;         // per blocker mesh
 
   int build(int first, int count) {
     Node node;
@@ -452,6 +454,15 @@ ShaftCuller::ShaftCuller(const std::vector<const Mesh*>& blockers)
     for (const Vec3& v : t.v) m.bounds.extend(v);
     ++m.count;
   }
+  impl_->ball_key.resize(impl_->solids.size());
+  for (std::size_t k = 0; k < impl_->solids.size(); ++k)
+    impl_->ball_key[k] = kSolidKey | std::uint32_t(k);
+  for (const Tri& t : impl_->tris) {
+    if (t.solid < 0 || !(impl_->solids[std::size_t(t.solid)].inner_radius > 0)) continue;
+    std::vector<std::uint32_t>& balls = impl_->meshes[std::size_t(t.mesh)].balls;
+    const std::uint32_t key = kSolidKey | std::uint32_t(t.solid);
+    if (std::find(balls.begin(), balls.end(), key) == balls.end()) balls.push_back(key);
+  }
   keys_.reserve(impl_->tris.size());
   for (std::size_t i = 0; i < impl_->tris.size(); ++i) {
     const Tri& t = impl_->tris[i];
@@ -539,6 +550,14 @@ Bounds3 ShaftCuller::key_bounds(std::uint32_t key) const {
 
 const BlockerSolid& ShaftCuller::solid_of_key(std::uint32_t key) const {
   return impl_->solids[key & ~kSolidKey];
+}
+
+std::span<const std::uint32_t> ShaftCuller::solids_with_balls(std::uint32_t key) const {
+  if (key & kSolidKey) return {};
+  if (key & kMeshKey) return impl_->meshes[key & ~kMeshKey].balls;
+  const int solid = impl_->tris[key].solid;
+  if (solid < 0 || !(impl_->solids[std::size_t(solid)].inner_radius > 0)) return {};
+  return {&impl_->ball_key[std::size_t(solid)], 1};
 }
 
 std::size_t ShaftCuller::triangle_count() const { return impl_->tris.size(); }

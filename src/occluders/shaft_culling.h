@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "core/geometry.h"
@@ -99,6 +100,10 @@ class ShaftCuller {
   std::uint32_t blocker_key(std::uint32_t triangle) const { return keys_[triangle]; }
   Bounds3 key_bounds(std::uint32_t key) const;
   const BlockerSolid& solid_of_key(std::uint32_t key) const;
+  // The solids with an inner ball (BlockerSolid::inner_radius) that a key's triangles belong
+  // to, as keys (kSolidKey | index): a dense mesh's, or a single triangle's; none for a key that
+  // is a convex solid's.
+  std::span<const std::uint32_t> solids_with_balls(std::uint32_t key) const;
   const Vec3& triangle_normal(std::uint32_t triangle) const;
 
  private:

@@ -520,6 +520,27 @@ class LightPairs final : public PairSource {
     return false;
   }
 
+  bool ball_hides(const std::vector<std::size_t>& texels,
+                  const std::vector<std::uint32_t>& seen) const override {
+    Bounds3 box;
+    for (std::size_t t : texels) box.extend(space_.ray_origin(t, offset_));
+    if (box.empty()) return false;
+    std::array<Vec3, 8> corners;
+    for (int k = 0; k < 8; ++k) corners[std::size_t(k)] = box.corner(k);
+    for (std::uint32_t key : seen)
+      for (std::uint32_t solid_key : in_.culler->solids_with_balls(key)) {
+        const BlockerSolid& solid = in_.culler->solid_of_key(solid_key);
+        // Every origin outside the solid: farther from the ball's centre than all its corners.
+        const Vec3 nearest = solid.inner_centre.cwiseMax(box.lo).cwiseMin(box.hi);
+        if (!((nearest - solid.inner_centre).norm() > solid.outer_radius)) continue;
+        const auto hides = [&](const Vec3& origin) {
+          return ball_hides_light(light_, solid.inner_centre, solid.inner_radius, origin, offset_);
+        };
+        if (std::all_of(corners.begin(), corners.end(), hides)) return true;
+      }
+    return false;
+  }
+
  private:
   // Whether every one of the texels' ray origins lies on the convex solid `key` (or in it): in
   // front of none of its face planes by more than the rays' offset, four times over, or a

@@ -583,4 +583,36 @@ bool triangle_hides_light(const Light& light, const Vec3* corners, const Vec3& o
   return true;
 }
 
+bool ball_hides_light(const Light& light, const Vec3& centre, double radius, const Vec3& origin,
+                      double light_offset) {
+  if (light.shape() != LightShape::rectangle && light.shape() != LightShape::disk &&
+      light.shape() != LightShape::polygon)
+    return false;
+  const Vec3& m = light.normal();
+  const double h_origin = m.dot(origin - light.centre()), h_centre = m.dot(centre - light.centre());
+  if (!(h_centre - radius > light_offset && h_centre + radius < h_origin)) return false;
+  const Vec3 axis = centre - origin;
+  const double distance = axis.norm();
+  if (!(distance > radius)) return false;
+  // The cone touching the ball: directions within asin(radius / distance) of its axis, less a
+  // billionth against rounding.
+  const double sin_cone = radius / distance, cos_cone = std::sqrt(1 - sin_cone * sin_cone);
+  std::array<Vec3, 4> outline;
+  const int count = light.outline(outline);
+  if (count > 0) {  // a convex polygon: inside the (convex) cone where its corners are
+    for (int c = 0; c < count; ++c) {
+      const Vec3 d = outline[std::size_t(c)] - origin;
+      if (!(axis.dot(d) > distance * d.norm() * (cos_cone + 1e-9))) return false;
+    }
+    return true;
+  }
+  // A disk: its centre's direction within the cone by more than the angle its bounding sphere
+  // subtends.
+  const Vec3 d = light.centre() - origin;
+  const double to_light = d.norm();
+  if (!(to_light > light.desc().radius)) return false;
+  const double off_axis = std::acos(std::clamp(axis.dot(d) / (distance * to_light), -1.0, 1.0));
+  return off_axis + std::asin(light.desc().radius / to_light) < std::asin(sin_cone) - 1e-9;
+}
+
 }  // namespace sb

@@ -187,6 +187,14 @@ class PenumbraEstimator {
 bool triangle_hides_light(const Light& light, const Vec3* corners, const Vec3& origin,
                           double light_offset);
 
+// Whether the ball (centre, radius) hides all of a rectangle, disk or polygon `light` from
+// `origin`: the ball between the origin and the light's plane, clear of the plane by
+// `light_offset`, and every direction from the origin to the light inside the cone from the origin
+// that touches the ball (a disk by the cone that holds its bounding sphere, as good as exact for
+// a sun). Sufficient, not necessary; its umbra is convex under a convex light.
+bool ball_hides_light(const Light& light, const Vec3& centre, double radius, const Vec3& origin,
+                      double light_offset);
+
 // The angle between a light's own axes and its rows, radians: far from 0°, 45° and 90°, the
 // directions furniture and panels share most.
 constexpr double kRowAngle = 0.4;

@@ -22,8 +22,10 @@
 //      distance d from a texel casts a penumbra at least d·θ wide (θ the light's narrowest
 //      apparent width), so shadows near contact refine down to single texels; unless all five
 //      samples lie in the umbra of one convex solid or one triangle (PairSource::
-//      one_triangle_hides): a convex blocker's umbra under a convex light is convex, so every
-//      texel between them lies in it, however near.
+//      one_triangle_hides), or all five are 0 and a ball inside a closed blocker they saw hides
+//      the light from every texel's ray origin (PairSource::ball_hides): a convex blocker's
+//      umbra under a convex light is convex, so every texel between them lies in it, however
+//      near.
 // Inside a cell that passes, V is interpolated linearly over the four triangles the centre makes
 // with the cell's sides, so it is exact at all five samples and continuous across cells. Texels
 // of a cell that fails at S = 2 are each evaluated. Every decision depends on exact values and
@@ -274,10 +276,19 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
     }
     std::sort(seen.begin(), seen.end());
     seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
-    // All five in the umbra of one triangle of what they saw (a tree crown's facet over its
-    // shadow, where the samples' own umbrae are of other facets or of the crown as a whole):
-    // whatever the distance, as above.
+    thread_local std::vector<std::size_t> inside;  // the texels the cell owns that are reached
+    inside.clear();
+    for (int y = c.y0; y < c.y0 + s; ++y)
+      for (int x = c.x0; x < c.x0 + s; ++x) {
+        const std::int32_t t = grid.texel(x, y);
+        if (t >= 0 && reached[std::size_t(t)]) inside.push_back(std::size_t(t));
+      }
+    // All five 0, and every texel in the umbra of a ball inside one closed blocker they saw
+    // (a tree crown, lumpy, that no one of its facets hides the light behind), or all five in
+    // the umbra of one triangle of what they saw (a crown's facet over its shadow): whatever
+    // the distance, as above.
     if (v(0) == 0 && v(1) == 0 && v(2) == 0 && v(3) == 0 && v(4) == 0) {
+      if (source.ball_hides(inside, seen)) return true;
       std::array<std::size_t, 5> points;
       for (std::size_t k = 0; k < 5; ++k) points[k] = std::size_t(at[k]);
       if (source.one_triangle_hides(points, seen)) return true;
@@ -289,13 +300,6 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
     // all there is to go on.
     for (std::size_t k = 0; k < 5; ++k)
       if (!sample_at(places[k]).listed) return true;
-    thread_local std::vector<std::size_t> inside;
-    inside.clear();
-    for (int y = c.y0; y < c.y0 + s; ++y)
-      for (int x = c.x0; x < c.x0 + s; ++x) {
-        const std::int32_t t = grid.texel(x, y);
-        if (t >= 0 && reached[std::size_t(t)]) inside.push_back(std::size_t(t));
-      }
     return !source.sees_unlisted(inside, seen);
   };
 

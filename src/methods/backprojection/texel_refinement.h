@@ -112,6 +112,15 @@ class PairSource {
     (void)samples, (void)seen;
     return false;
   }
+  // Whether a ball inside one closed blocker of `seen` hides all of the light from every point
+  // of the box of `texels`' ray origins (a cell's, all outside the blocker): the ball's umbra is
+  // convex, and a ray into the ball from outside the blocker meets the blocker's surface. False
+  // where the source cannot tell.
+  virtual bool ball_hides(const std::vector<std::size_t>& texels,
+                          const std::vector<std::uint32_t>& seen) const {
+    (void)texels, (void)seen;
+    return false;
+  }
 };
 
 struct RefinementSettings {

@@ -212,6 +212,65 @@ TEST(PenumbraEstimator, ATriangleHidesTheLightOnlyWhereTheOracleSeesNone) {
   EXPECT_TRUE(triangle_hides_light(light, over.data(), y, 1e-4));
 }
 
+// A ball hides the light only where every segment from the origin to the light passes through
+// it: on random balls between texels and a rectangle, a disk and a sun (a disk 1000 m away, 0.53°
+// across), against segments to a dense grid of the light's points; and it finds most of those
+// whose ball covers the light with a margin.
+TEST(PenumbraEstimator, ABallHidesTheLightOnlyWhereEverySegmentMeetsIt) {
+  LightDesc sun = disk_light();
+  sun.name = "sun";
+  sun.position = Vec3(300, 100, 950);
+  sun.normal = -sun.position.normalized();
+  sun.up = sun.normal.cross(Vec3::UnitX()).normalized();
+  sun.radius = 1000 * std::tan(0.265 * std::numbers::pi / 180);
+  for (const LightDesc& desc : {rectangle_light(), disk_light(), sun}) {
+    const Light light(desc);
+    // The light's points: a grid over its rectangle, or rings over its disk.
+    std::vector<Vec3> points;
+    for (int i = 0; i <= 24; ++i)
+      for (int j = 0; j <= 24; ++j) {
+        const double a = i / 24.0 - 0.5, b = j / 24.0 - 0.5;
+        if (desc.shape == LightShape::rectangle) {
+          points.push_back(light.centre() + a * desc.width * light.right() +
+                           b * desc.height * light.up());
+        } else {
+          const double r = desc.radius * (i / 24.0), phi = 2 * std::numbers::pi * j / 24.0;
+          points.push_back(light.centre() + r * std::cos(phi) * light.right() +
+                           r * std::sin(phi) * light.up());
+        }
+      }
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<double> u(0, 1);
+    int covered = 0, said = 0;
+    for (int i = 0; i < 4000; ++i) {
+      const Vec3 origin(-1.5 + 3 * u(rng), -1.5 + 3 * u(rng), 0.2 * u(rng));
+      const Vec3 to_light = (light.centre() - origin).normalized();
+      const double along = 0.2 + 1.4 * u(rng);
+      const Vec3 centre = origin + along * to_light + 0.3 * Vec3(u(rng) - 0.5, u(rng) - 0.5, 0);
+      const double radius = 0.05 + 0.6 * u(rng);
+      // How near the ball's centre each segment passes, relative to its radius: the most.
+      double worst = 0;
+      for (const Vec3& q : points) {
+        const Vec3 d = q - origin;
+        const double t = std::clamp((centre - origin).dot(d) / d.squaredNorm(), 0.0, 1.0);
+        worst = std::max(worst, (origin + t * d - centre).norm() / radius);
+      }
+      const bool says = ball_hides_light(light, centre, radius, origin, 1e-4);
+      const bool clear_of_both =
+          centre.z() - radius > origin.z() && light.normal().dot(centre - light.centre()) > radius;
+      said += says;
+      covered += worst < 0.95 && clear_of_both;
+      if (says) {
+        EXPECT_LT(worst, 1.0) << desc.name << " case " << i;
+      }
+    }
+    std::printf("%s: %d of 4000 balls cover the light with a margin, %d found to hide it\n",
+                desc.name.c_str(), covered, said);
+    EXPECT_GT(covered, 100) << desc.name;
+    EXPECT_GT(said, covered / 2) << desc.name;
+  }
+}
+
 // The bake's 32 rows, and 64 (rows are the estimator's one approximation that matters: its error
 // falls about threefold per doubling).
 TEST(PenumbraEstimator, MatchesTheExactOracleOnRandomTriangles) {

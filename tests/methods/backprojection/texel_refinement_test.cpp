@@ -77,9 +77,16 @@ class FieldSource final : public PairSource {
       if (!triangle_umbra_where(space_.texels[t].x, space_.texels[t].y)) return false;
     return true;
   }
+  bool ball_hides(const std::vector<std::size_t>& texels,
+                  const std::vector<std::uint32_t>&) const override {
+    if (!ball_umbra_where) return false;
+    for (std::size_t t : texels)
+      if (!ball_umbra_where(space_.texels[t].x, space_.texels[t].y)) return false;
+    return true;
+  }
   mutable std::atomic<int> evaluations{0};  // evaluated in parallel
   double nearest = 10.0;                    // metres: far, for penumbrae far wider than any cell
-  std::function<bool(int, int)> unlisted_where, umbra_where, triangle_umbra_where;
+  std::function<bool(int, int)> unlisted_where, umbra_where, triangle_umbra_where, ball_umbra_where;
 
  private:
   const TexelSpace& space_;
@@ -182,6 +189,26 @@ TEST(TexelRefinement, InterpolatesInsideOneTrianglesUmbra) {
     if (space.texels[t].x >= 32) {
       EXPECT_NE(field.route_at(space.texels[t].x, space.texels[t].y), TexelRoute::interpolated)
           << space.texels[t].x;
+    }
+  }
+}
+
+// The same where a ball inside a closed blocker hides the light from the cell's texels (a lumpy
+// tree crown's umbra): only the cells all of whose texels it hides interpolate, and only where
+// their samples are all 0.
+TEST(TexelRefinement, InterpolatesInsideABallsUmbra) {
+  const TexelSpace space = flat_space();
+  const auto dark_left = [](int x, int) { return x < 48 ? 0.0 : 0.5; };
+  FieldSource ball(space, dark_left);
+  ball.nearest = 0.001;
+  ball.ball_umbra_where = [](int x, int) { return x < 32 || x >= 48; };
+  const Outcome o = refine(space, ball, dark_left);
+  EXPECT_GT(o.interpolated, kSide * kSide / 4);
+  EXPECT_EQ(o.max_error, 0);
+  const LightField field = refine_light(space, TexelGrid(space), listed_tiles(), ball, {});
+  for (const Texel& t : space.texels) {
+    if (t.x >= 32) {
+      EXPECT_NE(field.route_at(t.x, t.y), TexelRoute::interpolated) << t.x << ", " << t.y;
     }
   }
 }
