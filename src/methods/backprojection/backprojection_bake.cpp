@@ -318,8 +318,7 @@ class LightPairs final : public PairSource {
         tiles_(tiles),
         offset_(in.rays->surface_offset()),
         estimator_(light, in.light_rows, offset_),
-        prepared_(tiles.kind.size()),
-        ready_(tiles.kind.size(), 0) {
+        prepared_of_(tiles.kind.size(), -1) {
     // The listed tiles' blockers, and those of the umbrae that hold the corners of a listed (or
     // unlisted) tile's cells: right of, below or below-right of one, whose texels the refinement
     // evaluates as those cells' samples.
@@ -328,17 +327,22 @@ class LightPairs final : public PairSource {
       const TileShafts::Kind k = tiles.kind[std::size_t(ty) * std::size_t(tiles.tiles_x) + tx];
       return k == TileShafts::Kind::listed || k == TileShafts::Kind::all;
     };
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tiles.kind.size(), 8), [&](const auto& r) {
-      for (std::size_t i = r.begin(); i != r.end(); ++i) {
-        const int tx = int(i % std::size_t(tiles.tiles_x)),
-                  ty = int(i / std::size_t(tiles.tiles_x));
-        if (tiles.kind[i] == TileShafts::Kind::listed ||
-            (tiles.kind[i] == TileShafts::Kind::umbra &&
-             (searched(tx - 1, ty) || searched(tx, ty - 1) || searched(tx - 1, ty - 1)))) {
-          prepared_[i] =
-              tile_blockers(*in.culler, light, tiles.candidates[i], tiles.origins[i], offset_);
-          ready_[i] = 1;
-        }
+    std::vector<std::size_t> prepare;  // those tiles, each given its place in prepared_
+    for (std::size_t i = 0; i < tiles.kind.size(); ++i) {
+      const int tx = int(i % std::size_t(tiles.tiles_x)), ty = int(i / std::size_t(tiles.tiles_x));
+      if (tiles.kind[i] == TileShafts::Kind::listed ||
+          (tiles.kind[i] == TileShafts::Kind::umbra &&
+           (searched(tx - 1, ty) || searched(tx, ty - 1) || searched(tx - 1, ty - 1)))) {
+        prepared_of_[i] = std::int32_t(prepare.size());
+        prepare.push_back(i);
+      }
+    }
+    prepared_.resize(prepare.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, prepare.size(), 8), [&](const auto& r) {
+      for (std::size_t k = r.begin(); k != r.end(); ++k) {
+        const std::size_t i = prepare[k];
+        prepared_[k] =
+            tile_blockers(*in.culler, light, tiles.candidates[i], tiles.origins[i], offset_);
       }
     });
   }
@@ -395,9 +399,9 @@ class LightPairs final : public PairSource {
     thread_local std::vector<ShaftPolygon> polygons;
     blockers.clear();
     const std::size_t tile = tiles_.tile_of(tx.x, tx.y);
-    const TileBlockers& prepared = prepared_[tile];
     PenumbraSample sample;
-    if (ready_[tile]) {
+    if (const std::int32_t at = prepared_of_[tile]; at >= 0) {
+      const TileBlockers& prepared = prepared_[std::size_t(at)];
       sample = estimator_.visibility(
           p, n, origin, Blockers{&prepared.polygons, &prepared.solids, &prepared.outlines},
           form_factor, &out.triangles);
@@ -569,8 +573,9 @@ class LightPairs final : public PairSource {
   const TileShafts& tiles_;
   double offset_;
   PenumbraEstimator estimator_;
-  std::vector<TileBlockers> prepared_;  // per tile: a listed one's, and some umbrae's (above)
-  std::vector<std::uint8_t> ready_;     // per tile: 1 where prepared_ holds its blockers
+  // The listed tiles' blockers, and some umbrae's (above); per tile, its place among them or -1.
+  std::vector<TileBlockers> prepared_;
+  std::vector<std::int32_t> prepared_of_;
 };
 
 // A light baked by rays alone: clear tiles and texels are 1, the rest the reference's own
