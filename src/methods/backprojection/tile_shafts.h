@@ -1,0 +1,28 @@
+// Stage 1 of the `backprojection` bake (backprojection_bake.cpp), per light: every tile of
+// TileShafts::kTile² texels tested as one box of its texels' ray origins (tile_shafts.cpp).
+#pragma once
+
+#include <cstddef>
+#include <span>
+
+#include "core/geometry.h"
+#include "methods/backprojection/texel_refinement.h"
+#include "occluders/shaft_culling.h"
+#include "scene/lights.h"
+#include "texels/texel_space.h"
+
+namespace sb {
+
+// Whether the triangle `corners` hides all of the light from every one of `points`, the first
+// likeliest to fail first (triangle_hides_light).
+bool hides_from_all(const Light& light, const Vec3* corners, std::span<const Vec3> points,
+                    double offset);
+
+// Every tile's shaft test for `light` (ShaftCuller::tile_candidates, at most `max` candidates a
+// tile): clear, listed, all, or, with `umbrae`, an umbra where one of its candidates hides all of
+// the light from the eight corners of its box of ray origins (so from every one of them: a
+// triangle's umbra is convex). `offset`: the rays' surface offset.
+TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const ShaftCuller& culler,
+                       const Light& light, double offset, std::size_t max, bool umbrae);
+
+}  // namespace sb
