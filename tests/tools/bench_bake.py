@@ -4,11 +4,18 @@
 time, and shadow rays per second. Developer tool; figures go to docs/performance.md.
 
 usage: tests/tools/bench_bake.py SCENE.toml [--runs 5] [--samples N ...] [--method M]
-       [--resolution N] [--cli build/shadowbake] [--versus METHOD:SAMPLES]
+       [--resolution N] [--cli build/shadowbake] [--versus METHOD:SAMPLES] [--memory warm|cold]
 
 With --versus, each run of the bake (the first --samples) is followed by one of METHOD at
 SAMPLES, so that both see the machine in the same state, and the ratio of their medians is
 printed with each pair's own ratio: how many times faster the first is, side by side.
+
+--memory sets the state of the machine's free memory before each bake. On a virtual machine
+that hands freed memory back to its host within seconds (this one: tests/tools/fresh_memory.cpp),
+a bake's first touch of its arrays costs from nothing to most of a second a gigabyte depending on
+how long ago memory was last freed. `warm`: fresh_memory.cpp (compiled with g++) touches and frees 2 GiB right before each
+bake (memory freed a moment ago, as on a machine whose memory stays backed); `cold`: it waits
+6 s before each bake. Without it, each bake starts after the previous process wrote its files.
 """
 import argparse
 import json
@@ -19,8 +26,27 @@ import time
 from pathlib import Path
 
 
+FRESH_MEMORY = None  # the compiled tests/tools/fresh_memory.cpp, for --memory warm
+
+
+def set_memory(state):
+    """Before a bake: free memory warm (2 GiB touched on two threads on 2 MiB pages, as the
+    executable advises its own, and freed) or cold (a 6 s pause)."""
+    global FRESH_MEMORY
+    if state == "warm":
+        if FRESH_MEMORY is None:
+            FRESH_MEMORY = Path(tempfile.mkdtemp()) / "fresh_memory"
+            source = Path(__file__).with_name("fresh_memory.cpp")
+            subprocess.run(["g++", "-O2", "-pthread", str(source), "-o", str(FRESH_MEMORY)],
+                           check=True)
+        subprocess.run([str(FRESH_MEMORY), "2", "2", "0"], check=True, stdout=subprocess.DEVNULL)
+    elif state == "cold":
+        time.sleep(6)
+
+
 def bake_once(args, out, samples, method):
     """One bake into `out`; its in-process bake seconds."""
+    set_memory(args.memory)
     cmd = [args.cli, "bake", args.scene, "-o", out, "--quiet", "--no-cache", "--samples", str(samples)]
     if method:
         cmd += ["--method", method]
@@ -54,6 +80,8 @@ def main():
     ap.add_argument("--resolution", type=int, default=None)
     ap.add_argument("--cli", default="build/shadowbake")
     ap.add_argument("--versus", default=None, help="METHOD:SAMPLES run after each run, side by side")
+    ap.add_argument("--memory", choices=["warm", "cold"], default=None,
+                    help="free memory's state before each bake (see above)")
     args = ap.parse_args()
     if args.versus:
         side_by_side(args)
@@ -72,6 +100,7 @@ def main():
                     cmd += ["--method", args.method]
                 if args.resolution:
                     cmd += ["--resolution", str(args.resolution)]
+                set_memory(args.memory)
                 start = time.perf_counter()
                 subprocess.run(cmd, check=True)
                 process.append(time.perf_counter() - start)
