@@ -8,8 +8,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <memory>
-#include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -23,6 +22,7 @@
 #include "scene/lights.h"
 #include "scene/mesh.h"
 #include "scene/scene.h"
+#include "support/built_scene.h"
 #include "support/test_scenes.h"
 #include "texels/texel_space.h"
 
@@ -33,47 +33,31 @@ struct Counts {
   std::int64_t lit = 0, clear = 0, wrong = 0;
 };
 
-// A corpus scene's meshes, blockers, lights and culler.
-struct Loaded {
-  std::optional<Scene> scene;
-  std::vector<Mesh> meshes;
-  std::vector<const Mesh*> blockers;
-  std::unique_ptr<RayScene> rays;
-  std::vector<Light> lights;
-  std::unique_ptr<ShaftCuller> culler;
-  explicit Loaded(const std::string& name) {
-    auto loaded = load_scene(std::string(SB_SOURCE_DIR) + "/scenes/" + name);
-    EXPECT_TRUE(loaded) << loaded.error().message;
-    scene = std::move(*loaded);
-    for (const auto& obj : scene->objects) {
-      auto m = import_mesh(obj, scene->file);
-      EXPECT_TRUE(m) << m.error().message;
-      meshes.push_back(std::move(*m));
-    }
-    for (std::size_t i = 0; i < meshes.size(); ++i)
-      if (scene->objects[i].blocker) blockers.push_back(&meshes[i]);
-    auto built = RayScene::build(blockers);
-    EXPECT_TRUE(built);
-    rays = std::make_unique<RayScene>(std::move(*built));
-    auto made = make_lights(scene->lights, scene->file);
-    EXPECT_TRUE(made);
-    lights = std::move(*made);
-    culler = std::make_unique<ShaftCuller>(blockers);
-  }
+// A corpus scene file, loaded.
+Scene corpus_scene(const std::string& name) {
+  auto scene = load_scene(std::string(SB_SOURCE_DIR) + "/scenes/" + name);
+  if (!scene) throw std::runtime_error(scene.error().message);
+  return std::move(*scene);
+}
+
+// A corpus scene, and its parts as the bake builds them.
+struct Loaded : test_scenes::Built {
+  Scene scene;
+  explicit Loaded(Scene loaded) : Built(loaded), scene(std::move(loaded)) {}
 };
 
 // Per light and receiver texel the light reaches: how many are clear, and how many of those a
 // shadow ray (of `samples` stratified ones) finds blocked.
 Counts check_scene(const std::string& name, int resolution, int samples) {
-  const Loaded in(name);
+  const Loaded in(corpus_scene(name));
   const std::vector<Mesh>& meshes = in.meshes;
-  const RayScene* rays = in.rays.get();
+  const RayScene* rays = &*in.rays;
   const std::vector<Light>* lights = &in.lights;
   const ShaftCuller& culler = *in.culler;
   const double offset = rays->surface_offset();
   Counts counts;
   for (std::size_t r = 0; r < meshes.size(); ++r) {
-    if (!in.scene->objects[r].receiver) continue;
+    if (!in.scene.objects[r].receiver) continue;
     const TexelSpace space = rasterise_texels(meshes[r], resolution, resolution);
     for (std::size_t l = 0; l < lights->size(); ++l) {
       const Light& light = (*lights)[l];
@@ -122,11 +106,11 @@ TEST_P(ShaftCulling, ClearTexelsHaveNoBlockedRay) {
 // bake's evaluations search among. Every tile of 8 × 8 texels in every group of 4 × 4, for every
 // light of the scene.
 TEST_P(ShaftCulling, TileCandidatesAmongALargerBoxsHoldTheirTexelsBlockers) {
-  const Loaded in(GetParam());
+  const Loaded in(corpus_scene(GetParam()));
   const double offset = in.rays->surface_offset();
   std::int64_t listed = 0, texels = 0;
   for (std::size_t r = 0; r < in.meshes.size(); ++r) {
-    if (!in.scene->objects[r].receiver) continue;
+    if (!in.scene.objects[r].receiver) continue;
     const TexelSpace space = rasterise_texels(in.meshes[r], 128, 128);
     constexpr int kTile = 8, kGroup = 4;
     const int tiles_x = 128 / kTile;

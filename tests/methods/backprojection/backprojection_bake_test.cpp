@@ -6,15 +6,12 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
-#include <optional>
 #include <stdexcept>
 #include <string>
 
 #include "methods/backprojection/backprojection_bake.h"
-#include "occluders/ray_scene.h"
-#include "occluders/shaft_culling.h"
 #include "pipeline/bake.h"
-#include "pipeline/receiver_stages.h"
+#include "support/built_scene.h"
 #include "support/closed_forms.h"
 #include "support/image_errors.h"
 #include "support/test_scenes.h"
@@ -72,27 +69,11 @@ TEST(BackprojectionBake, SameBytesForAnyThreadCountAndRun) {
   }
 }
 
-// A scene's meshes, lights and what the method reads built as the bake builds them, for tests
-// that call bake_backprojection on one receiver's texel space.
-struct Prepared {
-  std::vector<Mesh> meshes;
-  std::vector<Light> lights;
-  std::vector<const Mesh*> blockers;
-  std::optional<RayScene> rays;
-  std::optional<ShaftCuller> culler;
+// A scene built as the bake builds it, with what the method reads, for tests that call
+// bake_backprojection on one receiver's texel space.
+struct Prepared : test_scenes::Built {
   BackprojectionInputs in;
-  explicit Prepared(const Scene& scene) {
-    auto loaded = load_meshes(scene, nullptr);
-    if (!loaded) throw std::runtime_error(loaded.error().message);
-    meshes = std::move(*loaded);
-    auto made = make_lights(placed_lights(scene, meshes), scene.file);
-    if (!made) throw std::runtime_error(made.error().message);
-    lights = std::move(*made);
-    blockers = blocker_meshes(scene, meshes);
-    auto built = RayScene::build(blockers);
-    if (!built) throw std::runtime_error(built.error().message);
-    rays.emplace(std::move(*built));
-    culler.emplace(blockers);
+  explicit Prepared(const Scene& scene) : Built(scene) {
     in.lights = &lights;
     in.culler = &*culler;
     in.rays = &*rays;
