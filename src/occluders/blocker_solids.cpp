@@ -18,6 +18,8 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "core/nearest_point.h"
+
 namespace sb {
 
 namespace {
@@ -45,31 +47,6 @@ int find(std::vector<int>& parent, int i) {
 
 std::uint64_t edge_key(int a, int b) {
   return (std::uint64_t(std::uint32_t(a)) << 32) | std::uint32_t(b);
-}
-
-// The point of triangle t nearest to p (Ericson, Real-Time Collision Detection §5.1.5: by the
-// Voronoi region of p among the corners, edges and face). By hand: CGAL's squared_distance does
-// it, at the compile time of its kernel in a file that needs nothing else of it.
-Vec3 nearest_on_triangle(const std::array<Vec3, 3>& t, const Vec3& p) {
-  const Vec3 &a = t[0], &b = t[1], &c = t[2];
-  const Vec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return a;
-  const Vec3 bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return b;
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + d1 / (d1 - d3) * ab;
-  const Vec3 cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return c;
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + d2 / (d2 - d6) * ac;
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0)
-    return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
-  const double denominator = 1 / (va + vb + vc);
-  return a + ab * (vb * denominator) + ac * (vc * denominator);
 }
 
 // The solid angle triangle t subtends at p, signed (positive where p lies behind its normal's
@@ -102,7 +79,8 @@ void find_inner_ball(const std::vector<std::array<Vec3, 3>>& triangles, std::siz
   for (std::size_t i : list) {
     const auto& t = triangles[first + i];
     winding += solid_angle(t, centre);
-    nearest = std::min(nearest, (nearest_on_triangle(t, centre) - centre).norm());
+    double bary[3];
+    nearest = std::min(nearest, std::sqrt(nearest_point(t[0], t[1], t[2], centre, bary)));
     for (const Vec3& v : t) farthest = std::max(farthest, (v - centre).norm());
   }
   // The winding number is an integer off the surface: 1 inside, 0 outside.

@@ -37,6 +37,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/nearest_point.h"
 #include "texels/texel_space.h"
 
 namespace sb {
@@ -102,43 +103,6 @@ bool centre_barycentrics(const FaceFootprint& fp, double x, double y, double bar
   const double inverse_sum = 1.0 / sum;
   for (int i = 0; i < 3; ++i) bary[i] *= inverse_sum;
   return true;
-}
-
-// The point of triangle (a, b, c) nearest to p, as barycentrics; returns its squared distance to p.
-// Ericson, "Real-Time Collision Detection", §5.1.5, by Voronoi regions of the vertices and edges.
-double nearest_point(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& p, double bary[3]) {
-  const Vec2 ab = b - a, ac = c - a, ap = p - a;
-  const auto result = [&](double wa, double wb, double wc) {
-    bary[0] = wa;
-    bary[1] = wb;
-    bary[2] = wc;
-    return (wa * a + wb * b + wc * c - p).squaredNorm();
-  };
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0.0 && d2 <= 0.0) return result(1, 0, 0);
-  const Vec2 bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0.0 && d4 <= d3) return result(0, 1, 0);
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
-    const double t = d1 / (d1 - d3);
-    return result(1 - t, t, 0);
-  }
-  const Vec2 cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0.0 && d5 <= d6) return result(0, 0, 1);
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
-    const double t = d2 / (d2 - d6);
-    return result(1 - t, 0, t);
-  }
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
-    const double t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-    return result(0, 1 - t, t);
-  }
-  const double denom = va + vb + vc;
-  return result(va / denom, vb / denom, vc / denom);
 }
 
 // Overlaps shorter than this (in texels, along any separating axis) count as touching, not
