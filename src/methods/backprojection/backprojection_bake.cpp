@@ -421,8 +421,12 @@ class LightPairs final : public PairSource {
     if (box.empty()) return false;
     std::array<Vec3, 8> corners;
     for (int k = 0; k < 8; ++k) corners[std::size_t(k)] = box.corner(k);
+    thread_local std::vector<std::uint32_t> tried;  // a solid's triangles each name it
+    tried.clear();
     for (std::uint32_t key : seen)
       for (std::uint32_t solid_key : in_.culler->solids_with_balls(key)) {
+        if (std::find(tried.begin(), tried.end(), solid_key) != tried.end()) continue;
+        tried.push_back(solid_key);
         const BlockerSolid& solid = in_.culler->solid_of_key(solid_key);
         // Every origin outside the solid: farther from the ball's centre than all its corners.
         const Vec3 nearest = solid.inner_centre.cwiseMax(box.lo).cwiseMin(box.hi);
