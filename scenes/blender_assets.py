@@ -371,3 +371,47 @@ def write_scene_toml(path, comment, objects, lights, resolution=512, method="ref
             out.append(f"shadowmask_range = {toml_number(light['shadowmask_range'])}")
     with open(path, "w") as f:
         f.write("\n".join(out) + "\n")
+
+
+def render_world_equirectangular(path, width, height, samples, color_depth="16", filter_width=None):
+    """The scene's world through Cycles' equirectangular camera, looking along +X with +Z up (the
+    image's middle column +X, its top row the zenith, as Cycles maps a direction), written to
+    `path` as a ZIP-compressed float EXR of `color_depth` bits ("16" or "32"). With
+    `filter_width` (pixels), Cycles' pixel filter. Rendered to a scratch file, then written again
+    from its pixels alone: Cycles puts its render times in the file's header, which would change
+    its bytes on every run. Returns the pixels (RGBA, bottom row first)."""
+    scene = bpy.context.scene
+    camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
+    scene.collection.objects.link(camera)
+    camera.data.type = "PANO"
+    if hasattr(camera.data, "panorama_type"):
+        camera.data.panorama_type = "EQUIRECTANGULAR"
+    else:
+        camera.data.cycles.panorama_type = "EQUIRECTANGULAR"
+    camera.rotation_euler = (math.radians(90.0), 0.0, math.radians(-90.0))
+    scene.camera = camera
+    scene.render.engine = "CYCLES"
+    scene.cycles.samples = samples
+    scene.cycles.device = "CPU"
+    scene.cycles.use_denoising = False
+    if filter_width is not None:
+        scene.cycles.filter_width = filter_width
+    scene.render.resolution_x, scene.render.resolution_y = width, height
+    scene.render.resolution_percentage = 100
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = color_depth
+    scene.render.image_settings.color_mode = "RGB"
+    scene.render.image_settings.exr_codec = "ZIP"
+    scene.view_settings.view_transform = "Standard"
+    scratch = path + ".render.exr"
+    scene.render.filepath = scratch
+    bpy.ops.render.render(write_still=True)
+    image = bpy.data.images.load(scratch)
+    pixels = list(image.pixels)
+    clean = bpy.data.images.new("world", width, height, float_buffer=True)
+    clean.colorspace_settings.name = "Non-Color"
+    clean.pixels[:] = pixels
+    clean.save_render(path, scene=scene)
+    os.remove(scratch)
+    bpy.data.objects.remove(camera)
+    return pixels

@@ -16,8 +16,9 @@ its own light) rendered by Cycles through an equirectangular camera at 512 x 256
 `shape = "sky"` light reads. The sun lamp is aimed from the sky's brightest pixel, so the glow
 and the shadows agree.
 
-scene.toml bakes the courtyard with the sky; scene_sun.toml bakes the ground alone at 4096²
-under the sun alone (the convolution's own case, issue "outdoor light").
+scene.toml bakes the courtyard with the sky; scene_preetham.toml with Preetham's analytic sky
+around the level's sun instead of the map; scene_sun.toml bakes the ground alone at 4096² under
+the sun alone (the convolution's own case, issue "outdoor light").
 
     blender -b --factory-startup -P scenes/outdoor/make_scene.py
 """
@@ -64,40 +65,8 @@ def render_sky(path):
     sky.sun_rotation = math.radians(SUN_ROTATION_DEG)
     world.node_tree.links.new(sky.outputs["Color"], nodes["Background"].inputs["Color"])
     nodes["Background"].inputs["Strength"].default_value = 1.0
-    camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
-    scene.collection.objects.link(camera)
-    camera.data.type = "PANO"
-    if hasattr(camera.data, "panorama_type"):
-        camera.data.panorama_type = "EQUIRECTANGULAR"
-    else:
-        camera.data.cycles.panorama_type = "EQUIRECTANGULAR"
-    # Looking along +X with +Z up: the image's middle column is +X, as Cycles maps a direction.
-    camera.rotation_euler = (math.radians(90.0), 0.0, math.radians(-90.0))
-    scene.camera = camera
-    scene.render.engine = "CYCLES"
-    scene.cycles.samples = 16
-    scene.cycles.device = "CPU"
-    scene.cycles.use_denoising = False
-    scene.render.resolution_x, scene.render.resolution_y = 512, 256
-    scene.render.resolution_percentage = 100
-    scene.render.image_settings.file_format = "OPEN_EXR"
-    scene.render.image_settings.color_depth = "16"
-    scene.render.image_settings.color_mode = "RGB"
-    scene.render.image_settings.exr_codec = "ZIP"
-    scene.view_settings.view_transform = "Standard"
-    # Rendered to a scratch file, then written again from its pixels alone: Cycles puts its
-    # render times in the file's header, which would change its bytes on every run.
-    scratch = path + ".render.exr"
-    scene.render.filepath = scratch
-    bpy.ops.render.render(write_still=True)
-    image = bpy.data.images.load(scratch)
-    w, h = image.size
-    pixels = list(image.pixels)
-    clean = bpy.data.images.new("sky", w, h, float_buffer=True)
-    clean.colorspace_settings.name = "Non-Color"
-    clean.pixels[:] = pixels
-    clean.save_render(path, scene=scene)  # half float, ZIP, as the render settings say
-    os.remove(scratch)
+    w, h = 512, 256
+    pixels = ba.render_world_equirectangular(path, w, h, samples=16)
     best, best_i = -1.0, 0
     for i in range(w * h):
         lum = 0.2126 * pixels[4 * i] + 0.7152 * pixels[4 * i + 1] + 0.0722 * pixels[4 * i + 2]
@@ -106,7 +75,6 @@ def render_sky(path):
     x, y_up = best_i % w, best_i // w  # Blender's pixels start at the bottom row
     u, v = (x + 0.5) / w, (y_up + 0.5) / h
     phi, elevation = (0.5 - u) * 2 * math.pi, (v - 0.5) * math.pi
-    bpy.data.objects.remove(camera)
     scene.world = None
     return (math.cos(phi) * math.cos(elevation), math.sin(phi) * math.cos(elevation),
             math.sin(elevation))

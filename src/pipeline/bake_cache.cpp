@@ -184,6 +184,7 @@ Expected<std::vector<ReceiverKey>> receiver_keys(const KeyInputs& in,
     h.number(double(d.corners.size()));
     for (const Vec3& c : d.corners) h.vec(c);
     h.number(d.sky_strength), h.number(d.sky_rotation_deg), h.number(double(d.sky_parts));
+    h.number(d.sky_turbidity), h.vec(d.sky_sun_direction);
     h.text(d.texture.string());
     if (!d.texture.empty()) {
       auto found = textures.find(d.texture);

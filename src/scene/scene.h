@@ -171,6 +171,13 @@ struct LightDesc {
   double sky_strength = 1;
   double sky_rotation_deg = 0;
   int sky_parts = kSkyParts;
+  // An analytic sky in place of a map where sky_turbidity > 0: Preetham's clear sky of that
+  // turbidity (scene/sky_models.h) around a sun whose light travels along sky_sun_direction
+  // (unit, world), the direction of the sun light named sky_sun where it names one (set when the
+  // scene is loaded).
+  double sky_turbidity = 0;
+  std::string sky_sun;
+  Vec3 sky_sun_direction = Vec3::Zero();
   int line = 0;
 };
 

@@ -256,6 +256,7 @@ Expected<Scene> load_scene(const std::filesystem::path& file, bool need_lights) 
     scene.warnings.insert(scene.warnings.end(), level->warnings.begin(), level->warnings.end());
   }
 
+  if (Status s = resolve_sky_suns(file, scene.lights); !s) return s.error();
   if (scene.objects.empty()) {
     return located_error(file, 0, "scene", "no [[object]] table; a scene needs at least one");
   }

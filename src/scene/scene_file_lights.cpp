@@ -5,6 +5,7 @@
 
 #include <numbers>
 
+#include "scene/sky_models.h"
 #include "scene/sun_light.h"
 
 namespace sb {
@@ -46,8 +47,9 @@ void read_cone(TableReader& r, LightDesc& light) {
 // A sun: `direction` (where its light goes), `angle_deg` and `irradiance` on a surface facing
 // it, made a distant disk by sun_light (sun_light.h), placed for the scene by the bake.
 Expected<LightDesc> read_sun(TableReader& r, LightDesc light) {
-  for (const char* key : {"position", "normal", "up", "size", "radius", "power", "texture",
-                          "cone_deg", "blend", "strength", "map", "rotation_deg", "parts"})
+  for (const char* key :
+       {"position", "normal", "up", "size", "radius", "power", "texture", "cone_deg", "blend",
+        "strength", "map", "rotation_deg", "parts", "model", "turbidity", "sun", "sun_direction"})
     r.forbid(key,
              "does not apply to a sun, which is given by 'direction', 'angle_deg' and "
              "'irradiance'");
@@ -87,6 +89,38 @@ Expected<LightDesc> read_sun(TableReader& r, LightDesc light) {
   return sun;
 }
 
+// A sky's `model`: "uniform" (or its `map`), or "preetham", Preetham's clear sky
+// (scene/sky_models.h) of `turbidity` around the sun light named `sun`, or around a sun whose
+// light travels along `sun_direction`; with neither, the scene's one sun light
+// (resolve_sky_suns, scene_file_tables.h).
+void read_sky_model(TableReader& r, LightDesc& light) {
+  const std::optional<std::string> model = r.string("model");
+  if (model && *model != "uniform" && *model != "preetham")
+    r.fail_got("model", "\"uniform\" or \"preetham\"");
+  if (!model || *model != "preetham") {
+    for (const char* key : {"turbidity", "sun", "sun_direction"})
+      r.forbid(key, "applies only to a sky of model = \"preetham\"");
+    return;
+  }
+  r.forbid("map", "is a sky of its own; model = \"preetham\" is another (leave one out)");
+  r.forbid("rotation_deg", "turns a map; a Preetham sky turns with its sun");
+  light.sky_turbidity = kDefaultTurbidity;
+  if (auto v = r.number("turbidity",
+                        fmt::format("a number in [{:g}, {:g}]", kMinTurbidity, kMaxTurbidity),
+                        [](double x) { return x >= kMinTurbidity && x <= kMaxTurbidity; }))
+    light.sky_turbidity = *v;
+  if (r.find("sun") && r.find("sun_direction"))
+    r.fail("sun_direction", "'sun' and 'sun_direction' both place the sky's sun; give one");
+  if (auto name = r.string("sun")) {
+    if (name->empty()) r.fail_got("sun", "the name of a sun light");
+    light.sky_sun = *name;
+  }
+  if (auto v = r.vec3("sun_direction", "3 finite numbers, not all zero", is_finite)) {
+    if (v->isZero(0)) r.fail_got("sun_direction", "3 finite numbers, not all zero");
+    light.sky_sun_direction = v->normalized();
+  }
+}
+
 // A sky: `color` and `strength` (its radiance, W/m²/sr, as Blender's Background), an optional
 // equirectangular `map` and its `rotation_deg` about the zenith `up` (+Z; a glTF level's is
 // +Y), and the `parts` it is baked as
@@ -95,8 +129,8 @@ Expected<LightDesc> read_sky(TableReader& r, const std::filesystem::path& file, 
   for (const char* key : {"position", "normal", "size", "radius", "power", "texture", "direction",
                           "angle_deg", "irradiance", "cone_deg", "blend"})
     r.forbid(key,
-             "does not apply to a sky, which is given by 'color', 'strength', 'map', "
-             "'rotation_deg', 'up' and 'parts'");
+             "does not apply to a sky, which is given by 'color', 'strength', 'map' or "
+             "'model', 'rotation_deg', 'up' and 'parts'");
   light.shape = LightShape::sky;
   light.up = Vec3::UnitZ();  // a scene file's zenith; a glTF level's is +Y
   if (auto v = r.vec3("up", "3 finite numbers, not all zero", is_finite)) {
@@ -118,6 +152,7 @@ Expected<LightDesc> read_sky(TableReader& r, const std::filesystem::path& file, 
   if (auto v = r.number("rotation_deg", "a finite number of degrees", is_finite))
     light.sky_rotation_deg = *v;
   if (auto v = r.integer("parts", 20, 4096)) light.sky_parts = static_cast<int>(*v);
+  read_sky_model(r, light);
   if (auto v = r.number("shadowmask_range", "a number > 0 (metres)", is_positive))
     light.shadowmask_range = *v;
   if (r.failed()) return r.error();
@@ -125,6 +160,41 @@ Expected<LightDesc> read_sky(TableReader& r, const std::filesystem::path& file, 
 }
 
 }  // namespace
+
+Status resolve_sky_suns(const std::filesystem::path& file, std::vector<LightDesc>& lights) {
+  const auto is_sun = [](const LightDesc& l) { return l.sun_angle_deg > 0; };
+  for (LightDesc& sky : lights) {
+    if (sky.shape != LightShape::sky || !(sky.sky_turbidity > 0)) continue;
+    const auto fail = [&](const std::string& problem) {
+      return located_error(file, std::uint32_t(std::max(sky.line, 0)), item_name("light", sky.name),
+                           problem);
+    };
+    if (!sky.sky_sun.empty()) {
+      const auto named = std::find_if(lights.begin(), lights.end(),
+                                      [&](const LightDesc& l) { return l.name == sky.sky_sun; });
+      if (named == lights.end())
+        return fail(
+            fmt::format("'sun' names '{}', and the scene has no light of that name", sky.sky_sun));
+      if (!is_sun(*named))
+        return fail(fmt::format("'sun' names '{}', a {} light, not a sun", sky.sky_sun,
+                                to_string(named->shape)));
+      sky.sky_sun_direction = named->normal;
+    } else if (sky.sky_sun_direction.isZero(0)) {
+      const auto suns = std::count_if(lights.begin(), lights.end(), is_sun);
+      if (suns != 1)
+        return fail(fmt::format(
+            "a Preetham sky needs its sun: 'sun' (the name of a sun light) or 'sun_direction', "
+            "as the scene has {} sun lights",
+            suns));
+      sky.sky_sun_direction = std::find_if(lights.begin(), lights.end(), is_sun)->normal;
+    }
+    if (-sky.sky_sun_direction.dot(sky.up) < 0)
+      return fail(
+          "its sun is below the horizon (its light travels upwards along 'up'); the Preetham "
+          "sky is a daylight sky");
+  }
+  return Ok{};
+}
 
 Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::table& table,
                                std::size_t index) {
@@ -141,11 +211,30 @@ Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::ta
       }
     }
   }
-  r.check_known_keys({"name",      "shape",      "position",         "normal",
-                      "up",        "size",       "radius",           "color",
-                      "power",     "texture",    "shadowmask_range", "direction",
-                      "angle_deg", "irradiance", "cone_deg",         "blend",
-                      "strength",  "map",        "rotation_deg",     "parts"});
+  r.check_known_keys({"name",
+                      "shape",
+                      "position",
+                      "normal",
+                      "up",
+                      "size",
+                      "radius",
+                      "color",
+                      "power",
+                      "texture",
+                      "shadowmask_range",
+                      "direction",
+                      "angle_deg",
+                      "irradiance",
+                      "cone_deg",
+                      "blend",
+                      "strength",
+                      "map",
+                      "rotation_deg",
+                      "parts",
+                      "model",
+                      "turbidity",
+                      "sun",
+                      "sun_direction"});
   bool spot = false;
   if (r.require("shape")) {
     if (auto shape = r.string("shape")) {
@@ -171,7 +260,8 @@ Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::ta
   const std::string shape_name = spot ? "spot" : to_string(light.shape);
   for (const char* key : {"angle_deg", "irradiance"})
     r.forbid(key, fmt::format("applies only to sun lights, not {}", shape_name));
-  for (const char* key : {"strength", "map", "rotation_deg", "parts"})
+  for (const char* key :
+       {"strength", "map", "rotation_deg", "parts", "model", "turbidity", "sun", "sun_direction"})
     r.forbid(key, fmt::format("applies only to sky lights, not {}", shape_name));
   if (spot) {
     read_cone(r, light);

@@ -32,6 +32,12 @@ Expected<ObjectDesc> read_object(const std::filesystem::path& file, const toml::
 Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::table& table,
                                std::size_t index);
 
+// Each Preetham sky's sun (LightDesc::sky_sun_direction): the sun light it names, else the
+// direction it gives, else the scene's one sun light; an error (at the sky's line) where it names
+// no sun light, where it names none and the scene has not exactly one, or where its sun lies
+// below its horizon. After the imports, whose lights a sky may name.
+Status resolve_sky_suns(const std::filesystem::path& file, std::vector<LightDesc>& lights);
+
 // The [[import]] table at `index` (from 0): its level file's objects and lights, placed and
 // overridden as the table says.
 struct LevelContents;

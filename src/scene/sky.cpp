@@ -7,6 +7,7 @@
 #include <queue>
 
 #include "core/image_io.h"
+#include "scene/sky_models.h"
 #include "scene/sun_light.h"
 
 namespace sb {
@@ -14,6 +15,10 @@ namespace sb {
 namespace {
 
 constexpr double pi = std::numbers::pi;
+
+// The map an analytic sky is baked through: 0.7° pixels, where its radiance (the sun's glow
+// falls by e over some 25°) varies by well under a percent from one to the next.
+constexpr int kAnalyticMapWidth = 512;
 
 double luminance(const Vec3& c) { return 0.2126 * c.x() + 0.7152 * c.y() + 0.0722 * c.z(); }
 
@@ -115,10 +120,14 @@ void Sky::pixel_of(const Vec3& d, int* x, int* y) const {
   *y = std::clamp(int(std::floor((1 - v) * map_->height)), 0, map_->height - 1);
 }
 
-Vec3 Sky::direction_at(double u, double v) const {
+Vec3 equirectangular_direction(double u, double v) {
   const double phi = (0.5 - u) * 2 * pi, elevation = (v - 0.5) * pi;
-  const Vec3 r(std::cos(phi) * std::cos(elevation), std::sin(phi) * std::cos(elevation),
-               std::sin(elevation));
+  return {std::cos(phi) * std::cos(elevation), std::sin(phi) * std::cos(elevation),
+          std::sin(elevation)};
+}
+
+Vec3 Sky::direction_at(double u, double v) const {
+  const Vec3 r = equirectangular_direction(u, v);
   const double c = std::cos(rotation_), s = std::sin(rotation_);
   const Vec3 m(c * r.x() + s * r.y(), -s * r.x() + c * r.y(), r.z());  // turned back
   return frame_.transpose() * m;                                       // in the scene's axes
@@ -275,6 +284,12 @@ Expected<std::shared_ptr<const Sky>> make_sky(const LightDesc& desc,
                                               const std::filesystem::path& scene_file) {
   const Vec3 radiance = desc.color * desc.sky_strength;
   const double rotation = desc.sky_rotation_deg * pi / 180;
+  if (desc.sky_turbidity > 0) {  // an analytic sky, as a map in its own axes
+    const Vec3 sun = sky_frame(desc.up) * -desc.sky_sun_direction;
+    auto map = std::make_shared<const Image>(
+        preetham_map(sun, desc.sky_turbidity, kAnalyticMapWidth, kAnalyticMapWidth / 2));
+    return std::make_shared<const Sky>(radiance, std::move(map), rotation, desc.up);
+  }
   if (desc.texture.empty())
     return std::make_shared<const Sky>(radiance, nullptr, rotation, desc.up);
   const std::string where =

@@ -64,6 +64,11 @@ class Sky {
   std::vector<double> row_cdf_, column_cdf_, pixel_probability_;
 };
 
+// The direction (unit, in a map's own axes: Z its zenith) at image coordinates (u, v) ∈ [0, 1]²
+// of an equirectangular map, v = 1 its top row: Cycles' equirectangular mapping, the middle
+// column +X, u growing towards −Y.
+Vec3 equirectangular_direction(double u, double v);
+
 // The sky of a sky light (LightDesc::shape sky): its map read through OpenImageIO when it names
 // one (the scene file's folder resolved by the reader). Errors name scene_file, the light and the
 // image.

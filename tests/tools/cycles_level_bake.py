@@ -3,7 +3,7 @@ cross-check of `shadowbake bake LEVEL.glb --per-light` (docs/methods.md, "Levels
 
     blender -b --factory-startup -P tests/tools/cycles_level_bake.py -- LEVEL.glb --out DIR \
         [--res 256] [--samples 256] [--receivers floor,table] [--lights bulb,ceiling_panel]
-        [--sky MAP.exr --sky-strength S]
+        [--sky MAP.exr | --sky-preetham TURBIDITY [--sky-sun sun]] [--sky-strength S]
 
 The file is imported by Blender's own glTF importer, which is not shadowbake's reader: its lamps
 (KHR_lights_punctual) stay lamps, made points (shadow_soft_size 0, as shadowbake reads them) and
@@ -27,6 +27,7 @@ import sys
 import time
 
 import bpy
+import mathutils
 import numpy
 
 # Blender 3.4's glTF importer uses numpy.bool, which Debian 12's numpy 1.24 no longer has.
@@ -42,6 +43,11 @@ ap.add_argument("--receivers")
 ap.add_argument("--lights")
 ap.add_argument("--sky", help="an equirectangular map: the world's Environment Texture, baked as "
                 "the light 'sky' (a scene file's shape = \"sky\" light)")
+ap.add_argument("--sky-preetham", type=float, metavar="TURBIDITY",
+                help="Blender's own Preetham Sky Texture of this turbidity, its sun towards the "
+                "level's lamp --sky-sun, baked as the light 'sky' (shadowbake's model = "
+                "\"preetham\" with sun = that lamp)")
+ap.add_argument("--sky-sun", default="sun")
 ap.add_argument("--sky-strength", type=float, default=1.0)
 args = ap.parse_args(sys.argv[sys.argv.index("--") + 1:])
 
@@ -110,15 +116,24 @@ for emitter in emitters.values():
     emitter.visible_shadow = False
     front_only(emitter)
 all_lights = dict(lamps, **emitters)
-# A sky: the world's Environment Texture, as Cycles maps it (the mapping shadowbake follows).
+# A sky: the world's Environment Texture, as Cycles maps it (the mapping shadowbake follows), or
+# Blender's Preetham sky around the level's sun lamp (a lamp shines along its local -Z).
 sky_world = None
-if args.sky:
+if args.sky or args.sky_preetham:
     sky_world = bpy.data.worlds.new("sky")
     sky_world.use_nodes = True
     nodes = sky_world.node_tree.nodes
-    environment = nodes.new("ShaderNodeTexEnvironment")
-    environment.image = bpy.data.images.load(os.path.abspath(args.sky))
-    environment.image.colorspace_settings.name = "Linear"
+    if args.sky:
+        environment = nodes.new("ShaderNodeTexEnvironment")
+        environment.image = bpy.data.images.load(os.path.abspath(args.sky))
+        environment.image.colorspace_settings.name = "Linear"
+    else:
+        environment = nodes.new("ShaderNodeTexSky")
+        environment.sky_type = "PREETHAM"
+        environment.turbidity = args.sky_preetham
+        lamp = lamps[args.sky_sun]
+        towards = lamp.matrix_world.to_3x3() @ mathutils.Vector((0.0, 0.0, 1.0))
+        environment.sun_direction = towards.normalized()
     sky_world.node_tree.links.new(environment.outputs["Color"], nodes["Background"].inputs["Color"])
     nodes["Background"].inputs["Strength"].default_value = args.sky_strength
     all_lights["sky"] = sky_world
