@@ -1,5 +1,6 @@
-// A sky: light from every direction at infinity, uniform or an equirectangular environment map
-// (an HDR/EXR image, as Blender's Environment Texture maps it). Two routes bake it:
+// A sky: light from every direction at infinity, uniform, an equirectangular environment map
+// (an HDR/EXR image, as Blender's Environment Texture maps it) or an analytic clear sky
+// (sky_models.h), made a map of its own. Two routes bake it:
 //  - its parts (sky_parts): the sphere of directions cut into spherical triangles of roughly
 //    equal flux, as the seed document's "one directional light per patch of roughly equal
 //    brightness", each made a planar polygon light far away with its patch's mean radiance.
