@@ -350,7 +350,10 @@ void read_receiver(const json& entry, const std::string& where, const std::strin
   }
   if (const json* reuse = entry.contains("bake") ? fields.object("bake") : nullptr) {
     FieldReader reuse_fields(*reuse, where, fields.path_of("bake."), status);
-    ManifestReceiver::Reuse& b = r.bake.emplace();
+    // Assigned, not emplace()d: clang 14 (the fuzzing build's) does not count a nested struct
+    // with member initialisers as default-constructible inside its enclosing class.
+    r.bake = ManifestReceiver::Reuse{false, {}};
+    ManifestReceiver::Reuse& b = *r.bake;
     reuse_fields.read("reused", b.reused);
     reuse_fields.read("why", b.why);
   }

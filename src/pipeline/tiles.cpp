@@ -188,13 +188,14 @@ Expected<std::vector<ReceiverBake>> join_tiles(const Scene& scene,
       std::copy(t.covered.begin(), t.covered.end(),
                 covered.begin() + std::ptrdiff_t(std::size_t(t.tile->begin) * std::size_t(side)));
       // The method's counts and rays add up; its warnings once each.
-      for (const auto& [name, count] : t.report.tallies) {
+      // (A pair, not a structured binding: clang 14, the fuzzing build's, cannot capture one.)
+      for (const auto& added : t.report.tallies) {
         auto at = std::find_if(out.report.tallies.begin(), out.report.tallies.end(),
-                               [&](const auto& tally) { return tally.first == name; });
+                               [&](const auto& tally) { return tally.first == added.first; });
         if (at == out.report.tallies.end())
-          out.report.tallies.emplace_back(name, count);
+          out.report.tallies.push_back(added);
         else
-          at->second += count;
+          at->second += added.second;
       }
       for (const std::string& w : t.report.warnings)
         if (std::find(out.report.warnings.begin(), out.report.warnings.end(), w) ==

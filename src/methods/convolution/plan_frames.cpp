@@ -7,7 +7,6 @@
 #include <map>
 #include <numbers>
 #include <optional>
-#include <ranges>
 
 #include "methods/convolution/convolution_plan.h"
 #include "occluders/clusters.h"
@@ -154,6 +153,56 @@ std::vector<FaceRef> group_faces(const ConvolutionPlan& plan, const PlanInputs& 
 
 }  // namespace
 
+// The positions of the texels of groups `rest`, one group after another, as a range read in
+// place (a receiver's texels can be millions). Written out rather than std::views::join, which
+// clang 14, the fuzzing build's compiler, cannot compile against libstdc++ 12.
+class GroupPositions {
+ public:
+  GroupPositions(const TexelSpace& space, const std::vector<TexelGroup>& groups,
+                 const std::vector<int>& rest)
+      : space_(space), groups_(groups), rest_(rest) {}
+
+  class Iterator {
+   public:
+    Iterator(const GroupPositions& of, std::size_t group, std::size_t texel)
+        : of_(&of), group_(group), texel_(texel) {
+      skip_empty();
+    }
+    Vec3 operator*() const {
+      const std::size_t t = of_->texels(group_)[texel_];
+      return of_->space_.texels[t].position.cast<double>();
+    }
+    Iterator& operator++() {
+      ++texel_;
+      skip_empty();
+      return *this;
+    }
+    bool operator!=(const Iterator& other) const {
+      return group_ != other.group_ || texel_ != other.texel_;
+    }
+
+   private:
+    // Onto the next texel there is, from the current place: past the ends of groups.
+    void skip_empty() {
+      while (group_ < of_->rest_.size() && texel_ == of_->texels(group_).size())
+        ++group_, texel_ = 0;
+    }
+    const GroupPositions* of_;
+    std::size_t group_, texel_;
+  };
+
+  Iterator begin() const { return Iterator(*this, 0, 0); }
+  Iterator end() const { return Iterator(*this, rest_.size(), 0); }
+
+ private:
+  const std::vector<std::size_t>& texels(std::size_t r) const {
+    return groups_[std::size_t(rest_[r])].texels;
+  }
+  const TexelSpace& space_;
+  const std::vector<TexelGroup>& groups_;
+  const std::vector<int>& rest_;
+};
+
 // Frames, groups and root triples for one light part, appended to `plan`. A planar group (a
 // floor, one face plane of a bracket) is seen along its plane's normal: every texel then lies at
 // the same depth, the receiver plane of docs/design.md §2 is the group's own plane, and blockers
@@ -196,11 +245,7 @@ void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part) {
     }
   }
   if (!rest.empty()) {
-    auto rest_positions = rest |
-                          std::views::transform([&](int g) -> const std::vector<std::size_t>& {
-                            return groups[std::size_t(g)].texels;
-                          }) |
-                          std::views::join | std::views::transform(position);
+    const GroupPositions rest_positions(space, groups, rest);
     // Each leaf sizes its own pixels, so the tangent plane's stretch towards the widest angle
     // costs image size, not accuracy.
     if (const std::optional<ProjectionFrame> central =
