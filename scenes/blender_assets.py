@@ -373,6 +373,21 @@ def write_scene_toml(path, comment, objects, lights, resolution=512, method="ref
         f.write("\n".join(out) + "\n")
 
 
+def sky_world(sky_type):
+    """A new world of the current scene whose Background (Strength 1) is a Sky Texture of
+    `sky_type` ("NISHITA", "PREETHAM", ...). Returns the Sky Texture node, to be set."""
+    scene = bpy.context.scene
+    world = bpy.data.worlds.new("sky")
+    scene.world = world
+    world.use_nodes = True
+    nodes = world.node_tree.nodes
+    sky = nodes.new("ShaderNodeTexSky")
+    sky.sky_type = sky_type
+    world.node_tree.links.new(sky.outputs["Color"], nodes["Background"].inputs["Color"])
+    nodes["Background"].inputs["Strength"].default_value = 1.0
+    return sky
+
+
 def render_world_equirectangular(path, width, height, samples, color_depth="16", filter_width=None):
     """The scene's world through Cycles' equirectangular camera, looking along +X with +Z up (the
     image's middle column +X, its top row the zenith, as Cycles maps a direction), written to

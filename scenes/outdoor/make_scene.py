@@ -54,17 +54,10 @@ def render_sky(path):
     Returns the direction (Z up) of its brightest pixel, by Cycles' equirectangular mapping."""
     ba.reset()
     scene = bpy.context.scene
-    world = bpy.data.worlds.new("sky")
-    scene.world = world
-    world.use_nodes = True
-    nodes = world.node_tree.nodes
-    sky = nodes.new("ShaderNodeTexSky")
-    sky.sky_type = "NISHITA"
+    sky = ba.sky_world("NISHITA")
     sky.sun_disc = False
     sky.sun_elevation = math.radians(SUN_ELEVATION_DEG)
     sky.sun_rotation = math.radians(SUN_ROTATION_DEG)
-    world.node_tree.links.new(sky.outputs["Color"], nodes["Background"].inputs["Color"])
-    nodes["Background"].inputs["Strength"].default_value = 1.0
     w, h = 512, 256
     pixels = ba.render_world_equirectangular(path, w, h, samples=16)
     best, best_i = -1.0, 0

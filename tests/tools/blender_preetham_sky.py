@@ -19,7 +19,6 @@ import sys
 HERE = os.path.dirname(os.path.abspath(sys.argv[sys.argv.index("-P") + 1]))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scenes"))
 import blender_assets as ba  # noqa: E402
-import bpy  # noqa: E402
 
 SUN_ELEVATION_DEG = 38.0
 SUN_AZIMUTH_DEG = 215.0  # from +X towards +Y
@@ -33,18 +32,10 @@ sun = (math.cos(azimuth) * math.cos(elevation), math.sin(azimuth) * math.cos(ele
        math.sin(elevation))
 
 for turbidity in TURBIDITIES:
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    scene = bpy.context.scene
-    world = bpy.data.worlds.new("sky")
-    scene.world = world
-    world.use_nodes = True
-    nodes = world.node_tree.nodes
-    sky = nodes.new("ShaderNodeTexSky")
-    sky.sky_type = "PREETHAM"
+    ba.reset()
+    sky = ba.sky_world("PREETHAM")
     sky.turbidity = turbidity
     sky.sun_direction = sun
-    world.node_tree.links.new(sky.outputs["Color"], nodes["Background"].inputs["Color"])
-    nodes["Background"].inputs["Strength"].default_value = 1.0
     path = os.path.join(out, f"preetham_t{turbidity:g}.exr")
     ba.render_world_equirectangular(path, WIDTH, HEIGHT, samples=4, color_depth="32",
                                     filter_width=0.01)
