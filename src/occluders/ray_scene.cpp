@@ -24,6 +24,7 @@ struct RayScene::Impl {
   RTCScene scene = nullptr;
   Bounds3 bounds;
   double offset = 1e-4;
+  std::vector<std::int64_t> first_face;  // per Embree geometry: its mesh's first face's index
 
   ~Impl() {
     if (scene) rtcReleaseScene(scene);
@@ -47,9 +48,12 @@ Expected<RayScene> RayScene::build(const std::vector<const Mesh*>& blockers) {
   rtcSetSceneBuildQuality(impl->scene, RTC_BUILD_QUALITY_HIGH);
   rtcSetSceneFlags(impl->scene, RTC_SCENE_FLAG_ROBUST);
 
+  std::int64_t faces = 0;
   for (const Mesh* m : blockers) {
     const TriMesh& mesh = m->mesh;
+    faces += std::int64_t(mesh.n_faces());
     if (mesh.n_faces() == 0) continue;
+    impl->first_face.push_back(faces - std::int64_t(mesh.n_faces()));
     RTCGeometry geom = rtcNewGeometry(impl->device, RTC_GEOMETRY_TYPE_TRIANGLE);
     auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
         geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.n_vertices()));
@@ -72,12 +76,14 @@ Expected<RayScene> RayScene::build(const std::vector<const Mesh*>& blockers) {
   if (rtcGetDeviceError(impl->device) != RTC_ERROR_NONE) {
     return Error{ErrorKind::internal, "Embree: building the blocker scene failed"};
   }
-  if (!impl->bounds.empty()) {
-    const double largest =
-        impl->bounds.lo.cwiseAbs().cwiseMax(impl->bounds.hi.cwiseAbs()).maxCoeff();
-    impl->offset = 64.0 * std::ldexp(std::max(largest, 1e-3), -23) + 1e-6 * impl->bounds.diagonal();
-  }
+  impl->offset = surface_offset_for(impl->bounds);
   return RayScene(std::move(impl));
+}
+
+double surface_offset_for(const Bounds3& bounds) {
+  if (bounds.empty()) return 1e-4;
+  const double largest = bounds.lo.cwiseAbs().cwiseMax(bounds.hi.cwiseAbs()).maxCoeff();
+  return 64.0 * std::ldexp(std::max(largest, 1e-3), -23) + 1e-6 * bounds.diagonal();
 }
 
 const Bounds3& RayScene::bounds() const { return impl_->bounds; }
@@ -141,6 +147,34 @@ void RayScene::first_hit(int count, const Vec3* origins, const Vec3* directions,
           query.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID ? double(query.ray.tfar[i]) : -1.0;
     }
   }
+}
+
+RayScene::Hit RayScene::first_hit_face(const Vec3& origin, const Vec3& direction,
+                                       double length) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit query;
+  query.ray.org_x = float(origin.x());
+  query.ray.org_y = float(origin.y());
+  query.ray.org_z = float(origin.z());
+  query.ray.dir_x = float(direction.x());
+  query.ray.dir_y = float(direction.y());
+  query.ray.dir_z = float(direction.z());
+  // As fill_packet: the first surface_offset of the segment skipped.
+  query.ray.tnear = float(impl_->offset / std::max(direction.norm(), 1e-30));
+  query.ray.tfar = float(length);
+  query.ray.time = 0.0f;
+  query.ray.mask = 0xFFFFFFFFu;
+  query.ray.id = 0;
+  query.ray.flags = 0;
+  query.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  query.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(impl_->scene, &context, &query);
+  Hit hit;
+  if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID) return hit;
+  hit.t = double(query.ray.tfar);
+  hit.face = impl_->first_face[query.hit.geomID] + std::int64_t(query.hit.primID);
+  return hit;
 }
 
 void RayScene::occluded(int count, const Vec3* origins, const Vec3* directions,

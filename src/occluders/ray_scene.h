@@ -2,6 +2,7 @@
 // ray_scene.cpp; the methods see only this class.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -10,6 +11,10 @@
 #include "scene/mesh.h"
 
 namespace sb {
+
+// How far a shadow ray's origin is pushed off its surface, and how much of its start it skips,
+// in metres, for blockers within `bounds` (RayScene::surface_offset; ray_scene.cpp says why).
+double surface_offset_for(const Bounds3& bounds);
 
 class RayScene {
  public:
@@ -37,6 +42,15 @@ class RayScene {
   // Answers `count` segments at once, writing each first hit's t (or a negative value) into t_hit.
   void first_hit(int count, const Vec3* origins, const Vec3* directions, const double* lengths,
                  double* t_hit) const;
+
+  // The same for one segment, with the triangle it meets: its index among every face of the
+  // blockers, mesh after mesh in the order given to build (ShaftCuller counts them so too), or
+  // -1 when it meets none.
+  struct Hit {
+    double t = -1;
+    std::int64_t face = -1;
+  };
+  Hit first_hit_face(const Vec3& origin, const Vec3& direction, double length) const;
 
   // The blockers' bounding box (empty when there are none).
   const Bounds3& bounds() const;

@@ -21,6 +21,7 @@
 #include "occluders/shaft_culling.h"
 
 #include "occluders/blocker_solids.h"
+#include "occluders/ray_scene.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -110,6 +111,9 @@ struct ShaftCuller::Impl {
   };
   std::vector<std::uint32_t> ball_key;  // per solid: kSolidKey | it, where it has a ball
   std::vector<MeshInfo> meshes;         // per blocker mesh
+  std::vector<std::uint32_t> of_face;  // per face of the blockers: its triangle's index
+  // How much of its start a shadow ray skips (RayScene::surface_offset), metres.
+  double skip = 0;
 
   int build(int first, int count) {
     Node node;
@@ -287,10 +291,12 @@ struct ShaftCuller::Impl {
       }
     if (t.solid >= 0) {
       // Of a closed solid, seen from outside its box: a ray enters it through a triangle facing
-      // the ray's origin before it meets one facing away, so those facing away add nothing.
+      // the ray's origin before it meets one facing away, so those facing away add nothing. A
+      // ray skips the first `skip` of its segment (it may step over the face it enters by), so
+      // the origin must lie outside the box by that much.
       const Bounds3& solid = solids[std::size_t(t.solid)].bounds;
-      const bool outside =
-          (apex.hi.array() < solid.lo.array()).any() || (apex.lo.array() > solid.hi.array()).any();
+      const bool outside = ((apex.hi.array() + skip) < solid.lo.array()).any() ||
+                           ((apex.lo.array() - skip) > solid.hi.array()).any();
       const Vec3 p = 0.5 * (apex.lo + apex.hi);
       const double spread = (0.5 * (apex.hi - apex.lo)).dot(t.normal.cwiseAbs());
       if (outside && t.normal.dot(p - t.v[0]) + spread < 0) return false;
@@ -443,17 +449,22 @@ ShaftCuller::ShaftCuller(const std::vector<const Mesh*>& blockers)
   std::vector<int> where(impl_->tris.size());
   for (std::size_t i = 0; i < impl_->tris.size(); ++i)
     where[std::size_t(impl_->tris[i].source)] = int(i);
+  impl_->of_face.assign(where.begin(), where.end());
   for (Tri& t : impl_->tris)
     for (int k = 0; k < 3; ++k) {
       const int n = found.across[std::size_t(t.source)][std::size_t(k)];
       t.across[std::size_t(k)] = n < 0 ? -1 : where[std::size_t(n)];
     }
   impl_->meshes.resize(mesh_ends.size());
+  Bounds3 all;
   for (const Tri& t : impl_->tris) {
     Impl::MeshInfo& m = impl_->meshes[std::size_t(t.mesh)];
     for (const Vec3& v : t.v) m.bounds.extend(v);
     ++m.count;
   }
+  for (const Impl::MeshInfo& m : impl_->meshes)
+    if (!m.bounds.empty()) all.extend(m.bounds);
+  impl_->skip = surface_offset_for(all);
   impl_->ball_key.resize(impl_->solids.size());
   for (std::size_t k = 0; k < impl_->solids.size(); ++k)
     impl_->ball_key[k] = kSolidKey | std::uint32_t(k);
@@ -561,6 +572,10 @@ std::span<const std::uint32_t> ShaftCuller::solids_with_balls(std::uint32_t key)
 }
 
 std::size_t ShaftCuller::triangle_count() const { return impl_->tris.size(); }
+
+std::uint32_t ShaftCuller::triangle_of_face(std::int64_t face) const {
+  return impl_->of_face[std::size_t(face)];
+}
 
 int ShaftCuller::mesh_of(std::uint32_t triangle) const { return impl_->tris[triangle].mesh; }
 

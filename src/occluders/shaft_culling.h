@@ -86,6 +86,9 @@ class ShaftCuller {
   // the other way round, or -1 (a border, or more than two triangles on it).
   int neighbour(std::uint32_t triangle, int edge) const;
   std::size_t triangle_count() const;
+  // A triangle's index in the hierarchy from its index among every face of the blockers, mesh
+  // after mesh in the order given (RayScene::Hit::face).
+  std::uint32_t triangle_of_face(std::int64_t face) const;
   // The index, among the blockers it was built from, of the mesh a triangle is of.
   int mesh_of(std::uint32_t triangle) const;
   // The closed solid a triangle belongs to (blocker_solids.h), or null.

@@ -33,7 +33,7 @@ namespace {
 // (fewer, each exact interval beats cells).
 constexpr std::size_t kOutlineTriangles = 32;
 // The most candidates a tile lists before its texels search the hierarchy one by one.
-constexpr std::size_t kTileCandidates = 1 << 16;
+constexpr std::size_t kTileCandidates = 512;
 
 // A listed tile's blockers as its texels' evaluations take them: triangles one by one, and the
 // convex solids its texels all lie outside of whole, each with the edges that may be on its
@@ -101,7 +101,7 @@ TileBlockers tile_blockers(const ShaftCuller& culler, const Light& light,
     if (list.size() < kOutlineTriangles) {
       for (std::uint32_t i : list)
         out.polygons.push_back(
-            {culler.triangle_corners(i), 3, culler.triangle_normal(i), dense[k]});
+            {culler.triangle_corners(i), 3, culler.triangle_normal(i), dense[k], i});
       continue;
     }
     out.outlines.push_back(prepare_outline(culler, light, list, dense[k], origins, offset));
@@ -282,6 +282,20 @@ class LightPairs final : public PairSource {
     if (light_.shape() == LightShape::sphere &&
         (origin - p).norm() > kParallax * (light_.centre() - p).norm())
       return traced();
+    // The light's centre first: where the ray to it meets a triangle that hides all of the light
+    // alone, the texel lies in that triangle's umbra, exactly, whatever else its shaft holds.
+    if (const RayScene::Hit hit = in_.rays->first_hit_face(origin, light_.centre() - origin, 1.0);
+        hit.face >= 0) {
+      const std::uint32_t triangle = in_.culler->triangle_of_face(hit.face);
+      if (triangle_hides_light(light_, in_.culler->triangle_corners(triangle), origin, offset_)) {
+        out.route = TexelRoute::umbra;
+        out.visibility = 0;
+        out.nearest = 0;  // the shaft is not listed: nearer blockers are unknown
+        out.triangles.assign(1, in_.culler->blocker_key(triangle));
+        out.umbra = triangle;
+        return;
+      }
+    }
     // The blockers: the tile's candidates as they are (the estimator cuts what lies beyond the
     // light or behind the origin, and ignores what projects outside the light), or, for a tile
     // without a list, the texel's own shaft's polygons from the whole hierarchy.
@@ -302,7 +316,10 @@ class LightPairs final : public PairSource {
       for (const ShaftPolygon& poly : polygons)
         blockers.push_back({poly.v.data(), poly.count, poly.normal, poly.triangle});
       // The union of what samples see is kept by key (a solid's triangles as the solid).
-      for (BlockerPolygon& b : blockers) b.triangle = in_.culler->blocker_key(b.triangle);
+      for (BlockerPolygon& b : blockers) {
+        b.source = b.triangle;
+        b.triangle = in_.culler->blocker_key(b.triangle);
+      }
       sample = estimator_.visibility(p, n, origin, Blockers{&blockers, nullptr, nullptr},
                                      form_factor, &out.triangles);
     }

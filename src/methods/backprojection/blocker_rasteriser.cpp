@@ -284,7 +284,8 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
     // One polygon, clear of the origin, covering the whole light: its umbra, convex as a convex
     // solid's is (a tree crown's facet over a texel in the sun's shadow), so refinement may
     // interpolate between samples in it.
-    if (covers && gap >= light_offset) out.umbra = poly.triangle;
+    if (covers && gap >= light_offset)
+      out.umbra = poly.source == BlockerPolygon::kKeyIsConvex ? poly.triangle : poly.source;
     found(reaches, gap, poly.triangle);
   }
 

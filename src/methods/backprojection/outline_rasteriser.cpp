@@ -178,7 +178,7 @@ BlockerOutline prepare_outline(const ShaftCuller& culler, const Light& light,
     const Bounds3 b = culler.triangle_bounds(t);
     if (!within ||
         (b.lo - origins.hi).cwiseMax(origins.lo - b.hi).cwiseMax(Vec3::Zero()).norm() < offset) {
-      out.apart.push_back({c, 3, culler.triangle_normal(t), key});
+      out.apart.push_back({c, 3, culler.triangle_normal(t), key, t});
       continue;
     }
     const Vec3& normal = culler.triangle_normal(t);
@@ -261,7 +261,7 @@ void rasterise_outline(const RasterTarget& target, const BlockerOutline& outline
       }
       const double gap = (lo - origin).cwiseMax(origin - hi).cwiseMax(Vec3::Zero()).norm();
       if (!within || gap < target.light_offset) {
-        apart.push_back({c, 3, culler.triangle_normal(t), outline.key});
+        apart.push_back({c, 3, culler.triangle_normal(t), outline.key, t});
         continue;
       }
       facing_of(t);  // marks it as one of the union's

@@ -542,8 +542,43 @@ PenumbraSample PenumbraEstimator::visibility_traced(const Vec3& position, const 
   return out;
 }
 
+namespace {
+
+// triangle_hides_light for a sphere: every segment from the origin to the ball crosses the
+// triangle exactly where the ball lies beyond the triangle's plane (seen from the origin) and
+// inside the three planes through the origin and each edge, each by the radius (distances to a
+// plane are the ball's, exactly). Clear of the origin and of the light's surface by the offset
+// a shadow ray skips at each end.
+bool triangle_hides_sphere(const Light& light, const Vec3* corners, const Vec3& origin,
+                           double light_offset) {
+  const Vec3 c = light.centre();
+  const double radius = light.desc().radius;
+  Vec3 normal = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
+  const double area = normal.norm();
+  if (!(area > 0)) return false;
+  normal /= area;
+  double h_origin = normal.dot(origin - corners[0]), h_centre = normal.dot(c - corners[0]);
+  if (h_origin < 0) h_origin = -h_origin, h_centre = -h_centre;
+  if (!(h_origin > light_offset && -h_centre > radius + 2 * light_offset)) return false;
+  const double reach = (c - origin).norm();
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 a = corners[k] - origin, b = corners[(k + 1) % 3] - origin;
+    Vec3 n = a.cross(b);
+    const double norm = n.norm();
+    if (!(norm > 0)) return false;
+    n /= norm;
+    if (n.dot(corners[(k + 2) % 3] - origin) < 0) n = -n;
+    if (!(n.dot(c - origin) > radius + 1e-9 * reach)) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 bool triangle_hides_light(const Light& light, const Vec3* corners, const Vec3& origin,
                           double light_offset) {
+  if (light.shape() == LightShape::sphere)
+    return triangle_hides_sphere(light, corners, origin, light_offset);
   if (light.shape() != LightShape::rectangle && light.shape() != LightShape::disk &&
       light.shape() != LightShape::polygon)
     return false;

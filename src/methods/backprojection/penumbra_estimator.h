@@ -20,12 +20,17 @@ struct BlockedRows;
 struct BlockerSolid;
 
 // A blocker polygon as the estimator takes it: convex, in world space (a triangle of the scene,
-// or its part in a texel's shaft), with its plane's unit normal and the triangle it comes from.
+// or its part in a texel's shaft), with its plane's unit normal, what `blocking` reports it as
+// (its triangle, or ShaftCuller::blocker_key of it), and the triangle it comes from where that
+// key names a dense mesh: a polygon that hides all of the light alone reports the convex
+// blocker whose umbra holds the texel (PenumbraSample::umbra), never a mesh's many triangles.
 struct BlockerPolygon {
+  static constexpr std::uint32_t kKeyIsConvex = 0xffffffffu;
   const Vec3* v = nullptr;
   int count = 0;
   Vec3 normal = Vec3::Zero();
   std::uint32_t triangle = 0;
+  std::uint32_t source = kKeyIsConvex;  // kKeyIsConvex: `triangle` names one triangle or solid
 };
 
 // A convex, closed blocker solid (occluders/blocker_solids.h), taken whole through its
@@ -182,8 +187,8 @@ class PenumbraEstimator {
 // Whether the triangle `corners` hides all of `light` from `origin` (exactly: every segment from
 // the origin to the light passes through it), clear of the origin and of the light's plane by
 // `light_offset` as a shadow ray is (RayScene::surface_offset). Its umbra, the points from which
-// it does, is convex under a convex light. False for a sphere (its silhouette moves with the
-// origin; no test here).
+// it does, is convex under a convex light (the intersection of its shadows from each point of the
+// light). Rectangles, disks, polygons and spheres; false for the others.
 bool triangle_hides_light(const Light& light, const Vec3* corners, const Vec3& origin,
                           double light_offset);
 

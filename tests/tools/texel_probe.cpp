@@ -1,0 +1,104 @@
+// What each of the default method's routes gives one texel of one light (a developer tool, for
+// finding why a texel comes out wrong): the texel's record, the reference's estimate at several
+// sample counts, the centre ray's first hit, the texel's own shaft's polygons from the whole
+// hierarchy and the estimator's value over them, and the whole method's value for the texel.
+//
+// Run: build/shadowbake_texel_probe SCENE.toml RECEIVER LIGHT X Y [X Y ...]
+#include <fmt/core.h>
+
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "methods/backprojection/backprojection_bake.h"
+#include "methods/backprojection/penumbra_estimator.h"
+#include "occluders/shadow_rays.h"
+#include "support/built_scene.h"
+#include "texels/lightmap_sizes.h"
+
+int main(int argc, char** argv) {
+  using namespace sb;
+  if (argc < 6 || (argc - 4) % 2 != 0) {
+    fmt::print(stderr, "usage: {} SCENE RECEIVER LIGHT X Y [X Y ...]\n", argv[0]);
+    return 2;
+  }
+  auto scene = load_scene(argv[1]);
+  if (!scene) {
+    fmt::print(stderr, "{}\n", scene.error().message);
+    return 1;
+  }
+  const test_scenes::Built built(*scene);
+  const std::vector<int> sides = lightmap_sides(*scene, built.meshes, nullptr);
+  std::size_t object = 0, receiver = 0;
+  for (std::size_t i = 0, r = 0; i < scene->objects.size(); ++i) {
+    if (!scene->objects[i].receiver) continue;
+    if (scene->objects[i].name == argv[2]) object = i, receiver = r;
+    ++r;
+  }
+  std::size_t light = 0;
+  for (std::size_t l = 0; l < built.lights.size(); ++l)
+    if (built.lights[l].desc().name == argv[3]) light = l;
+  const int side = sides[receiver];
+  const TexelSpace space = rasterise_texels(built.meshes[object], side, side);
+  const Light& L = built.lights[light];
+  const double offset = built.rays->surface_offset();
+  BackprojectionInputs in;
+  in.lights = &built.lights;
+  in.culler = &*built.culler;
+  in.rays = &*built.rays;
+  const LightField field = backprojection_light(space, in, light);
+  const TexelGrid grid(space);
+  for (int a = 4; a + 1 < argc; a += 2) {
+    const int x = std::atoi(argv[a]), y = std::atoi(argv[a + 1]);
+    const std::int32_t t = grid.texel(x, y);
+    if (t < 0) {
+      fmt::print("({}, {}): not covered\n", x, y);
+      continue;
+    }
+    const Texel& tx = space.texels[std::size_t(t)];
+    const Vec3 p = tx.position.cast<double>(), n = tx.normal.cast<double>();
+    const Vec3 o = space.ray_origin(std::size_t(t), offset);
+    fmt::print("({}, {}) texel {} face {} p ({:.4f} {:.4f} {:.4f}) n ({:.3f} {:.3f} {:.3f}) "
+               "origin-p ({:.2e} {:.2e} {:.2e}) F {:.3e}\n",
+               x, y, t, tx.face, p.x(), p.y(), p.z(), n.x(), n.y(), n.z(), (o - p).x(),
+               (o - p).y(), (o - p).z(), L.form_factor(p, n));
+    fmt::print("  method: V {:.4f} route {}\n", field.visibility_at(x, y),
+               to_string(field.route_at(x, y)));
+    for (int samples : {64, 1024, 16384}) {
+      ShadowRays batch(samples);
+      std::vector<Vec2> strata;
+      Vec3 v;
+      if (estimate_visibility(space, std::size_t(t), L, *built.rays, samples, 3, 0, batch, strata,
+                              &v))
+        fmt::print("  reference {}: V {:.4f}\n", samples, v.x());
+    }
+    const Vec3 dir = L.centre() - o;
+    const double hit = built.rays->first_hit(o, dir, 1.0);
+    fmt::print("  centre ray: {}\n", hit < 0 ? std::string("clear")
+                                              : fmt::format("hit at {:.4f} m", hit * dir.norm()));
+    std::vector<ShaftPolygon> polygons;
+    const auto listed = built.culler->shaft_polygons(o, p, n, L, nullptr, 100000, polygons);
+    fmt::print("  own shaft: {} polygons ({})\n", polygons.size(),
+               listed == ShaftCuller::Polygons::listed ? "listed" : "not all listed");
+    std::vector<BlockerPolygon> blockers;
+    for (const ShaftPolygon& poly : polygons) {
+      blockers.push_back({poly.v.data(), poly.count, poly.normal, poly.triangle});
+      if (polygons.size() <= 12) {
+        fmt::print("    triangle {} key {:x} normal ({:.3f} {:.3f} {:.3f}) corners {}:", poly.triangle,
+                   built.culler->blocker_key(poly.triangle), poly.normal.x(), poly.normal.y(),
+                   poly.normal.z(), poly.count);
+        for (const Vec3& c : std::span(built.culler->triangle_corners(poly.triangle), 3))
+          fmt::print(" ({:.4f} {:.4f} {:.4f})", c.x(), c.y(), c.z());
+        fmt::print("\n");
+      }
+    }
+    for (int rows : {32, 64}) {
+      const PenumbraEstimator estimator(L, rows, offset);
+      const PenumbraSample s =
+          estimator.visibility(p, n, o, Blockers{&blockers, nullptr, nullptr}, 0, nullptr);
+      fmt::print("  estimator over its own shaft, {} rows: V {:.4f} (contributes {})\n", rows,
+                 s.visibility, s.contributes);
+    }
+  }
+  return 0;
+}
