@@ -39,6 +39,8 @@ struct TexelBlock {
   // and no lift (its shadow origin is its position).
   bool uniform = false;
   Vec3f normal = Vec3f::Zero(), geometric = Vec3f::Zero();
+  // The largest texel step on the surface among its texels' faces (TexelSpace::face_texel_sizes).
+  float texel_size = 0;
   bool empty() const { return lo.x() > hi.x(); }
 };
 
@@ -54,6 +56,11 @@ struct TexelSpace {
   FreshVector<Texel> texels;
   // Per face of the mesh: its unit normal (from its corners' positions).
   std::vector<Vec3f> face_normals;
+  // Per face: the farthest apart two of its texels one pixel apart in the lightmap can lie on
+  // the surface, metres (the largest stretch of its UV-to-surface map, at most its longest
+  // side): two neighbouring texels farther apart than their faces' steps lie on different
+  // pieces of surface (a UV chart border). 0 for a face that covers no texel.
+  std::vector<float> face_texel_sizes;
   // Per texel, where some texel's shadow origin is not its position (a curved mesh's, below):
   // shadow origin − position; empty where every texel's is its position.
   FreshVector<Vec3f> lifts;

@@ -86,6 +86,23 @@ struct FaceSurface {
   bool curved = false;
 };
 
+// How far apart on the surface two points of a face one pixel apart in the lightmap lie at most:
+// the largest singular value of its map from texel coordinates to world space, at most its
+// longest side (a face whose UVs nearly collapse stretches without bound).
+double texel_step(const FaceFootprint& fp, const FaceSurface& s) {
+  const Vec2 t1 = fp.texel_uv[1] - fp.texel_uv[0], t2 = fp.texel_uv[2] - fp.texel_uv[0];
+  const Vec3 p1 = s.position[1] - s.position[0], p2 = s.position[2] - s.position[0];
+  const double longest =
+      std::max({p1.norm(), p2.norm(), (s.position[2] - s.position[1]).norm()});
+  const double det = t1.x() * t2.y() - t1.y() * t2.x();
+  if (!(std::abs(det) > 0)) return longest;
+  // J = [p1 p2] · [t1 t2]⁻¹; its largest singular value from the 2 × 2 matrix JᵀJ.
+  const Vec3 ju = (p1 * t2.y() - p2 * t1.y()) / det, jv = (p2 * t1.x() - p1 * t2.x()) / det;
+  const double a = ju.dot(ju), b = ju.dot(jv), c = jv.dot(jv);
+  const double largest = 0.5 * (a + c) + std::sqrt(0.25 * (a - c) * (a - c) + b * b);
+  return std::min(std::sqrt(largest), longest);
+}
+
 // Twice the signed area of (a, b, p); positive when p lies to the left of a → b.
 double orient(const Vec2& a, const Vec2& b, const Vec2& p) {
   return (b.x() - a.x()) * (p.y() - a.y()) - (b.y() - a.y()) * (p.x() - a.x());
@@ -369,10 +386,12 @@ TexelSpace rasterise_texels(const Mesh& mesh, int width, int height, RowRange ro
   for (int y = 0; y < window; ++y) row_count[std::size_t(y) + 1] += row_count[std::size_t(y)];
   space.texels.resize(row_count[std::size_t(window)]);
   space.face_normals.resize(tri_mesh.n_faces(), Vec3f::Zero());
+  space.face_texel_sizes.resize(tri_mesh.n_faces(), 0.0f);
   bool lifted = false;
   for (const FaceFootprint& fp : footprints) {
     const FaceSurface& s = surfaces[std::size_t(fp.face)];
     space.face_normals[std::size_t(fp.face)] = s.face_normal.cast<float>();
+    space.face_texel_sizes[std::size_t(fp.face)] = float(texel_step(fp, s));
     lifted = lifted || s.curved;
   }
   if (lifted) space.lifts.resize(space.texels.size());
@@ -393,11 +412,13 @@ TexelSpace rasterise_texels(const Mesh& mesh, int width, int height, RowRange ro
     const bool flat = lift == Vec3f::Zero();
     if (b.empty()) {
       b.lo = b.hi = t.position;
+      b.texel_size = space.face_texel_sizes[std::size_t(t.face)];
       b.uniform = flat;
       b.normal = t.normal;
       b.geometric = geometric;
       return;
     }
+    b.texel_size = std::max(b.texel_size, space.face_texel_sizes[std::size_t(t.face)]);
     b.lo = b.lo.cwiseMin(t.position);
     b.hi = b.hi.cwiseMax(t.position);
     b.uniform = b.uniform && flat && t.normal == b.normal && geometric == b.geometric;

@@ -33,7 +33,8 @@ namespace {
 // (fewer, each exact interval beats cells).
 constexpr std::size_t kOutlineTriangles = 32;
 // The most candidates a tile lists before its texels search the hierarchy one by one.
-constexpr std::size_t kTileCandidates = 512;
+constexpr std::size_t kTileCandidates = 1 << 16;
+
 
 // A listed tile's blockers as its texels' evaluations take them: triangles one by one, and the
 // convex solids its texels all lie outside of whole, each with the edges that may be on its
@@ -208,31 +209,36 @@ class LightPairs final : public PairSource {
         tiles_(tiles),
         offset_(in.rays->surface_offset()),
         estimator_(light, in.light_rows, offset_),
-        prepared_of_(tiles.kind.size(), -1) {
-    // The listed tiles' blockers, and those of the umbrae that hold the corners of a listed (or
-    // unlisted) tile's cells: right of, below or below-right of one, whose texels the refinement
-    // evaluates as those cells' samples.
+        prepared_of_(tiles.patches.size(), -1) {
+    // The listed patches' blockers, and those of the umbrae whose texels the refinement may
+    // evaluate as its cells' corners: the umbra patches of a tile that holds cells, or of a tile
+    // right of, below or below-right of one.
     const auto searched = [&](int tx, int ty) {
       if (tx < 0 || ty < 0) return false;
       const TileShafts::Kind k = tiles.kind[std::size_t(ty) * std::size_t(tiles.tiles_x) + tx];
       return k == TileShafts::Kind::listed || k == TileShafts::Kind::all;
     };
-    std::vector<std::size_t> prepare;  // those tiles, each given its place in prepared_
+    std::vector<std::size_t> prepare;  // those patches, each given its place in prepared_
     for (std::size_t i = 0; i < tiles.kind.size(); ++i) {
       const int tx = int(i % std::size_t(tiles.tiles_x)), ty = int(i / std::size_t(tiles.tiles_x));
-      if (tiles.kind[i] == TileShafts::Kind::listed ||
-          (tiles.kind[i] == TileShafts::Kind::umbra &&
-           (searched(tx - 1, ty) || searched(tx, ty - 1) || searched(tx - 1, ty - 1)))) {
-        prepared_of_[i] = std::int32_t(prepare.size());
-        prepare.push_back(i);
+      const bool corners = searched(tx, ty) || searched(tx - 1, ty) || searched(tx, ty - 1) ||
+                           searched(tx - 1, ty - 1);
+      for (std::uint32_t p = tiles.first_patch[i]; p < tiles.first_patch[i + 1]; ++p) {
+        const TileShafts::Kind k = tiles.patches[p].kind;
+        // (An umbra proven by the ray from its centre has no list: its texels search the
+        // hierarchy.)
+        if (k == TileShafts::Kind::listed ||
+            (k == TileShafts::Kind::umbra && corners && !tiles.patches[p].candidates.empty())) {
+          prepared_of_[p] = std::int32_t(prepare.size());
+          prepare.push_back(p);
+        }
       }
     }
     prepared_.resize(prepare.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, prepare.size(), 8), [&](const auto& r) {
       for (std::size_t k = r.begin(); k != r.end(); ++k) {
-        const std::size_t i = prepare[k];
-        prepared_[k] =
-            tile_blockers(*in.culler, light, tiles.candidates[i], tiles.origins[i], offset_);
+        const TileShafts::Patch& patch = tiles.patches[prepare[k]];
+        prepared_[k] = tile_blockers(*in.culler, light, patch.candidates, patch.origins, offset_);
       }
     });
   }
@@ -302,9 +308,8 @@ class LightPairs final : public PairSource {
     thread_local std::vector<BlockerPolygon> blockers;
     thread_local std::vector<ShaftPolygon> polygons;
     blockers.clear();
-    const std::size_t tile = tiles_.tile_of(tx.x, tx.y);
     PenumbraSample sample;
-    if (const std::int32_t at = prepared_of_[tile]; at >= 0) {
+    if (const std::int32_t at = prepared_of_[patch_index(tx.x, tx.y)]; at >= 0) {
       const TileBlockers& prepared = prepared_[std::size_t(at)];
       sample = estimator_.visibility(
           p, n, origin, Blockers{&prepared.polygons, &prepared.solids, &prepared.outlines},
@@ -369,46 +374,56 @@ class LightPairs final : public PairSource {
 
   bool sees_unlisted(const std::vector<std::size_t>& texels,
                      const std::vector<std::uint32_t>& listed) const override {
-    if (texels.empty()) return false;
-    const Texel& first = space_.texels[texels[0]];
-    const std::size_t tile = tiles_.tile_of(first.x, first.y);
-    if (tiles_.kind[tile] != TileShafts::Kind::listed) {  // the whole hierarchy, texel by texel
-      for (std::size_t t : texels) {
-        const Texel& tx = space_.texels[t];
-        if (in_.culler->maybe_blocked(space_.ray_origin(t, offset_), tx.position.cast<double>(),
-                                      tx.normal.cast<double>(), light_, nullptr, &listed))
-          return true;
-      }
-      return false;
-    }
-    // The tile's candidates no sample listed, but for those of a convex solid every texel lies
-    // on (their own surface: a ray that leaves it above the horizon does not come back to it,
-    // and where it grazes it the samples listed it).
+    // Texel by texel, among its patch's candidates no sample listed; but for those of a convex
+    // solid every texel of the patch lies on (their own surface: a ray that leaves it above the
+    // horizon does not come back to it, and where it grazes it the samples listed it). A texel
+    // of a patch without a list searches the whole hierarchy.
     thread_local std::vector<Vec3> origins;
-    origins.clear();
-    Bounds3 box;
-    for (std::size_t t : texels) {
-      origins.push_back(space_.ray_origin(t, offset_));
-      box.extend(origins.back());
-    }
     thread_local std::vector<std::uint32_t> unlisted;
-    unlisted.clear();
-    std::uint32_t on_key = 0, off_key = 0;  // the last solid found to hold the texels, or not
-    for (std::uint32_t i : tiles_.candidates[tile]) {
-      const std::uint32_t key = in_.culler->blocker_key(i);
-      if (std::binary_search(listed.begin(), listed.end(), key)) continue;
-      if (key & ShaftCuller::kSolidKey) {
-        if (key != on_key && key != off_key) (on_solid(key, origins, box) ? on_key : off_key) = key;
-        if (key == on_key) continue;
+    for (std::size_t k = 0; k < texels.size();) {
+      const Texel& first = space_.texels[texels[k]];
+      const TileShafts::Patch& patch = tiles_.patch(first.x, first.y);
+      // The run of texels of this patch that starts here.
+      std::size_t end = k + 1;
+      while (end < texels.size() && &tiles_.patch(space_.texels[texels[end]].x,
+                                                 space_.texels[texels[end]].y) == &patch)
+        ++end;
+      origins.clear();
+      Bounds3 box;
+      for (std::size_t j = k; j < end; ++j) {
+        origins.push_back(space_.ray_origin(texels[j], offset_));
+        box.extend(origins.back());
       }
-      unlisted.push_back(i);
-    }
-    if (unlisted.empty()) return false;
-    for (std::size_t k = 0; k < texels.size(); ++k) {
-      const Texel& tx = space_.texels[texels[k]];
-      if (in_.culler->maybe_blocked(origins[k], tx.position.cast<double>(),
-                                    tx.normal.cast<double>(), light_, &unlisted))
-        return true;
+      if (patch.kind != TileShafts::Kind::listed) {
+        for (std::size_t j = k; j < end; ++j) {
+          const Texel& tx = space_.texels[texels[j]];
+          if (in_.culler->maybe_blocked(origins[j - k], tx.position.cast<double>(),
+                                        tx.normal.cast<double>(), light_, nullptr, &listed))
+            return true;
+        }
+        k = end;
+        continue;
+      }
+      unlisted.clear();
+      std::uint32_t on_key = 0, off_key = 0;  // the last solid found to hold the texels, or not
+      for (std::uint32_t i : patch.candidates) {
+        const std::uint32_t key = in_.culler->blocker_key(i);
+        if (std::binary_search(listed.begin(), listed.end(), key)) continue;
+        if (key & ShaftCuller::kSolidKey) {
+          if (key != on_key && key != off_key)
+            (on_solid(key, origins, box) ? on_key : off_key) = key;
+          if (key == on_key) continue;
+        }
+        unlisted.push_back(i);
+      }
+      if (!unlisted.empty())
+        for (std::size_t j = k; j < end; ++j) {
+          const Texel& tx = space_.texels[texels[j]];
+          if (in_.culler->maybe_blocked(origins[j - k], tx.position.cast<double>(),
+                                        tx.normal.cast<double>(), light_, &unlisted))
+            return true;
+        }
+      k = end;
     }
     return false;
   }
@@ -416,14 +431,15 @@ class LightPairs final : public PairSource {
   bool one_triangle_hides(const std::array<std::size_t, 5>& samples,
                           const std::vector<std::uint32_t>& seen) const override {
     const Texel& first = space_.texels[samples[0]];
-    const std::size_t tile = tiles_.tile_of(first.x, first.y);
-    if (tiles_.kind[tile] != TileShafts::Kind::listed) return false;
+    const TileShafts::Patch& patch = tiles_.patch(first.x, first.y);
+    if (patch.kind != TileShafts::Kind::listed && patch.kind != TileShafts::Kind::umbra)
+      return false;
     // The centre (the last sample) first.
     std::array<Vec3, 5> origins;
     for (std::size_t k = 0; k < 5; ++k) origins[k] = space_.ray_origin(samples[4 - k], offset_);
-    // The tile's candidates of what the samples saw (a triangle hiding all of the light from
-    // one of them is among them).
-    for (std::uint32_t i : tiles_.candidates[tile]) {
+    // The first sample's patch's candidates of what the samples saw (a triangle hiding all of the
+    // light from it is among them).
+    for (std::uint32_t i : patch.candidates) {
       if (std::binary_search(seen.begin(), seen.end(), in_.culler->blocker_key(i)) &&
           hides_from_all(light_, in_.culler->triangle_corners(i), origins, offset_))
         return true;
@@ -481,10 +497,16 @@ class LightPairs final : public PairSource {
   const TexelSpace& space_;
   const Light& light_;
   const BackprojectionInputs& in_;
+  // The index in tiles_.patches of the patch of the texel at pixel (x, y).
+  std::size_t patch_index(int x, int y) const {
+    return std::size_t(&tiles_.patch(x, y) - tiles_.patches.data());
+  }
+
   const TileShafts& tiles_;
   double offset_;
   PenumbraEstimator estimator_;
-  // The listed tiles' blockers, and some umbrae's (above); per tile, its place among them or -1.
+  // The listed patches' blockers, and some umbrae's (above); per patch, its place among them or
+  // -1.
   std::vector<TileBlockers> prepared_;
   std::vector<std::int32_t> prepared_of_;
 };
@@ -498,7 +520,7 @@ void bake_light_by_rays(const TexelSpace& space, const TexelGrid& grid,
   const Light& light = (*in.lights)[l];
   const double offset = in.rays->surface_offset();
   const TileShafts tiles =
-      tile_shafts(space, grid, *in.culler, light, offset, kTileCandidates, /*umbrae=*/false);
+      tile_shafts(space, grid, *in.culler, *in.rays, light, kTileCandidates, /*umbrae=*/false);
   // Counted: the kept rows' texels (a tile's halo is not).
   const auto kept = kept_texels(space);
   const std::size_t kept0 = kept.first, kept1 = kept.second;
@@ -512,11 +534,11 @@ void bake_light_by_rays(const TexelSpace& space, const TexelGrid& grid,
                         const Texel& tx = space.texels[t];
                         const Vec3 p = tx.position.cast<double>(), n = tx.normal.cast<double>();
                         if (!light.reaches(p, n)) continue;
-                        const std::size_t tile = tiles.tile_of(tx.x, tx.y);
-                        if (tiles.kind[tile] == TileShafts::Kind::clear ||
+                        const TileShafts::Patch& patch = tiles.patch(tx.x, tx.y);
+                        if (patch.kind == TileShafts::Kind::clear ||
                             !in.culler->maybe_blocked(space.ray_origin(t, offset), p, n, light,
-                                                      tiles.kind[tile] == TileShafts::Kind::listed
-                                                          ? &tiles.candidates[tile]
+                                                      patch.kind == TileShafts::Kind::listed
+                                                          ? &patch.candidates
                                                           : nullptr)) {
                           mix.set(l, t, Vec3::Ones());
                           local_clear += t >= kept0 && t < kept1;
@@ -555,8 +577,7 @@ LightField light_field(const TexelSpace& space, const TexelGrid& grid,
                        const BackprojectionInputs& in, std::size_t l) {
   const Light& light = (*in.lights)[l];
   const TileShafts tiles =
-      tile_shafts(space, grid, *in.culler, light, in.rays->surface_offset(), kTileCandidates,
-                  /*umbrae=*/true);
+      tile_shafts(space, grid, *in.culler, *in.rays, light, kTileCandidates, /*umbrae=*/true);
   const LightPairs pairs(space, light, in, tiles);
   return refine_light(space, grid, tiles, pairs, in.refinement);
 }

@@ -150,12 +150,13 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, slotted.size(), 64), [&](const auto& r) {
     for (std::size_t s = r.begin(); s != r.end(); ++s) {
       const std::size_t tile = slotted[s];
-      const Kind kind = tiles.kind[tile];
       const int x0 = int(tile % std::size_t(tiles.tiles_x)) * kTile;
       const int y0 = int(tile / std::size_t(tiles.tiles_x)) * kTile;
       for (int j = 0; j < kTile * kTile; ++j) {
         const std::int32_t t = grid.texel(x0 + j % kTile, y0 + j / kTile);
         const bool lit = t >= 0 && reached[std::size_t(t)];
+        // The texel's own patch's kind (a tile's patches may differ).
+        const Kind kind = lit ? tiles.kind_at(x0 + j % kTile, y0 + j / kTile) : Kind::empty;
         const bool clear = lit && kind == Kind::clear, umbra = lit && kind == Kind::umbra;
         const std::size_t i = s * std::size_t(kTile * kTile) + std::size_t(j);
         field.visibility[i] = umbra ? 0.0f : 1.0f;

@@ -53,11 +53,17 @@ class TexelGrid {
 };
 
 // The shaft test of each tile of kTile × kTile texels (ShaftCuller::tile_candidates) for one
-// light: what the refinement's cells start from.
+// light: what the refinement's cells start from. A tile's texels the light reaches are tested in
+// patches, each one piece of surface (texels joined to their neighbours in the tile where they
+// lie no farther apart on the surface than their faces' texel steps allow): a tile of an atlas
+// of many small charts holds pieces of surface from all over a level, whose joint box's shaft
+// would cross much of it.
 struct TileShafts {
   static constexpr int kTile = 8;
   // Tiles are first tested kGroup × kGroup together: one clear group clears them all.
   static constexpr int kGroup = 4;
+  // A tile has at most this many patches (the last takes whatever pieces remain).
+  static constexpr int kMaxPatches = 16;
   enum class Kind : std::uint8_t {
     empty,   // no covered texel the light reaches
     clear,   // nothing can block the light from any of its texels
@@ -65,14 +71,33 @@ struct TileShafts {
     all,     // too many to list, or the light reaches only part of it: each texel searches all
     umbra    // one of `candidates` hides all of the light from every texel: V = 0
   };
+  struct Patch {
+    Kind kind = Kind::empty;
+    std::vector<std::uint32_t> candidates;  // sorted
+    Bounds3 origins;  // the box of its texels' ray origins
+  };
   int tiles_x = 0, tiles_y = 0;
+  // Per tile: its patches' kind where they all have one; listed where they differ.
   std::vector<Kind> kind;
-  std::vector<std::vector<std::uint32_t>> candidates;
-  std::vector<Bounds3> origins;       // the box of each tile's texels' ray origins (those reached)
+  std::vector<Patch> patches;
+  std::vector<std::uint32_t> first_patch;  // per tile and one more: tile i's are [i], [i + 1])
+  // Per tile of more than one patch, its place in `patch_at`, else -1; there, per pixel of the
+  // tile (row-major), its texel's patch within the tile.
+  std::vector<std::int32_t> mixed;
+  std::vector<std::array<std::uint8_t, kTile * kTile>> patch_at;
   FreshVector<std::uint8_t> reached;  // per texel: 1 where the light reaches it (H0 > 0)
   std::size_t tile_of(int x, int y) const {
     return std::size_t(y / kTile) * std::size_t(tiles_x) + std::size_t(x / kTile);
   }
+  // The patch of the texel at pixel (x, y), covered and reached.
+  const Patch& patch(int x, int y) const {
+    const std::size_t tile = tile_of(x, y);
+    const std::int32_t m = mixed.empty() ? -1 : mixed[tile];
+    const std::uint32_t within =
+        m < 0 ? 0u : patch_at[std::size_t(m)][std::size_t((y % kTile) * kTile + x % kTile)];
+    return patches[first_patch[tile] + within];
+  }
+  Kind kind_at(int x, int y) const { return patch(x, y).kind; }
 };
 
 // One exact evaluation of the light at a texel.

@@ -7,11 +7,39 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <numeric>
 #include <vector>
 
 #include "methods/backprojection/penumbra_estimator.h"
 
 namespace sb {
+
+namespace {
+
+using Kind = TileShafts::Kind;
+constexpr int kTile = TileShafts::kTile;
+
+// Two texels one pixel apart lie on one piece of surface where they are no farther apart than
+// this many times the larger of their faces' texel steps (TexelSpace::face_texel_sizes): a texel
+// that takes its face's nearest point (a chart's border) may lie a step beyond it.
+constexpr float kJoinSteps = 2.0f;
+
+// A tile's patches as one band's task finds them.
+struct TilePatches {
+  std::vector<TileShafts::Patch> patches;
+  std::array<std::uint8_t, kTile * kTile> at{};  // per pixel, where there are several
+  float step = 0;  // the largest texel step of its texels' faces (TexelSpace::face_texel_sizes)
+};
+
+int root_of(std::array<std::uint8_t, kTile * kTile>& parent, int i) {
+  while (parent[std::size_t(i)] != i) {
+    parent[std::size_t(i)] = parent[std::size_t(parent[std::size_t(i)])];
+    i = parent[std::size_t(i)];
+  }
+  return i;
+}
+
+}  // namespace
 
 bool hides_from_all(const Light& light, const Vec3* corners, std::span<const Vec3> points,
                     double offset) {
@@ -21,100 +49,196 @@ bool hides_from_all(const Light& light, const Vec3* corners, std::span<const Vec
 }
 
 TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const ShaftCuller& culler,
-                       const Light& light, double offset, std::size_t max, bool umbrae) {
+                       const RayScene& rays, const Light& light, std::size_t max, bool umbrae) {
+  const double offset = rays.surface_offset();
   static_assert(TileShafts::kTile == TexelBlock::kSide, "a tile is a block of the texel space");
   TileShafts tiles;
-  constexpr int k = TileShafts::kTile;
-  tiles.tiles_x = (space.width + k - 1) / k;
-  tiles.tiles_y = (space.height + k - 1) / k;
+  tiles.tiles_x = (space.width + kTile - 1) / kTile;
+  tiles.tiles_y = (space.height + kTile - 1) / kTile;
   const std::size_t count = std::size_t(tiles.tiles_x) * std::size_t(tiles.tiles_y);
-  tiles.kind.assign(count, TileShafts::Kind::empty);
-  tiles.candidates.resize(count);
-  std::vector<Bounds3>& boxes = tiles.origins;
-  boxes.assign(count, Bounds3());
+  tiles.kind.assign(count, Kind::empty);
   tiles.reached.resize(space.texels.size());  // every texel's written below
   const bool blocks = space.blocks.size() == count;
-  // Bands of kGroup tile rows in parallel, each in one pass over its texels through the grid.
-  // A tile whose block shares one normal and that the light reaches all of (the sun over flat
-  // ground) takes its box from the block, shifted as each ray origin is (the same box: rounding
-  // is monotonic), and its texels' records are not read.
+  const bool sizes = !space.face_texel_sizes.empty();
+  // Bands of kGroup tile rows in parallel. A tile whose block shares one normal, lies within the
+  // box one piece of surface of its texel steps could fill, and that the light reaches all of (the
+  // sun over flat ground) is one patch that takes its box from the block, shifted as each ray
+  // origin is (the same box: rounding is monotonic), and its texels' records are not read.
   constexpr int g = TileShafts::kGroup;
-  const auto test = [&](std::size_t i, const std::vector<std::uint32_t>* among) {
-    std::vector<std::uint32_t>& list = tiles.candidates[i];
-    if (!culler.tile_candidates(boxes[i], light, max, list, among)) {
-      tiles.kind[i] = TileShafts::Kind::clear;
+  const int bands = (tiles.tiles_y + g - 1) / g;
+  std::vector<std::vector<TilePatches>> found(static_cast<std::size_t>(bands));
+  const auto test = [&](TileShafts::Patch& patch, const std::vector<std::uint32_t>* among) {
+    std::array<Vec3, 8> corners;
+    for (int k = 0; k < 8; ++k) corners[std::size_t(k)] = patch.origins.corner(k);
+    // The triangle the ray from the box's centre to the light's centre meets first, where it
+    // hides all of the light from the box's corners: an umbra, without listing its shaft (the
+    // shaft of a patch behind a wall from a small light crosses much of a level).
+    if (umbrae) {
+      const Vec3 from = patch.origins.centre();
+      const RayScene::Hit hit = rays.first_hit_face(from, light.centre() - from, 1.0);
+      if (hit.face >= 0 &&
+          hides_from_all(light, culler.triangle_corners(culler.triangle_of_face(hit.face)),
+                         corners, offset)) {
+        patch.kind = Kind::umbra;
+        return;
+      }
+    }
+    std::vector<std::uint32_t>& list = patch.candidates;
+    if (!culler.tile_candidates(patch.origins, light, max, list, among)) {
+      patch.kind = Kind::clear;
     } else if (list.empty()) {
-      tiles.kind[i] = TileShafts::Kind::all;
+      patch.kind = Kind::all;
     } else {
-      tiles.kind[i] = TileShafts::Kind::listed;
+      patch.kind = Kind::listed;
       std::sort(list.begin(), list.end());
       if (!umbrae) return;
-      std::array<Vec3, 8> corners;
-      for (int k = 0; k < 8; ++k) corners[std::size_t(k)] = boxes[i].corner(k);
       for (std::uint32_t c : list)
         if (hides_from_all(light, culler.triangle_corners(c), corners, offset)) {
-          tiles.kind[i] = TileShafts::Kind::umbra;
+          patch.kind = Kind::umbra;
           return;
         }
     }
   };
-  tbb::parallel_for(tbb::blocked_range<int>(0, (tiles.tiles_y + g - 1) / g), [&](const auto& r) {
-    const int ty0 = r.begin() * g, ty1 = std::min(r.end() * g, tiles.tiles_y);
-    const std::size_t first_tile = std::size_t(ty0) * std::size_t(tiles.tiles_x);
-    thread_local std::vector<std::uint8_t> whole;  // per tile of the band
-    whole.assign(std::size_t(ty1 - ty0) * std::size_t(tiles.tiles_x), 0);
-    for (std::size_t i = first_tile; blocks && i < first_tile + whole.size(); ++i) {
-      const TexelBlock& b = space.blocks[i];
-      if (!b.uniform || b.empty()) continue;
-      Bounds3 positions;
-      positions.extend(b.lo.cast<double>());
-      positions.extend(b.hi.cast<double>());
-      if (!light.reaches_all(positions, b.normal.cast<double>())) continue;
-      whole[i - first_tile] = 1;
-      const Vec3 shift = offset * b.geometric.cast<double>();
-      boxes[i].extend(Vec3(b.lo.cast<double>() + shift));
-      boxes[i].extend(Vec3(b.hi.cast<double>() + shift));
-    }
-    grid.for_each(ty0 * k, std::min(space.height, ty1 * k), [&](std::size_t t, int x, int y) {
-      const std::size_t tile = tiles.tile_of(x, y);
-      if (whole[tile - first_tile]) {
-        tiles.reached[t] = 1;
-        return;
-      }
-      const Texel& tx = space.texels[t];
-      tiles.reached[t] = light.reaches(tx.position.cast<double>(), tx.normal.cast<double>());
-      if (tiles.reached[t]) boxes[tile].extend(space.ray_origin(t, offset));
-    });
-    // A group of g × g tiles whose joint box's shaft is clear is clear throughout (each tile's
-    // shaft lies inside it); otherwise its tiles are tested one by one, among the group's
-    // candidates where it listed them (a tile's shaft lies inside the group's, so every triangle
-    // in it is among them) rather than down the whole hierarchy again.
-    thread_local std::vector<std::uint32_t> group_list;
-    for (int gy = ty0; gy < ty1; gy += g)
+  tbb::parallel_for(tbb::blocked_range<int>(0, bands), [&](const auto& r) {
+    for (int band = r.begin(); band != r.end(); ++band) {
+      const int ty0 = band * g, ty1 = std::min(ty0 + g, tiles.tiles_y);
+      std::vector<TilePatches>& out = found[std::size_t(band)];
+      out.assign(std::size_t(ty1 - ty0) * std::size_t(tiles.tiles_x), TilePatches());
+      for (int ty = ty0; ty < ty1; ++ty)
+        for (int tx = 0; tx < tiles.tiles_x; ++tx) {
+          const std::size_t i = std::size_t(ty) * std::size_t(tiles.tiles_x) + std::size_t(tx);
+          TilePatches& tile = out[i - std::size_t(ty0) * std::size_t(tiles.tiles_x)];
+          if (blocks) {
+            const TexelBlock& b = space.blocks[i];
+            if (b.empty()) continue;
+            const Vec3 lo = b.lo.cast<double>(), hi = b.hi.cast<double>();
+            Bounds3 positions;
+            positions.extend(lo);
+            positions.extend(hi);
+            const double reach = double(b.texel_size) * kJoinSteps * kTile * std::sqrt(3.0);
+            if (b.uniform && (!sizes || (hi - lo).norm() <= reach) &&
+                light.reaches_all(positions, b.normal.cast<double>())) {
+              const Vec3 shift = offset * b.geometric.cast<double>();
+              tile.step = b.texel_size;
+              TileShafts::Patch& patch = tile.patches.emplace_back();
+              patch.origins.extend(Vec3(lo + shift));
+              patch.origins.extend(Vec3(hi + shift));
+              for (int y = ty * kTile; y < std::min(space.height, (ty + 1) * kTile); ++y)
+                for (int x = tx * kTile; x < std::min(space.width, (tx + 1) * kTile); ++x)
+                  if (const std::int32_t t = grid.texel(x, y); t >= 0)
+                    tiles.reached[std::size_t(t)] = 1;
+              continue;
+            }
+          }
+          // Texel by texel: which the light reaches, and their pieces of surface.
+          std::array<std::int32_t, kTile * kTile> texel;
+          std::array<std::uint8_t, kTile * kTile> parent;
+          for (int j = 0; j < kTile * kTile; ++j) {
+            parent[std::size_t(j)] = std::uint8_t(j);
+            const std::int32_t t = grid.texel(tx * kTile + j % kTile, ty * kTile + j / kTile);
+            texel[std::size_t(j)] = -1;
+            if (t < 0) continue;
+            const Texel& record = space.texels[std::size_t(t)];
+            tiles.reached[std::size_t(t)] =
+                light.reaches(record.position.cast<double>(), record.normal.cast<double>());
+            if (tiles.reached[std::size_t(t)]) texel[std::size_t(j)] = t;
+          }
+          const auto joined = [&](std::int32_t a, std::int32_t b) {
+            if (!sizes) return true;
+            const Texel& ta = space.texels[std::size_t(a)];
+            const Texel& tb = space.texels[std::size_t(b)];
+            const float step = std::max(space.face_texel_sizes[std::size_t(ta.face)],
+                                        space.face_texel_sizes[std::size_t(tb.face)]);
+            return (ta.position - tb.position).norm() <= kJoinSteps * step;
+          };
+          for (int j = 0; j < kTile * kTile; ++j) {
+            if (texel[std::size_t(j)] < 0) continue;
+            for (const int k : {j % kTile + 1 < kTile ? j + 1 : -1, j + kTile})
+              if (k >= 0 && k < kTile * kTile && texel[std::size_t(k)] >= 0 &&
+                  joined(texel[std::size_t(j)], texel[std::size_t(k)]))
+                parent[std::size_t(root_of(parent, k))] = std::uint8_t(root_of(parent, j));
+          }
+          // Patches in order of their first pixel; past kMaxPatches, the rest join the last.
+          std::array<std::int8_t, kTile * kTile> patch_of_root;
+          patch_of_root.fill(-1);
+          for (int j = 0; j < kTile * kTile; ++j) {
+            if (texel[std::size_t(j)] < 0) continue;
+            const int root = root_of(parent, j);
+            if (patch_of_root[std::size_t(root)] < 0) {
+              if (int(tile.patches.size()) < TileShafts::kMaxPatches) tile.patches.emplace_back();
+              patch_of_root[std::size_t(root)] = std::int8_t(tile.patches.size() - 1);
+            }
+            const std::uint8_t p = std::uint8_t(patch_of_root[std::size_t(root)]);
+            if (sizes)
+              tile.step = std::max(
+                  tile.step,
+                  space.face_texel_sizes[std::size_t(space.texels[std::size_t(texel[std::size_t(j)])].face)]);
+            tile.at[std::size_t(j)] = p;
+            tile.patches[p].origins.extend(space.ray_origin(std::size_t(texel[std::size_t(j)]),
+                                                            offset));
+          }
+        }
+      // A group of g × g tiles on one piece of surface (its joint box no larger than one piece
+      // of its texel steps could fill) whose joint box's shaft is clear is clear throughout (each
+      // patch's shaft lies inside it); otherwise its patches are tested one by one, among the
+      // group's candidates where it listed them (a patch's shaft lies inside the group's, so
+      // every triangle in it is among them) rather than down the whole hierarchy again. A group
+      // of pieces from all over a level is not tested: its shaft would cross much of it.
+      thread_local std::vector<std::uint32_t> group_list;
       for (int gx = 0; gx < tiles.tiles_x; gx += g) {
-        const int x1 = std::min(gx + g, tiles.tiles_x), y1 = std::min(gy + g, ty1);
+        const int x1 = std::min(gx + g, tiles.tiles_x);
         Bounds3 joint;
         int filled = 0;
-        for (int ty = gy; ty < y1; ++ty)
+        float step = 0;
+        for (int ty = ty0; ty < ty1; ++ty)
           for (int tx = gx; tx < x1; ++tx) {
-            const Bounds3& b = boxes[std::size_t(ty) * std::size_t(tiles.tiles_x) + tx];
-            if (b.empty()) continue;
-            joint.extend(b);
-            ++filled;
+            const TilePatches& tile =
+                out[std::size_t(ty - ty0) * std::size_t(tiles.tiles_x) + std::size_t(tx)];
+            step = std::max(step, tile.step);
+            for (const TileShafts::Patch& p : tile.patches) {
+              joint.extend(p.origins);
+              ++filled;
+            }
           }
         if (filled == 0) continue;
-        const bool clear = filled > 1 && !culler.tile_candidates(joint, light, max, group_list);
-        for (int ty = gy; ty < y1; ++ty)
-          for (int tx = gx; tx < x1; ++tx) {
-            const std::size_t i = std::size_t(ty) * std::size_t(tiles.tiles_x) + tx;
-            if (boxes[i].empty()) continue;
-            if (clear)
-              tiles.kind[i] = TileShafts::Kind::clear;
-            else
-              test(i, filled > 1 && !group_list.empty() ? &group_list : nullptr);
-          }
+        const bool coherent =
+            !sizes || joint.diagonal() <= double(step) * kJoinSteps * g * kTile * std::sqrt(3.0);
+        group_list.clear();
+        const bool clear =
+            filled > 1 && coherent && !culler.tile_candidates(joint, light, max, group_list);
+        for (int ty = ty0; ty < ty1; ++ty)
+          for (int tx = gx; tx < x1; ++tx)
+            for (TileShafts::Patch& p :
+                 out[std::size_t(ty - ty0) * std::size_t(tiles.tiles_x) + std::size_t(tx)].patches) {
+              if (clear)
+                p.kind = Kind::clear;
+              else
+                test(p, filled > 1 && !group_list.empty() ? &group_list : nullptr);
+            }
       }
+    }
   });
+  // The bands' patches in tile order.
+  tiles.first_patch.assign(count + 1, 0);
+  tiles.mixed.assign(count, -1);
+  std::size_t i = 0;
+  for (std::vector<TilePatches>& band : found)
+    for (TilePatches& tile : band) {
+      tiles.first_patch[i] = std::uint32_t(tiles.patches.size());
+      if (tile.patches.size() > 1) {
+        tiles.mixed[i] = std::int32_t(tiles.patch_at.size());
+        tiles.patch_at.push_back(tile.at);
+      }
+      if (!tile.patches.empty()) {
+        Kind kind = tile.patches[0].kind;
+        for (const TileShafts::Patch& p : tile.patches)
+          if (p.kind != kind) kind = Kind::listed;
+        tiles.kind[i] = kind;
+      }
+      for (TileShafts::Patch& p : tile.patches) tiles.patches.push_back(std::move(p));
+      ++i;
+    }
+  tiles.first_patch[count] = std::uint32_t(tiles.patches.size());
   return tiles;
 }
 

@@ -7,6 +7,7 @@
 
 #include "core/geometry.h"
 #include "methods/backprojection/texel_refinement.h"
+#include "occluders/ray_scene.h"
 #include "occluders/shaft_culling.h"
 #include "scene/lights.h"
 #include "texels/texel_space.h"
@@ -18,11 +19,12 @@ namespace sb {
 bool hides_from_all(const Light& light, const Vec3* corners, std::span<const Vec3> points,
                     double offset);
 
-// Every tile's shaft test for `light` (ShaftCuller::tile_candidates, at most `max` candidates a
-// tile): clear, listed, all, or, with `umbrae`, an umbra where one of its candidates hides all of
-// the light from the eight corners of its box of ray origins (so from every one of them: a
-// triangle's umbra is convex). `offset`: the rays' surface offset.
+// Every tile's shaft test for `light`, patch by patch (TileShafts; ShaftCuller::tile_candidates,
+// at most `max` candidates a patch): clear, listed, all, or, with `umbrae`, an umbra where a
+// triangle hides all of the light from the eight corners of its box of ray origins (so from
+// every one of them: a triangle's umbra is convex): the triangle the ray from the box's centre to
+// the light's centre meets, or one of its candidates. `rays`: those rays, and the surface offset.
 TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const ShaftCuller& culler,
-                       const Light& light, double offset, std::size_t max, bool umbrae);
+                       const RayScene& rays, const Light& light, std::size_t max, bool umbrae);
 
 }  // namespace sb

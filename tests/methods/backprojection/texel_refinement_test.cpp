@@ -40,8 +40,9 @@ TileShafts listed_tiles() {
   TileShafts tiles;
   tiles.tiles_x = tiles.tiles_y = kSide / TileShafts::kTile;
   tiles.kind.assign(std::size_t(tiles.tiles_x * tiles.tiles_y), TileShafts::Kind::listed);
-  tiles.candidates.assign(tiles.kind.size(), {7});
-  tiles.origins.assign(tiles.kind.size(), Bounds3());
+  tiles.patches.assign(tiles.kind.size(), {TileShafts::Kind::listed, {7}, Bounds3()});
+  tiles.first_patch.resize(tiles.kind.size() + 1);
+  for (std::size_t i = 0; i <= tiles.kind.size(); ++i) tiles.first_patch[i] = std::uint32_t(i);
   tiles.reached.assign(kSide * kSide, 1);
   return tiles;
 }
@@ -253,6 +254,7 @@ TEST(TexelRefinement, TilesWithoutPlacesHoldTheirKindsValue) {
   tiles.kind[at(3, 2)] = Kind::umbra;   // ... hold their corners
   tiles.kind[at(6, 6)] = Kind::umbra;   // alone: one value
   tiles.kind[at(0, 7)] = Kind::empty;
+  for (std::size_t i = 0; i < tiles.kind.size(); ++i) tiles.patches[i].kind = tiles.kind[i];
   for (int y = 0; y < k; ++y)  // the light reaches only the left half of tile (5, 0)
     for (int x = 5 * k + k / 2; x < 6 * k; ++x) tiles.reached[std::size_t(y * kSide + x)] = 0;
   for (int y = 7 * k; y < 8 * k; ++y)  // nor any of the empty tile
