@@ -231,6 +231,61 @@ std::optional<Fold> border_crosses(const std::vector<Vec2>& uv, const std::vecto
   return std::nullopt;
 }
 
+// Whether two triangles of a flattened chart overlap with positive area in UV (coplanar faces
+// that overlap in space, as brushwork's often do, lie on each other once projected; their border
+// edges cross as a crack's lips do): the separating axis test over the six edge normals, with
+// overlaps thinner than a ten-millionth of the longer triangle counted as touching (neighbours,
+// T-junctions). Found by a sweep over their u extents; where they overlap, the triangles' centres
+// in space.
+std::optional<Fold> triangles_overlap(const ChartUvs& uv, const Surface& s,
+                                      const std::vector<int>& chart) {
+  struct Extent {
+    double lo, hi;
+  };
+  const auto extent = [&](std::size_t t, const Vec2& axis) {
+    Extent e{1e300, -1e300};
+    for (const Vec2& p : uv[t])
+      e.lo = std::min(e.lo, axis.dot(p)), e.hi = std::max(e.hi, axis.dot(p));
+    return e;
+  };
+  const auto longest = [&](std::size_t t) {
+    return std::max(
+        {(uv[t][1] - uv[t][0]).norm(), (uv[t][2] - uv[t][1]).norm(), (uv[t][0] - uv[t][2]).norm()});
+  };
+  const auto overlap = [&](std::size_t a, std::size_t b) {
+    const double tolerance = 1e-7 * std::max(longest(a), longest(b));
+    for (const std::size_t t : {a, b})
+      for (int k = 0; k < 3; ++k) {
+        const Vec2 edge = uv[t][std::size_t((k + 1) % 3)] - uv[t][std::size_t(k)];
+        const double length = edge.norm();
+        if (!(length > 0)) continue;
+        const Vec2 axis(-edge.y() / length, edge.x() / length);
+        const Extent ea = extent(a, axis), eb = extent(b, axis);
+        if (std::min(ea.hi, eb.hi) - std::max(ea.lo, eb.lo) <= tolerance) return false;
+      }
+    return true;
+  };
+  std::vector<std::size_t> order(uv.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  const Vec2 x_axis(1, 0);
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return extent(a, x_axis).lo < extent(b, x_axis).lo;
+  });
+  std::vector<std::size_t> active;
+  for (const std::size_t t : order) {
+    const double x = extent(t, x_axis).lo;
+    std::erase_if(active, [&](std::size_t a) { return extent(a, x_axis).hi < x; });
+    for (const std::size_t a : active)
+      if (overlap(a, t)) {
+        const Face& fa = s.faces[std::size_t(chart[a])];
+        const Face& ft = s.faces[std::size_t(chart[t])];
+        return Fold{(fa.p[0] + fa.p[1] + fa.p[2]) / 3.0, (ft.p[0] + ft.p[1] + ft.p[2]) / 3.0};
+      }
+    active.push_back(t);
+  }
+  return std::nullopt;
+}
+
 // The chart flattened, scaled so its UV area equals its surface area; nothing when it cannot be
 // (not a disc, folded, or its triangles' areas spread beyond kMaxAreaSpread); `fold` then says
 // where it folded, if that was why.
@@ -300,6 +355,7 @@ std::optional<ChartUvs> flatten(const Surface& s, const std::vector<int>& chart,
   for (const auto& [edge, count] : uses)
     if (count == 1) border.push_back(edge);
   if ((*fold = border_crosses(uv, positions, border))) return std::nullopt;
+  if ((*fold = triangles_overlap(out, s, chart))) return std::nullopt;
   return out;
 }
 

@@ -163,9 +163,9 @@ TEST(AutoUv, ACrackIsNotAFold) {
   EXPECT_EQ(made->charts, 1);
 }
 
-// A ramp winding `turns` turns (a helicoid, radii 0.3 to 1 m, rising 0.2 m a turn), 72 segments
-// a turn: its normals stay within 6° of up, so it grows as one smooth chart.
-Mesh helical_ramp(double turns) {
+// A ramp winding `turns` turns (a helicoid, radii 0.3 to 1 m, rising `rise` m a turn), 72
+// segments a turn: its normals stay within 6° of up, so it grows as one smooth chart.
+Mesh helical_ramp(double turns, double rise_per_turn = 0.2) {
   Mesh m;
   m.name = "ramp";
   const int around = int(72 * turns), across = 4;
@@ -179,7 +179,8 @@ Mesh helical_ramp(double turns) {
           m.mesh.add_vertex(TriMesh::Point(r * std::cos(angle), r * std::sin(angle), rise)));
       // The helicoid's normal: across the radial and tangential directions.
       const Vec3 radial(std::cos(angle), std::sin(angle), 0);
-      const Vec3 along(-r * std::sin(angle), r * std::cos(angle), 0.2 / (2 * std::numbers::pi));
+      const Vec3 along(-r * std::sin(angle), r * std::cos(angle),
+                       rise_per_turn / (2 * std::numbers::pi));
       const Vec3 n = radial.cross(along).normalized();
       m.mesh.set_normal(v.back(), TriMesh::Normal(n.x(), n.y(), n.z()));
     }
@@ -212,6 +213,35 @@ TEST(AutoUv, AChartThatFoldsIsCut) {
   EXPECT_EQ(layout.overlapping_texels, 0);
   EXPECT_EQ(layout.texels_near_other_charts, 0);
   EXPECT_LT(layout.stretch, 1.05);
+}
+
+// A flat fan around one vertex whose wedges add up to more than a turn (405°): its last triangle
+// lies on its first, coplanar, as brushwork's overlapping faces do (zdm2's among them), so its
+// border edges cross where they also touch in space, as a crack's lips do. The triangles' overlap
+// cuts it all the same: no texel is claimed twice.
+TEST(AutoUv, CoplanarFacesThatOverlapAreCutApart) {
+  Mesh m;
+  m.name = "fan";
+  std::vector<Vec2> unused;
+  auto vertex = [&](double x, double y) {
+    const auto h = m.mesh.add_vertex(TriMesh::Point(x, y, 0));
+    m.mesh.set_normal(h, TriMesh::Normal(0, 0, 1));
+    return h;
+  };
+  const auto centre = vertex(0, 0);
+  std::vector<TriMesh::VertexHandle> rim;
+  for (const double degrees : {0.0, 90.0, 180.0, 270.0, 405.0}) {
+    const double a = degrees * std::numbers::pi / 180, r = degrees > 360 ? 0.5 : 1.0;
+    rim.push_back(vertex(r * std::cos(a), r * std::sin(a)));
+  }
+  for (std::size_t k = 0; k + 1 < rim.size(); ++k)
+    add_triangle(m.mesh, centre, rim[k], rim[k + 1], unused);
+  m.mesh.update_face_normals();
+  auto made = generate_lightmap_uvs(m, side_target(64));
+  ASSERT_TRUE(made) << made.error().message;
+  EXPECT_GE(made->charts, 2);
+  const TexelSpace space = rasterise_texels(m, 64, 64);
+  EXPECT_EQ(check_uv_layout(m, space, 4).overlapping_texels, 0);
 }
 
 TEST(AutoUv, ChartsThatCannotFitTheSideAreAnError) {
