@@ -138,7 +138,7 @@ struct ShaftCuller::Impl {
   };
   std::vector<std::uint32_t> ball_key;  // per solid: kSolidKey | it, where it has a ball
   std::vector<MeshInfo> meshes;         // per blocker mesh
-  std::vector<std::uint32_t> of_face;  // per face of the blockers: its triangle's index
+  std::vector<std::uint32_t> of_face;   // per face of the blockers: its triangle's index
   // How much of its start a shadow ray skips (RayScene::surface_offset), metres.
   double skip = 0;
 
@@ -198,18 +198,16 @@ struct ShaftCuller::Impl {
       if (best_axis >= 0) {
         const double lo = centroids.lo[best_axis], ext = extent[best_axis];
         const auto middle = std::partition(
-            tris.begin() + first, tris.begin() + first + count, [&](const Tri& t) {
-              return bin_of(centroid(t)[best_axis], lo, ext) < best_split;
-            });
+            tris.begin() + first, tris.begin() + first + count,
+            [&](const Tri& t) { return bin_of(centroid(t)[best_axis], lo, ext) < best_split; });
         half = int(middle - (tris.begin() + first));
       }
     }
     if (half <= 0 || half >= count) {
       half = count / 2;
-      std::nth_element(tris.begin() + first, tris.begin() + first + half,
-                       tris.begin() + first + count, [axis](const Tri& a, const Tri& b) {
-                         return centroid(a)[axis] < centroid(b)[axis];
-                       });
+      std::nth_element(
+          tris.begin() + first, tris.begin() + first + half, tris.begin() + first + count,
+          [axis](const Tri& a, const Tri& b) { return centroid(a)[axis] < centroid(b)[axis]; });
     }
     const int left = build(first, half, depth + 1);
     const int right = build(first + half, count - half, depth + 1);

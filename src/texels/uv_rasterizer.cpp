@@ -92,8 +92,7 @@ struct FaceSurface {
 double texel_step(const FaceFootprint& fp, const FaceSurface& s) {
   const Vec2 t1 = fp.texel_uv[1] - fp.texel_uv[0], t2 = fp.texel_uv[2] - fp.texel_uv[0];
   const Vec3 p1 = s.position[1] - s.position[0], p2 = s.position[2] - s.position[0];
-  const double longest =
-      std::max({p1.norm(), p2.norm(), (s.position[2] - s.position[1]).norm()});
+  const double longest = std::max({p1.norm(), p2.norm(), (s.position[2] - s.position[1]).norm()});
   const double det = t1.x() * t2.y() - t1.y() * t2.x();
   if (!(std::abs(det) > 0)) return longest;
   // J = [p1 p2] · [t1 t2]⁻¹; its largest singular value from the 2 × 2 matrix JᵀJ.

@@ -58,10 +58,11 @@ int main(int argc, char** argv) {
     const Texel& tx = space.texels[std::size_t(t)];
     const Vec3 p = tx.position.cast<double>(), n = tx.normal.cast<double>();
     const Vec3 o = space.ray_origin(std::size_t(t), offset);
-    fmt::print("({}, {}) texel {} face {} p ({:.4f} {:.4f} {:.4f}) n ({:.3f} {:.3f} {:.3f}) "
-               "origin-p ({:.2e} {:.2e} {:.2e}) F {:.3e}\n",
-               x, y, t, tx.face, p.x(), p.y(), p.z(), n.x(), n.y(), n.z(), (o - p).x(),
-               (o - p).y(), (o - p).z(), L.form_factor(p, n));
+    fmt::print(
+        "({}, {}) texel {} face {} p ({:.4f} {:.4f} {:.4f}) n ({:.3f} {:.3f} {:.3f}) "
+        "origin-p ({:.2e} {:.2e} {:.2e}) F {:.3e}\n",
+        x, y, t, tx.face, p.x(), p.y(), p.z(), n.x(), n.y(), n.z(), (o - p).x(), (o - p).y(),
+        (o - p).z(), L.form_factor(p, n));
     fmt::print("  method: V {:.4f} route {}\n", field.visibility_at(x, y),
                to_string(field.route_at(x, y)));
     for (int samples : {64, 1024, 16384}) {
@@ -74,8 +75,8 @@ int main(int argc, char** argv) {
     }
     const Vec3 dir = L.centre() - o;
     const double hit = built.rays->first_hit(o, dir, 1.0);
-    fmt::print("  centre ray: {}\n", hit < 0 ? std::string("clear")
-                                              : fmt::format("hit at {:.4f} m", hit * dir.norm()));
+    fmt::print("  centre ray: {}\n",
+               hit < 0 ? std::string("clear") : fmt::format("hit at {:.4f} m", hit * dir.norm()));
     std::vector<ShaftPolygon> polygons;
     const auto listed = built.culler->shaft_polygons(o, p, n, L, nullptr, 100000, polygons);
     fmt::print("  own shaft: {} polygons ({})\n", polygons.size(),
@@ -84,9 +85,9 @@ int main(int argc, char** argv) {
     for (const ShaftPolygon& poly : polygons) {
       blockers.push_back({poly.v.data(), poly.count, poly.normal, poly.triangle});
       if (polygons.size() <= 12) {
-        fmt::print("    triangle {} key {:x} normal ({:.3f} {:.3f} {:.3f}) corners {}:", poly.triangle,
-                   built.culler->blocker_key(poly.triangle), poly.normal.x(), poly.normal.y(),
-                   poly.normal.z(), poly.count);
+        fmt::print("    triangle {} key {:x} normal ({:.3f} {:.3f} {:.3f}) corners {}:",
+                   poly.triangle, built.culler->blocker_key(poly.triangle), poly.normal.x(),
+                   poly.normal.y(), poly.normal.z(), poly.count);
         for (const Vec3& c : std::span(built.culler->triangle_corners(poly.triangle), 3))
           fmt::print(" ({:.4f} {:.4f} {:.4f})", c.x(), c.y(), c.z());
         fmt::print("\n");

@@ -35,7 +35,6 @@ constexpr std::size_t kOutlineTriangles = 32;
 // The most candidates a tile lists before its texels search the hierarchy one by one.
 constexpr std::size_t kTileCandidates = 1 << 16;
 
-
 // A listed tile's blockers as its texels' evaluations take them: triangles one by one, and the
 // convex solids its texels all lie outside of whole, each with the edges that may be on its
 // silhouette from some point of the tile (between faces that do not face the same way from all
@@ -385,8 +384,8 @@ class LightPairs final : public PairSource {
       const TileShafts::Patch& patch = tiles_.patch(first.x, first.y);
       // The run of texels of this patch that starts here.
       std::size_t end = k + 1;
-      while (end < texels.size() && &tiles_.patch(space_.texels[texels[end]].x,
-                                                 space_.texels[texels[end]].y) == &patch)
+      while (end < texels.size() &&
+             &tiles_.patch(space_.texels[texels[end]].x, space_.texels[texels[end]].y) == &patch)
         ++end;
       origins.clear();
       Bounds3 box;
@@ -525,38 +524,37 @@ void bake_light_by_rays(const TexelSpace& space, const TexelGrid& grid,
   const auto kept = kept_texels(space);
   const std::size_t kept0 = kept.first, kept1 = kept.second;
   std::atomic<std::int64_t> clear{0}, traced{0}, rays{0};
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, space.texels.size(), 64),
-                    [&](const auto& r) {
-                      ShadowRays batch(samples);
-                      std::vector<Vec2> strata;
-                      std::int64_t local_clear = 0, local_traced = 0, local_rays = 0;
-                      for (std::size_t t = r.begin(); t != r.end(); ++t) {
-                        const Texel& tx = space.texels[t];
-                        const Vec3 p = tx.position.cast<double>(), n = tx.normal.cast<double>();
-                        if (!light.reaches(p, n)) continue;
-                        const TileShafts::Patch& patch = tiles.patch(tx.x, tx.y);
-                        if (patch.kind == TileShafts::Kind::clear ||
-                            !in.culler->maybe_blocked(space.ray_origin(t, offset), p, n, light,
-                                                      patch.kind == TileShafts::Kind::listed
-                                                          ? &patch.candidates
-                                                          : nullptr)) {
-                          mix.set(l, t, Vec3::Ones());
-                          local_clear += t >= kept0 && t < kept1;
-                          continue;
-                        }
-                        Vec3 v;
-                        if (!estimate_visibility(space, t, light, *in.rays, samples, in.seed,
-                                                 in.stream, batch, strata, &v))
-                          continue;
-                        mix.set(l, t, v);
-                        if (t < kept0 || t >= kept1) continue;
-                        ++local_traced;
-                        local_rays += batch.size();
-                      }
-                      clear += local_clear;
-                      traced += local_traced;
-                      rays += local_rays;
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, space.texels.size(), 64), [&](const auto& r) {
+        ShadowRays batch(samples);
+        std::vector<Vec2> strata;
+        std::int64_t local_clear = 0, local_traced = 0, local_rays = 0;
+        for (std::size_t t = r.begin(); t != r.end(); ++t) {
+          const Texel& tx = space.texels[t];
+          const Vec3 p = tx.position.cast<double>(), n = tx.normal.cast<double>();
+          if (!light.reaches(p, n)) continue;
+          const TileShafts::Patch& patch = tiles.patch(tx.x, tx.y);
+          if (patch.kind == TileShafts::Kind::clear ||
+              !in.culler->maybe_blocked(
+                  space.ray_origin(t, offset), p, n, light,
+                  patch.kind == TileShafts::Kind::listed ? &patch.candidates : nullptr)) {
+            mix.set(l, t, Vec3::Ones());
+            local_clear += t >= kept0 && t < kept1;
+            continue;
+          }
+          Vec3 v;
+          if (!estimate_visibility(space, t, light, *in.rays, samples, in.seed, in.stream, batch,
+                                   strata, &v))
+            continue;
+          mix.set(l, t, v);
+          if (t < kept0 || t >= kept1) continue;
+          ++local_traced;
+          local_rays += batch.size();
+        }
+        clear += local_clear;
+        traced += local_traced;
+        rays += local_rays;
+      });
   counts[TexelRoute::clear] += clear;
   counts[TexelRoute::traced] += traced;
   counts.rays += rays;

@@ -74,7 +74,7 @@ struct TileShafts {
   struct Patch {
     Kind kind = Kind::empty;
     std::vector<std::uint32_t> candidates;  // sorted
-    Bounds3 origins;  // the box of its texels' ray origins
+    Bounds3 origins;                        // the box of its texels' ray origins
   };
   int tiles_x = 0, tiles_y = 0;
   // Per tile: its patches' kind where they all have one; listed where they differ.

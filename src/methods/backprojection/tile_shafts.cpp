@@ -77,8 +77,8 @@ TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const Sha
       const Vec3 from = patch.origins.centre();
       const RayScene::Hit hit = rays.first_hit_face(from, light.centre() - from, 1.0);
       if (hit.face >= 0 &&
-          hides_from_all(light, culler.triangle_corners(culler.triangle_of_face(hit.face)),
-                         corners, offset)) {
+          hides_from_all(light, culler.triangle_corners(culler.triangle_of_face(hit.face)), corners,
+                         offset)) {
         patch.kind = Kind::umbra;
         return;
       }
@@ -170,12 +170,12 @@ TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const Sha
             }
             const std::uint8_t p = std::uint8_t(patch_of_root[std::size_t(root)]);
             if (sizes)
-              tile.step = std::max(
-                  tile.step,
-                  space.face_texel_sizes[std::size_t(space.texels[std::size_t(texel[std::size_t(j)])].face)]);
+              tile.step =
+                  std::max(tile.step, space.face_texel_sizes[std::size_t(
+                                          space.texels[std::size_t(texel[std::size_t(j)])].face)]);
             tile.at[std::size_t(j)] = p;
-            tile.patches[p].origins.extend(space.ray_origin(std::size_t(texel[std::size_t(j)]),
-                                                            offset));
+            tile.patches[p].origins.extend(
+                space.ray_origin(std::size_t(texel[std::size_t(j)]), offset));
           }
         }
       // A group of g × g tiles on one piece of surface (its joint box no larger than one piece
@@ -209,7 +209,8 @@ TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const Sha
         for (int ty = ty0; ty < ty1; ++ty)
           for (int tx = gx; tx < x1; ++tx)
             for (TileShafts::Patch& p :
-                 out[std::size_t(ty - ty0) * std::size_t(tiles.tiles_x) + std::size_t(tx)].patches) {
+                 out[std::size_t(ty - ty0) * std::size_t(tiles.tiles_x) + std::size_t(tx)]
+                     .patches) {
               if (clear)
                 p.kind = Kind::clear;
               else
