@@ -14,10 +14,16 @@
 // load (meshes, rays, shaft hierarchy) in proportion to its texels. A scene's time is its whole
 // bake (load and every receiver); its RMSE pools every receiver's covered texels.
 //
+// Levels made by others (--levels, paths from the repository's root, each PATH or
+// PATH@TEXELS_PER_METRE) are baked at their own sizes (or that density) and margins, not at
+// --resolution; `--levels` alone leaves out the corpus. Per scene it also counts wrong texels:
+// those off the truth by more than 0.25 where the reference at 64 samples is within 0.1 of it.
+//
 // Run: build/shadowbake_corpus_bench [--scenes room/scene.toml,...] [--repeat 5]
 //      [--truth-samples 4096] [--resolution 512] [--target 0.005] [--json out/corpus.json]
-//      [--truth-only 1]
-// The truths are cached under out/corpus-truth/ (keyed by the scene file's bytes, resolution,
+//      [--truth-only 1] [--levels ../shared/assets/godot/zdm2.toml@5,...]
+//      [--variants backprojection,reference-64,reference-256]
+// The truths are cached under out/corpus-truth/ (keyed by the scene file's bytes, its size,
 // samples and the reference's version), so later runs only bake the variants.
 #include <fmt/core.h>
 #include <sys/wait.h>
@@ -39,6 +45,7 @@
 
 #include "core/image_io.h"
 #include "pipeline/bake.h"
+#include "scene/level_file.h"
 #include "scene/scene.h"
 #include "support/image_errors.h"
 
@@ -83,12 +90,13 @@ double median(std::vector<double> v) {
 }
 
 // Peak resident memory of a whole `shadowbake bake` process, MiB.
-double process_peak_mib(const std::string& scene, const Variant& v, int resolution) {
+double process_peak_mib(const std::string& scene, const Variant& v,
+                        const std::vector<std::string>& sizing) {
   const fs::path out =
       fs::temp_directory_path() / ("shadowbake_corpus_mem_" + std::to_string(::getpid()));
-  std::vector<std::string> args = {
-      SB_CLI, "bake",     scene,    "-o",           out.string(),
-      "-q",   "--method", v.method, "--resolution", std::to_string(resolution)};
+  std::vector<std::string> args = {SB_CLI,       "bake", scene,      "-o",
+                                   out.string(), "-q",   "--method", v.method};
+  args.insert(args.end(), sizing.begin(), sizing.end());
   if (v.samples > 0) {
     args.push_back("--samples");
     args.push_back(std::to_string(v.samples));
@@ -146,6 +154,7 @@ struct Measured {
   std::map<std::string, std::int64_t> texels;
   std::map<std::string, sb::MethodStats> stats;
   std::vector<double> scene_runs;
+  std::vector<double> scene_bakes;  // bake_seconds alone (the scene loaded)
   double scene_rmse = 0;
   double peak_mib = NAN;
 };
@@ -171,8 +180,18 @@ std::string ratio_text(const std::optional<double>& reference, double ours,
 
 }  // namespace
 
+// A scene to bake: its file, and how it is sized.
+struct SceneSpec {
+  fs::path file;
+  std::string name;                        // as printed
+  std::optional<double> texels_per_metre;  // a level's density, where given
+  bool level = false;                      // its own sizes and margin, not --resolution
+};
+
 int main(int argc, char** argv) {
   std::vector<std::string> scenes = kDefaultScenes;
+  std::vector<std::string> levels;
+  std::vector<std::string> only_variants;
   int repeat = 5, truth_samples = 4096, resolution = 512;
   double target = 0.005;
   bool truth_only = false;
@@ -195,31 +214,68 @@ int main(int argc, char** argv) {
       json_path = value;
     } else if (key == "--truth-only") {
       truth_only = value == "1";
+    } else if (key == "--levels" || key == "--variants") {
+      std::vector<std::string>& list = key == "--levels" ? levels : only_variants;
+      if (key == "--levels" && scenes == kDefaultScenes) scenes.clear();
+      std::stringstream items(value);
+      for (std::string item; std::getline(items, item, ',');) list.push_back(item);
     } else {
       fmt::print(stderr, "unknown option {}\n", key);
       return 2;
     }
   }
-  const std::vector<Variant> vs = variants();
+  std::vector<Variant> vs;
+  for (const Variant& v : variants())
+    if (only_variants.empty() || v.label == "backprojection" ||
+        std::find(only_variants.begin(), only_variants.end(), v.label) != only_variants.end())
+      vs.push_back(v);
+  // The reference at 64 samples: the speed goal's yardstick and the wrong texels' witness.
+  std::size_t ref64 = 0;
+  for (std::size_t k = 0; k < vs.size(); ++k)
+    if (vs[k].label == "reference-64") ref64 = k;
+  if (ref64 == 0) {
+    fmt::print(stderr, "the variants must include reference-64\n");
+    return 2;
+  }
+  std::vector<SceneSpec> specs;
+  for (const std::string& name : scenes)
+    specs.push_back({fs::path(SB_SOURCE_DIR) / "scenes" / name, name, std::nullopt, false});
+  for (const std::string& item : levels) {
+    SceneSpec spec;
+    spec.level = true;
+    spec.name = item;
+    const std::size_t at = item.rfind('@');
+    spec.file = fs::path(SB_SOURCE_DIR) / item.substr(0, at);
+    if (at != std::string::npos) spec.texels_per_metre = std::stod(item.substr(at + 1));
+    specs.push_back(spec);
+  }
   nlohmann::ordered_json report = nlohmann::ordered_json::array();
   const fs::path cache = fs::path(SB_SOURCE_DIR) / "out" / "corpus-truth";
 
-  for (const std::string& name : scenes) {
-    const fs::path file = fs::path(SB_SOURCE_DIR) / "scenes" / name;
-    auto loaded = sb::load_scene(file);
+  for (const SceneSpec& spec : specs) {
+    const fs::path& file = spec.file;
+    const std::string& name = spec.name;
+    auto loaded =
+        spec.file.extension() == ".toml" ? sb::load_scene(file) : sb::load_level_scene(file);
     if (!loaded) {
       fmt::print(stderr, "{}\n", loaded.error().message);
       return 3;
     }
     sb::Scene scene = *loaded;
-    scene.bake.resolution = resolution;
-    scene.bake.margin = 0;
+    if (!spec.level) {
+      scene.bake.resolution = resolution;
+      scene.bake.margin = 0;
+    } else if (spec.texels_per_metre) {
+      scene.bake.texels_per_metre = *spec.texels_per_metre;
+    }
+    const std::string size_key = spec.level
+                                     ? fmt::format("level/{}", spec.texels_per_metre.value_or(0))
+                                     : std::to_string(resolution);
 
     // The truth, cached by the scene file's bytes (and the reference's own version: its samples
     // cover the part of a light above the horizon since version 2).
-    const std::size_t key =
-        std::hash<std::string>{}(slurp(file) + std::to_string(resolution) + "/" +
-                                 std::to_string(truth_samples) + "/reference-2");
+    const std::size_t key = std::hash<std::string>{}(
+        slurp(file) + size_key + "/" + std::to_string(truth_samples) + "/reference-2");
     const fs::path truth_dir = cache / fmt::format("{:016x}", key);
     std::map<std::string, sb::Image> truth;
     for (const auto& obj : scene.objects) {
@@ -249,6 +305,9 @@ int main(int argc, char** argv) {
     // The variants, interleaved repeat by repeat so that load on the machine hits all alike.
     std::vector<Measured> measured(vs.size());
     std::vector<std::string> receivers;
+    // The default's and the reference at 64's images of the first repeat, for the wrong texels.
+    std::map<std::size_t, std::map<std::string, sb::Image>> first_images;
+    std::map<std::string, std::vector<std::uint8_t>> covered_of;
     for (int rep = 0; rep < repeat; ++rep) {
       for (std::size_t k = 0; k < vs.size(); ++k) {
         if (rep > 0 && !vs[k].repeat) continue;
@@ -269,8 +328,10 @@ int main(int argc, char** argv) {
           const double share = total_texels > 0 ? double(r.covered_texels) / total_texels : 0;
           measured[k].seconds[r.name].push_back(r.seconds + share * result->load_seconds);
           if (rep == 0) {
+            if (k == 0 || k == ref64) first_images[k][r.name] = r.image;
             // Covered texels of this bake (margin 0: every texel with a value is covered).
             const image_errors::Errors e = image_errors::errors(r.image, truth[r.name], r.covered);
+            if (k == 0) covered_of[r.name] = r.covered;
             measured[k].rmse[r.name] = e.rmse;
             measured[k].texels[r.name] = e.count;
             measured[k].stats[r.name] = r.report.stats;
@@ -279,10 +340,15 @@ int main(int argc, char** argv) {
         }
         if (rep == 0) measured[k].scene_rmse = image_errors::pooled(parts).rmse;
         measured[k].scene_runs.push_back(result->load_seconds + result->bake_seconds);
+        measured[k].scene_bakes.push_back(result->bake_seconds);
       }
     }
+    std::vector<std::string> sizing;
+    if (!spec.level) sizing = {"--resolution", std::to_string(resolution)};
+    if (spec.texels_per_metre)
+      sizing = {"--texels-per-metre", fmt::format("{}", *spec.texels_per_metre)};
     for (std::size_t k = 0; k < vs.size(); ++k)
-      if (vs[k].memory) measured[k].peak_mib = process_peak_mib(file.string(), vs[k], resolution);
+      if (vs[k].memory) measured[k].peak_mib = process_peak_mib(file.string(), vs[k], sizing);
 
     // Per receiver: the default's time, RMSE and routes; the references'; the ratios.
     const Measured& ours = measured[0];
@@ -323,7 +389,7 @@ int main(int argc, char** argv) {
                  route("traced_fraction"));
       for (std::size_t k = 1; k < vs.size(); ++k)
         fmt::print(" {:.3f}, {:.4f} |", seconds(k, r), measured[k].rmse.at(r));
-      fmt::print(" {:.2f} | {} | {} |\n", seconds(2, r) / t, ratio_text(at_target, t),
+      fmt::print(" {:.2f} | {} | {} |\n", seconds(ref64, r) / t, ratio_text(at_target, t),
                  ratio_text(at_ours, t, beyond));
       auto& j = entry["receivers"][r];
       j["texels"] = ours.texels.at(r);
@@ -337,6 +403,29 @@ int main(int argc, char** argv) {
       j["reference_seconds_at_our_rmse_at_least"] =
           beyond ? nlohmann::ordered_json(*beyond) : nlohmann::ordered_json();
     }
+    // Wrong texels: off the truth by more than 0.25 where the reference at 64 is within 0.1.
+    std::int64_t wrong = 0;
+    for (const std::string& r : receivers) {
+      const sb::Image& ours = first_images[0][r];
+      const sb::Image& witness = first_images[ref64][r];
+      const sb::Image& t = truth[r];
+      const std::vector<std::uint8_t>& covered = covered_of[r];
+      for (std::size_t i = 0; i < covered.size(); ++i) {
+        if (!covered[i]) continue;
+        bool off = false;
+        for (int c = 0; c < t.channels; ++c) {
+          const std::size_t at = i * std::size_t(t.channels) + std::size_t(c);
+          off = off || (std::abs(double(ours.pixels[at]) - double(t.pixels[at])) > 0.25 &&
+                        std::abs(double(witness.pixels[at]) - double(t.pixels[at])) <= 0.1);
+        }
+        if (off) {
+          if (wrong < 10)
+            fmt::print(stderr, "{}: wrong texel {} ({}, {})\n", name, r, i % std::size_t(t.width),
+                       i / std::size_t(t.width));
+          ++wrong;
+        }
+      }
+    }
     // The scene as a whole.
     const auto scene_curve = curve([&](std::size_t k) { return median(measured[k].scene_runs); },
                                    [&](std::size_t k) { return measured[k].scene_rmse; });
@@ -345,15 +434,23 @@ int main(int argc, char** argv) {
     const auto scene_at_ours = time_at(scene_curve, ours.scene_rmse);
     const auto scene_beyond = time_beyond(scene_curve, ours.scene_rmse);
     fmt::print("| **scene** | {:.3f} | {:.4f} | peak {:.0f} MiB (reference-64: {:.0f}) |", scene_t,
-               ours.scene_rmse, ours.peak_mib, measured[2].peak_mib);
+               ours.scene_rmse, ours.peak_mib, measured[ref64].peak_mib);
     for (std::size_t k = 1; k < vs.size(); ++k)
       fmt::print(" {:.3f}, {:.4f} |", median(measured[k].scene_runs), measured[k].scene_rmse);
-    fmt::print(" {:.2f} | {} | {} |\n", median(measured[2].scene_runs) / scene_t,
+    fmt::print(" {:.2f} | {} | {} |\n", median(measured[ref64].scene_runs) / scene_t,
                ratio_text(scene_at_target, scene_t),
                ratio_text(scene_at_ours, scene_t, scene_beyond));
+    const double bake_t = median(ours.scene_bakes),
+                 ref64_bake = median(measured[ref64].scene_bakes);
+    fmt::print(
+        "\nIn-process bake (scene loaded): {:.3f} s against the reference at 64's {:.3f} s "
+        "({:.2f}x); wrong texels: {}\n",
+        bake_t, ref64_bake, ref64_bake / bake_t, wrong);
     auto& j = entry["scene_totals"];
+    j["wrong_texels"] = wrong;
     for (std::size_t k = 0; k < vs.size(); ++k)
       j[vs[k].label] = {{"seconds", median(measured[k].scene_runs)},
+                        {"bake_seconds", median(measured[k].scene_bakes)},
                         {"rmse", measured[k].scene_rmse},
                         {"peak_mib", std::isnan(measured[k].peak_mib)
                                          ? nlohmann::ordered_json()

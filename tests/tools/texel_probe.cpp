@@ -3,16 +3,19 @@
 // sample counts, the centre ray's first hit, the texel's own shaft's polygons from the whole
 // hierarchy and the estimator's value over them, and the whole method's value for the texel.
 //
-// Run: build/shadowbake_texel_probe SCENE.toml RECEIVER LIGHT X Y [X Y ...]
+// Run: build/shadowbake_texel_probe SCENE RECEIVER LIGHT X Y [X Y ...] (SCENE: a scene file or a
+// level)
 #include <fmt/core.h>
 
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include "methods/backprojection/backprojection_bake.h"
 #include "methods/backprojection/penumbra_estimator.h"
 #include "occluders/shadow_rays.h"
+#include "scene/level_file.h"
 #include "support/built_scene.h"
 #include "texels/lightmap_sizes.h"
 
@@ -22,7 +25,8 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "usage: {} SCENE RECEIVER LIGHT X Y [X Y ...]\n", argv[0]);
     return 2;
   }
-  auto scene = load_scene(argv[1]);
+  const std::filesystem::path file = argv[1];
+  auto scene = file.extension() == ".toml" ? load_scene(file) : load_level_scene(file);
   if (!scene) {
     fmt::print(stderr, "{}\n", scene.error().message);
     return 1;
@@ -74,9 +78,11 @@ int main(int argc, char** argv) {
         fmt::print("  reference {}: V {:.4f}\n", samples, v.x());
     }
     const Vec3 dir = L.centre() - o;
-    const double hit = built.rays->first_hit(o, dir, 1.0);
+    const RayScene::Hit hit = built.rays->first_hit_face(o, dir, 1.0);
     fmt::print("  centre ray: {}\n",
-               hit < 0 ? std::string("clear") : fmt::format("hit at {:.4f} m", hit * dir.norm()));
+               hit.face < 0 ? std::string("clear")
+                            : fmt::format("hit at {:.3g} m, triangle {}", hit.t * dir.norm(),
+                                          built.culler->triangle_of_face(hit.face)));
     std::vector<ShaftPolygon> polygons;
     const auto listed = built.culler->shaft_polygons(o, p, n, L, nullptr, 100000, polygons);
     fmt::print("  own shaft: {} polygons ({})\n", polygons.size(),
@@ -92,6 +98,16 @@ int main(int argc, char** argv) {
           fmt::print(" ({:.4f} {:.4f} {:.4f})", c.x(), c.y(), c.z());
         fmt::print("\n");
       }
+    }
+    std::vector<BlockerPolygon> whole;
+    for (const ShaftPolygon& poly : polygons)
+      whole.push_back(
+          {built.culler->triangle_corners(poly.triangle), 3, poly.normal, poly.triangle});
+    {
+      const PenumbraEstimator estimator(L, 32, offset);
+      const PenumbraSample s =
+          estimator.visibility(p, n, o, Blockers{&whole, nullptr, nullptr}, 0, nullptr);
+      fmt::print("  estimator over its shaft's whole triangles, 32 rows: V {:.4f}\n", s.visibility);
     }
     for (int rows : {32, 64}) {
       const PenumbraEstimator estimator(L, rows, offset);

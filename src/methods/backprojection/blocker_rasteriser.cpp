@@ -82,7 +82,7 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
   if (!(h_origin > f.clip_height) || n == 0) return;  // the origin is on or behind the light
   const double s_origin = f.s_axis.dot(origin - f.centre);
   const double t_origin = f.t_axis.dot(origin - f.centre);
-  const double h_top = h_origin * (1 - 1e-9);  // blockers above this are behind the origin
+  const double h_top = origin_ceiling(h_origin, light_offset);  // above: behind the origin
   // The texel's horizon in the light's plane: above it where x·s + y·t + z > 0.
   const Vec3 horizon(normal.dot(f.s_axis), normal.dot(f.t_axis), normal.dot(f.centre - position));
   const auto is_above = [&](const Vec2& p) {
@@ -131,8 +131,78 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
       hi[std::size_t(r)] = std::max(hi[std::size_t(r)], x);
     }
   };
+  // A point (s, t) of the light's plane in world space: the frame's axes may be scaled (a
+  // sphere's rows are those of the unit disk).
+  const Vec3 s_step = f.s_axis / f.s_axis.squaredNorm(), t_step = f.t_axis / f.t_axis.squaredNorm();
+  // A polygon's plane (unit normal `normal`, at signed distance `height` from the origin) near
+  // the origin: the rays that meet it within the surface offset of the origin skip it there.
+  struct Skip {
+    Vec3 normal;
+    double height = 0;
+  };
+  // Along row r, the s where the ray from the origin meets the skip's plane within the offset:
+  // |x − o| < offset at x = o + λ·w, λ = height / (normal·w) > 0, w = L(s) − o, which is
+  // height²·|w|² < offset²·(normal·w)² (a quadratic in s) with normal·w of height's sign (a
+  // half-line): at most two intervals, ends possibly infinite.
+  struct Span {
+    double a, b;
+  };
+  const auto skipped = [&](const Skip& skip, int r, std::array<Span, 2>& out) {
+    const Vec3 w0 = f.centre + (rows.first + r * rows.pitch) * t_step - origin;
+    const double h2 = skip.height * skip.height, o2 = light_offset * light_offset;
+    const double mw = skip.normal.dot(w0), ms = skip.normal.dot(s_step);
+    const double qa = h2 * s_step.squaredNorm() - o2 * ms * ms;
+    const double qb = 2 * (h2 * w0.dot(s_step) - o2 * mw * ms);
+    const double qc = h2 * w0.squaredNorm() - o2 * mw * mw;
+    // Where the quadratic is negative.
+    std::array<Span, 2> negative;
+    int count = 0;
+    const double big = kInfinity;
+    if (qa == 0) {
+      if (qb > 0)
+        negative[std::size_t(count++)] = {-big, -qc / qb};
+      else if (qb < 0)
+        negative[std::size_t(count++)] = {-qc / qb, big};
+      else if (qc < 0)
+        negative[std::size_t(count++)] = {-big, big};
+    } else {
+      const double disc = qb * qb - 4 * qa * qc;
+      if (disc > 0) {
+        const double root = std::sqrt(disc);
+        // Numerically stable roots.
+        const double q = -0.5 * (qb + std::copysign(root, qb));
+        double x0 = q / qa, x1 = q != 0 ? qc / q : x0;
+        if (x0 > x1) std::swap(x0, x1);
+        if (qa > 0) {
+          negative[std::size_t(count++)] = {x0, x1};
+        } else {
+          negative[std::size_t(count++)] = {-big, x0};
+          negative[std::size_t(count++)] = {x1, big};
+        }
+      } else if (qa < 0) {
+        negative[std::size_t(count++)] = {-big, big};
+      }
+    }
+    // Towards the plane: sign(mw + s·ms) = sign(height).
+    Span towards{-big, big};
+    const double sign = skip.height > 0 ? 1.0 : -1.0;
+    if (ms * sign > 0)
+      towards.a = -mw / ms;
+    else if (ms * sign < 0)
+      towards.b = -mw / ms;
+    else if (mw * sign <= 0)
+      towards = {big, -big};  // never
+    int n_out = 0;
+    for (int k = 0; k < count; ++k) {
+      const Span c{std::max(negative[std::size_t(k)].a, towards.a),
+                   std::min(negative[std::size_t(k)].b, towards.b)};
+      if (c.a < c.b) out[std::size_t(n_out++)] = c;
+    }
+    return n_out;
+  };
   bool covers = false;  // the last region committed covered every row from end to end
-  const auto commit = [&] {
+  // Each row's chord within the light, less what `skip` leaves out, into the rows.
+  const auto commit = [&](const Skip* skip) {
     bool reaches = false;
     covers = r0 == 0 && r1 == n - 1;
     for (int r = r0; r <= r1; ++r) {
@@ -142,8 +212,22 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
       const double b = std::min(hi[std::size_t(r)], rows.leave[std::size_t(r)]);
       if (!(a < b)) continue;
       const double t = rows.first + r * rows.pitch;
-      reaches = reaches || is_above(Vec2(a, t)) || is_above(Vec2(b, t));
-      blocked.add(rows, r, a, b);
+      std::array<Span, 2> cut;
+      const int cuts = skip ? skipped(*skip, r, cut) : 0;
+      if (cuts == 2 && cut[1].a < cut[0].a) std::swap(cut[0], cut[1]);
+      // [a, b] less the cuts, piece by piece.
+      double from = a;
+      for (int k = 0; k <= cuts; ++k) {
+        const double to = k < cuts ? std::min(cut[std::size_t(k)].a, b) : b;
+        if (from < to) {
+          reaches = reaches || is_above(Vec2(from, t)) || is_above(Vec2(to, t));
+          blocked.add(rows, r, from, to);
+        }
+        if (k < cuts) {
+          if (cut[std::size_t(k)].b > a && cut[std::size_t(k)].a < b) covers = false;
+          from = std::max(from, cut[std::size_t(k)].b);
+        }
+      }
     }
     return reaches;
   };
@@ -159,7 +243,7 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
   // (what lies in the texel's shaft, and may hide some of the light).
   std::array<Vec2, kPieceVertices> projected;
   std::array<Vec3, kPieceVertices> clipped, below;
-  const auto add = [&](const Vec3* v, int count) {
+  const auto add = [&](const Vec3* v, int count, const Skip* skip = nullptr) {
     // Heights over the light's plane: a polygon wholly within the slab is taken as it is.
     std::array<double, kPieceVertices> height;
     bool inside = true, beyond = true, behind = true;
@@ -214,14 +298,12 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
     begin(t_lo, t_hi);
     for (int k = 0; k < m; ++k)
       edge(projected[std::size_t(k)], projected[std::size_t((k + 1) % m)]);
-    return commit() || corner_in_light;
+    return commit(skip) || (corner_in_light && !skip);
   };
 
   // A polygon of a blocker. A shadow ray ignores what it meets within the surface offset of its
-  // origin (RayScene): the polygon's points within that distance (a disk of its plane, taken as
-  // the octagon around it) block nothing. What is left is convex in pieces: the part beyond
-  // each side of the octagon and within the sides before it.
-  std::array<Vec3, kPieceVertices> piece, scratch;
+  // origin (RayScene): where the polygon comes that near, the rows leave out, exactly, the part
+  // of each chord whose rays meet its plane within that distance (commit's skip).
   // Below the texel's horizon (and the origin's, which may lie a little below it on a curved
   // surface): no segment from the origin to a point of the light above the horizon gets there.
   const double floor_level = std::min(normal.dot(position), normal.dot(origin));
@@ -230,38 +312,11 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
     for (int k = 0; k < count && below_horizon; ++k) below_horizon = normal.dot(v[k]) < floor_level;
     if (below_horizon) return false;
     const double plane = plane_normal.dot(origin - v[0]);
-    const double radius2 = light_offset * light_offset - plane * plane;
-    if (gap >= light_offset || !(radius2 > 0)) return add(v, count);
-    bool reaches = false;
-    const Vec3 foot = origin - plane * plane_normal;
-    const Vec3 u = any_orthogonal(plane_normal), w = plane_normal.cross(u);
-    const double reach = std::sqrt(radius2);  // the octagon's inradius: the disk's radius
-    for (int side = 0; side < 8; ++side) {
-      int m = count;
-      std::copy_n(v, m, piece.begin());
-      // Keep where (x − foot)·dir ≥ reach for this side, and ≤ reach for the sides before it.
-      const auto keep = [&](const Vec3& dir, bool outside) {
-        int out = 0;
-        for (int k = 0; k < m; ++k) {
-          const Vec3& a = piece[std::size_t(k)];
-          const Vec3& b = piece[std::size_t((k + 1) % m)];
-          const double da = (outside ? 1 : -1) * (dir.dot(a - foot) - reach);
-          const double db = (outside ? 1 : -1) * (dir.dot(b - foot) - reach);
-          if (out + 2 > kPieceVertices) break;
-          if (da >= 0) scratch[std::size_t(out++)] = a;
-          if ((da < 0 && db > 0) || (da > 0 && db < 0))
-            scratch[std::size_t(out++)] = a + (b - a) * (da / (da - db));
-        }
-        m = out;
-        std::copy_n(scratch.begin(), m, piece.begin());
-      };
-      for (int k = 0; k <= side && m >= 3; ++k) {
-        const double angle = k * std::numbers::pi / 4;
-        keep(std::cos(angle) * u + std::sin(angle) * w, k == side);
-      }
-      if (m >= 3) reaches = add(piece.data(), m) || reaches;
-    }
-    return reaches;
+    if (gap >= light_offset || !(plane * plane < light_offset * light_offset)) return add(v, count);
+    // The origin on the polygon's plane: a ray either stays in it or leaves it at once.
+    if (plane == 0) return false;
+    const Skip skip{plane_normal, -plane};
+    return add(v, count, &skip);
   };
   const auto gap_to = [&](const Vec3& lo_corner, const Vec3& hi_corner) {
     return (lo_corner - origin).cwiseMax(origin - hi_corner).cwiseMax(Vec3::Zero()).norm();
@@ -461,7 +516,7 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
       if (hi_t < t_first || lo_t > t_last || hi_s < extent_lo || lo_s > extent_hi) continue;
       begin(lo_t, hi_t);
       for (const auto& [p, q] : outline) edge(p, q);
-      const bool reaches = commit() || outline_in_light;
+      const bool reaches = commit(nullptr) || outline_in_light;
       settle(reaches, edge_distance);
       continue;
     }
@@ -480,7 +535,7 @@ void rasterise_polygons_and_solids(const RasterTarget& target,
       near_edge(p, q, solid.corners[std::size_t(ends[0])], solid.corners[std::size_t(ends[1])],
                 edge_distance);
     }
-    settle(commit() || corner_in_light, edge_distance);
+    settle(commit(nullptr) || corner_in_light, edge_distance);
   }
 }
 

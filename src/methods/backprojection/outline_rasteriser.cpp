@@ -221,7 +221,7 @@ void rasterise_outline(const RasterTarget& target, const BlockerOutline& outline
   const int n = rows.count;
   const double h_origin = f.normal.dot(origin - f.centre);
   if (!(h_origin > f.clip_height) || n == 0) return;
-  const double h_top = h_origin * (1 - 1e-9);
+  const double h_top = origin_ceiling(h_origin, target.light_offset);
   const double s_origin = f.s_axis.dot(origin - f.centre);
   const double t_origin = f.t_axis.dot(origin - f.centre);
   // Facing the origin turns counter-clockwise in (s, t) when the frame's axes do, seen from it.

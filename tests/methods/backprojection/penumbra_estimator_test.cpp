@@ -173,6 +173,26 @@ TEST(PenumbraEstimator, OnePolygonCoveringTheLightIsAnUmbra) {
   EXPECT_EQ(partly.umbra, PenumbraSample::kNoUmbra);
 }
 
+// A polygon listed by a key that names many triangles (a dense mesh's: ShaftCuller::kMeshKey)
+// reports the triangle it comes from as its umbra: samples that report one umbra lie in one
+// convex umbra, which a mesh's union is not (zdm2's wrong texels: a lit slit between two of a
+// mesh's triangles, interpolated over as 0).
+TEST(PenumbraEstimator, AMeshsPolygonReportsItsOwnTriangleAsTheUmbra) {
+  const Light light(rectangle_light());
+  const PenumbraEstimator estimator(light, 32, 1e-4);
+  const Vec3 n(0, 0, 1), y(0.1, -0.2, 0);
+  const std::array<Vec3, 3> corners = {Vec3(-3, -3, 1), Vec3(3, -3, 1), Vec3(0, 3, 1)};
+  constexpr std::uint32_t kMesh = 0x40000000u;  // ShaftCuller::kMeshKey | 0
+  const std::vector<BlockerPolygon> of_mesh = {
+      {corners.data(), 3, Vec3(0, 0, 1), kMesh, /*source=*/42}};
+  std::vector<std::uint32_t> blocking;
+  const PenumbraSample covered =
+      estimator.visibility(y, n, y, Blockers{&of_mesh, nullptr, nullptr}, 0, &blocking);
+  EXPECT_EQ(covered.visibility, 0.0);
+  EXPECT_EQ(covered.umbra, 42u);
+  EXPECT_EQ(blocking, std::vector<std::uint32_t>{kMesh}) << "listed by its key";
+}
+
 // triangle_hides_light, the refinement's proof that a cell lies in one triangle's umbra: never
 // where the exact oracle sees any of the light, and for most of the triangles that hide it all.
 TEST(PenumbraEstimator, ATriangleHidesTheLightOnlyWhereTheOracleSeesNone) {
