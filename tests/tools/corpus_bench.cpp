@@ -361,12 +361,20 @@ int main(int argc, char** argv) {
       for (std::size_t k = 1; k < vs.size(); ++k) points.emplace_back(time(k), error(k));
       return points;
     };
-    fmt::print("\n## {} ({}², truth: reference-{})\n\n", name, resolution, truth_samples);
-    fmt::print(
-        "| receiver | backprojection s | RMSE | clear / exact / interpolated / traced | "
-        "reference-16 s, RMSE | -64 | -256 | -1024 | ref-64 / ours | at RMSE {} | at our RMSE "
-        "|\n|---|---|---|---|---|---|---|---|---|---|---|\n",
-        target);
+    fmt::print("\n## {} ({}, truth: reference-{})\n\n", name,
+               spec.level ? (spec.texels_per_metre
+                                 ? fmt::format("{} texels per metre", *spec.texels_per_metre)
+                                 : std::string("its own sizes"))
+                          : fmt::format("{}²", resolution),
+               truth_samples);
+    std::string columns, rule;
+    for (std::size_t k = 1; k < vs.size(); ++k) {
+      columns += " " + vs[k].label + " s, RMSE |";
+      rule += "---|";
+    }
+    fmt::print("| receiver | backprojection s | RMSE | clear / exact / interpolated / traced |{} "
+               "ref-64 / ours | at RMSE {} | at our RMSE |\n|---|---|---|---|{}---|---|---|\n",
+               columns, target, rule);
     nlohmann::ordered_json entry;
     entry["scene"] = name;
     entry["resolution"] = resolution;
