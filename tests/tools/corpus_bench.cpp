@@ -372,9 +372,10 @@ int main(int argc, char** argv) {
       columns += " " + vs[k].label + " s, RMSE |";
       rule += "---|";
     }
-    fmt::print("| receiver | backprojection s | RMSE | clear / exact / interpolated / traced |{} "
-               "ref-64 / ours | at RMSE {} | at our RMSE |\n|---|---|---|---|{}---|---|---|\n",
-               columns, target, rule);
+    fmt::print(
+        "| receiver | backprojection s | RMSE | clear / exact / interpolated / traced |{} "
+        "ref-64 / ours | at RMSE {} | at our RMSE |\n|---|---|---|---|{}---|---|---|\n",
+        columns, target, rule);
     nlohmann::ordered_json entry;
     entry["scene"] = name;
     entry["resolution"] = resolution;

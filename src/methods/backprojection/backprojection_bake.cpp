@@ -34,6 +34,8 @@ namespace {
 constexpr std::size_t kOutlineTriangles = 32;
 // The most candidates a tile lists before its texels search the hierarchy one by one.
 constexpr std::size_t kTileCandidates = 1 << 16;
+// A texel whose patch lists more polygons than this first tries the ray to the light's centre.
+constexpr std::size_t kRayFirst = 8;
 
 // A listed tile's blockers as its texels' evaluations take them: triangles one by one, and the
 // convex solids its texels all lie outside of whole, each with the edges that may be on its
@@ -287,17 +289,27 @@ class LightPairs final : public PairSource {
     if (light_.shape() == LightShape::sphere &&
         (origin - p).norm() > kParallax * (light_.centre() - p).norm())
       return traced();
-    // The light's centre first: where the ray to it meets a triangle that hides all of the light
-    // alone, the texel lies in that triangle's umbra, exactly, whatever else its shaft holds.
-    if (const RayScene::Hit hit = in_.rays->first_hit_face(origin, light_.centre() - origin, 1.0);
+    // The light's centre first, where the texel's blockers are many (not listed, a dense mesh's
+    // outline, or more polygons than kRayFirst): where the ray to it meets a triangle that hides
+    // all of the light alone, the texel lies in that triangle's umbra, exactly, whatever else its
+    // shaft holds. (A few polygons or convex solids cost the estimator less than the ray.)
+    const std::int32_t at = prepared_of_[patch_index(tx.x, tx.y)];
+    const bool busy = at < 0 || !prepared_[std::size_t(at)].outlines.empty() ||
+                      prepared_[std::size_t(at)].polygons.size() > kRayFirst;
+    if (const RayScene::Hit hit =
+            busy ? in_.rays->first_hit_face(origin, light_.centre() - origin, 1.0)
+                 : RayScene::Hit();
         hit.face >= 0) {
       const std::uint32_t triangle = in_.culler->triangle_of_face(hit.face);
       if (triangle_hides_light(light_, in_.culler->triangle_corners(triangle), origin, offset_)) {
         out.route = TexelRoute::umbra;
         out.visibility = 0;
         out.nearest = 0;  // the shaft is not listed: nearer blockers are unknown
-        out.triangles.assign(1, in_.culler->blocker_key(triangle));
-        out.umbra = triangle;
+        const std::uint32_t key = in_.culler->blocker_key(triangle);
+        out.triangles.assign(1, key);
+        // A convex solid's face: the solid's umbra, which holds the face's (and is convex), so
+        // that samples behind different faces of one box lie in one umbra.
+        out.umbra = key & ShaftCuller::kSolidKey ? key : triangle;
         return;
       }
     }
@@ -308,7 +320,7 @@ class LightPairs final : public PairSource {
     thread_local std::vector<ShaftPolygon> polygons;
     blockers.clear();
     PenumbraSample sample;
-    if (const std::int32_t at = prepared_of_[patch_index(tx.x, tx.y)]; at >= 0) {
+    if (at >= 0) {
       const TileBlockers& prepared = prepared_[std::size_t(at)];
       sample = estimator_.visibility(
           p, n, origin, Blockers{&prepared.polygons, &prepared.solids, &prepared.outlines},

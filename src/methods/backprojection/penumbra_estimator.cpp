@@ -593,6 +593,25 @@ bool triangle_hides_light(const Light& light, const Vec3* corners, const Vec3& o
   }
   if ((lo - origin).cwiseMax(origin - hi).cwiseMax(Vec3::Zero()).norm() < light_offset)
     return false;
+  // First a cheap necessary test (a dense mesh's small triangles fail it): the triangle projected
+  // from the origin onto the light's plane holds the light, so its inscribed circle is no smaller
+  // than the light's (a rectangle's half its shorter side, a disk's radius).
+  if (light.shape() != LightShape::polygon) {
+    const double inradius = light.shape() == LightShape::disk
+                                ? light.desc().radius
+                                : 0.5 * std::min(light.desc().width, light.desc().height);
+    std::array<Vec3, 3> projected;
+    for (int k = 0; k < 3; ++k) {
+      const double h = m.dot(corners[k] - light.centre());
+      projected[std::size_t(k)] = origin + (corners[k] - origin) * (h_origin / (h_origin - h));
+    }
+    const double area2 =
+        (projected[1] - projected[0]).cross(projected[2] - projected[0]).norm();  // twice
+    const double perimeter = (projected[1] - projected[0]).norm() +
+                             (projected[2] - projected[1]).norm() +
+                             (projected[0] - projected[2]).norm();
+    if (area2 < inradius * perimeter * (1 - 1e-6)) return false;
+  }
   // The light inside the cone from the origin over the triangle: on the inner side of each plane
   // through the origin and an edge, with a margin of a billionth against rounding.
   std::array<Vec3, 4> outline;

@@ -4,12 +4,15 @@
 // pairs by route).
 //
 //   clear         The shaft test (occluders/shaft_culling.cpp) finds no blocker triangle between
-//                 the texel and the light, for its tile of 8 × 8 texels or for the texel alone:
-//                 V = 1 exactly, nothing else is computed.
-//   umbra         The shaft test's other sure answer: one of its tile's candidate triangles hides
-//                 all of the light from the eight corners of the tile's box of ray origins, so
-//                 from every texel of it (a triangle's umbra is convex): V = 0 exactly, nothing
-//                 else is computed.
+//                 the texel and the light, for its patch (its tile of 8 × 8 texels' piece of
+//                 surface it lies on) or for the texel alone: V = 1 exactly, nothing else is
+//                 computed.
+//   umbra         The shaft test's other sure answer: one triangle hides all of the light from
+//                 the eight corners of the patch's box of ray origins, so from every texel of it
+//                 (a triangle's umbra is convex): the triangle the ray from the box's centre to
+//                 the light's centre meets, or one of the patch's candidates; or, for one texel,
+//                 the triangle the ray from its origin to the light's centre meets hides all of
+//                 the light from it. V = 0 exactly, nothing else is computed.
 //   convolved     The convolution (methods/convolution) where it is exact: a planar receiver
 //                 parallel to the light and blockers in planes parallel to both, so its penumbra
 //                 error bound is zero and its value stands in the penumbra too.

@@ -23,12 +23,15 @@ constexpr int kTile = TileShafts::kTile;
 // this many times the larger of their faces' texel steps (TexelSpace::face_texel_sizes): a texel
 // that takes its face's nearest point (a chart's border) may lie a step beyond it.
 constexpr float kJoinSteps = 2.0f;
+// The most candidates a patch tries one by one as the triangle its umbra is (below).
+constexpr std::size_t kUmbraCandidates = 256;
 
 // A tile's patches as one band's task finds them.
 struct TilePatches {
   std::vector<TileShafts::Patch> patches;
   std::array<std::uint8_t, kTile * kTile> at{};  // per pixel, where there are several
-  float step = 0;  // the largest texel step of its texels' faces (TexelSpace::face_texel_sizes)
+  float step = 0;      // the largest texel step of its texels' faces (TexelSpace::face_texel_sizes)
+  bool whole = false;  // one patch from its block's summary: the light reaches all its texels
 };
 
 int root_of(std::array<std::uint8_t, kTile * kTile>& parent, int i) {
@@ -68,36 +71,30 @@ TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const Sha
   const int bands = (tiles.tiles_y + g - 1) / g;
   std::vector<std::vector<TilePatches>> found(static_cast<std::size_t>(bands));
   const auto test = [&](TileShafts::Patch& patch, const std::vector<std::uint32_t>* among) {
-    std::array<Vec3, 8> corners;
-    for (int k = 0; k < 8; ++k) corners[std::size_t(k)] = patch.origins.corner(k);
-    // The triangle the ray from the box's centre to the light's centre meets first, where it
-    // hides all of the light from the box's corners: an umbra, without listing its shaft (the
-    // shaft of a patch behind a wall from a small light crosses much of a level).
-    if (umbrae) {
-      const Vec3 from = patch.origins.centre();
-      const RayScene::Hit hit = rays.first_hit_face(from, light.centre() - from, 1.0);
-      if (hit.face >= 0 &&
-          hides_from_all(light, culler.triangle_corners(culler.triangle_of_face(hit.face)), corners,
-                         offset)) {
-        patch.kind = Kind::umbra;
-        return;
-      }
-    }
     std::vector<std::uint32_t>& list = patch.candidates;
     if (!culler.tile_candidates(patch.origins, light, max, list, among)) {
       patch.kind = Kind::clear;
-    } else if (list.empty()) {
-      patch.kind = Kind::all;
-    } else {
-      patch.kind = Kind::listed;
-      std::sort(list.begin(), list.end());
-      if (!umbrae) return;
-      for (std::uint32_t c : list)
-        if (hides_from_all(light, culler.triangle_corners(c), corners, offset)) {
-          patch.kind = Kind::umbra;
-          return;
-        }
+      return;
     }
+    patch.kind = list.empty() ? Kind::all : Kind::listed;
+    std::sort(list.begin(), list.end());
+    if (!umbrae) return;
+    // An umbra: a triangle that hides all of the light from the box's corners. Each candidate is
+    // tried where they are few; where they are many (a dense mesh's small triangles, none of
+    // which hides a light alone: trying them all cost the dense scene a third of its bake), or
+    // not listed, the one the ray from the box's centre to the light's centre meets first.
+    std::array<Vec3, 8> corners;
+    for (int k = 0; k < 8; ++k) corners[std::size_t(k)] = patch.origins.corner(k);
+    const auto hides = [&](std::uint32_t triangle) {
+      return hides_from_all(light, culler.triangle_corners(triangle), corners, offset);
+    };
+    if (patch.kind == Kind::listed && list.size() <= kUmbraCandidates) {
+      if (std::any_of(list.begin(), list.end(), hides)) patch.kind = Kind::umbra;
+      return;
+    }
+    const Vec3 from = patch.origins.centre();
+    const RayScene::Hit hit = rays.first_hit_face(from, light.centre() - from, 1.0);
+    if (hit.face >= 0 && hides(culler.triangle_of_face(hit.face))) patch.kind = Kind::umbra;
   };
   tbb::parallel_for(tbb::blocked_range<int>(0, bands), [&](const auto& r) {
     for (int band = r.begin(); band != r.end(); ++band) {
@@ -123,10 +120,7 @@ TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const Sha
               TileShafts::Patch& patch = tile.patches.emplace_back();
               patch.origins.extend(Vec3(lo + shift));
               patch.origins.extend(Vec3(hi + shift));
-              for (int y = ty * kTile; y < std::min(space.height, (ty + 1) * kTile); ++y)
-                for (int x = tx * kTile; x < std::min(space.width, (tx + 1) * kTile); ++x)
-                  if (const std::int32_t t = grid.texel(x, y); t >= 0)
-                    tiles.reached[std::size_t(t)] = 1;
+              tile.whole = true;  // its texels' `reached` set below, row by row
               continue;
             }
           }
@@ -178,6 +172,12 @@ TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const Sha
                 space.ray_origin(std::size_t(texel[std::size_t(j)]), offset));
           }
         }
+      // The whole tiles' texels are reached, in one pass over the band's rows.
+      grid.for_each(
+          ty0 * kTile, std::min(space.height, ty1 * kTile), [&](std::size_t t, int x, int y) {
+            if (out[tiles.tile_of(x, y) - std::size_t(ty0) * std::size_t(tiles.tiles_x)].whole)
+              tiles.reached[t] = 1;
+          });
       // A group of g × g tiles on one piece of surface (its joint box no larger than one piece
       // of its texel steps could fill) whose joint box's shaft is clear is clear throughout (each
       // patch's shaft lies inside it); otherwise its patches are tested one by one, among the
