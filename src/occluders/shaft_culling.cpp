@@ -25,6 +25,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <array>
@@ -506,13 +507,18 @@ ShaftCuller::ShaftCuller(const std::vector<const Mesh*>& blockers)
     }
     mesh_ends.push_back(impl_->tris.size());
   }
-  BlockerSolids found = find_solids(corners, mesh_ends);
-  for (std::size_t i = 0; i < impl_->tris.size(); ++i) impl_->tris[i].solid = found.solid_of[i];
+  // The solids and the tree do not depend on each other: found side by side (a dense mesh's
+  // 100,000 triangles take a tenth of a second each), the solids then given to each triangle
+  // by its index in the input.
+  BlockerSolids found;
+  tbb::parallel_invoke([&] { found = find_solids(corners, mesh_ends); },
+                       [&] {
+                         if (impl_->tris.empty()) return;
+                         impl_->nodes.reserve(2 * impl_->tris.size() / kLeafSize + 2);
+                         impl_->build(0, int(impl_->tris.size()));
+                       });
+  for (Tri& t : impl_->tris) t.solid = found.solid_of[std::size_t(t.source)];
   impl_->solids = std::move(found.solids);
-  if (!impl_->tris.empty()) {
-    impl_->nodes.reserve(2 * impl_->tris.size() / kLeafSize + 2);
-    impl_->build(0, int(impl_->tris.size()));
-  }
   // Neighbours across edges, renumbered to where the build put each triangle.
   std::vector<int> where(impl_->tris.size());
   for (std::size_t i = 0; i < impl_->tris.size(); ++i)
