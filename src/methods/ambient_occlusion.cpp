@@ -28,8 +28,14 @@ Image bake_ambient_occlusion(const TexelSpace& space, const AmbientOcclusionInpu
         std::vector<Vec3> origins(n), directions(n);
         const std::vector<double> lengths(n, in.distance);
         std::vector<std::uint8_t> hit(n);
+        std::int64_t range_traced = 0;
         for (std::size_t t = range.begin(); t != range.end(); ++t) {
           const Texel& texel = space.texels[t];
+          if (rays.buried(texel.position.cast<double>(), space.geometric_normal(t).cast<double>(),
+                          in.mesh, space.face_normals[std::size_t(texel.face)].cast<double>())) {
+            for (int c = 0; c < 3; ++c) out.at(texel.x, texel.y)[c] = 0.0f;
+            continue;
+          }
           const Vec3 normal = texel.normal.cast<double>();
           const Vec3 origin = space.ray_origin(t, offset);
           Rng rng(stream_seed(in.seed, in.stream, std::uint64_t(texel.y) * space.width + texel.x));
@@ -39,12 +45,13 @@ Image bake_ambient_occlusion(const TexelSpace& space, const AmbientOcclusionInpu
             directions[s] = cosine_direction(normal, strata[s]);
           }
           rays.occluded(int(n), origins.data(), directions.data(), lengths.data(), hit.data());
+          range_traced += std::int64_t(n);
           std::size_t open = 0;
           for (std::size_t s = 0; s < n; ++s) open += hit[s] ? 0 : 1;
           const float a = float(double(open) / double(n));
           for (int c = 0; c < 3; ++c) out.at(texel.x, texel.y)[c] = a;
         }
-        traced += std::int64_t(range.size() * n);
+        traced += range_traced;
         if (in.texels_done) {
           const auto done = (*in.texels_done += std::int64_t(range.size()));
           if (in.progress) in.progress(double(done));
@@ -64,6 +71,7 @@ class AmbientOcclusionMethod final : public Method {
     const BakeSettings& settings = context_.scene->bake;
     AmbientOcclusionInputs in;
     in.rays = context_.rays;
+    in.mesh = receiver.mesh;
     in.distance = settings.ao_distance;
     in.samples = settings.samples;
     in.seed = settings.seed;

@@ -15,8 +15,9 @@ namespace sb {
 
 struct AmbientOcclusionInputs {
   const RayScene* rays = nullptr;
-  double distance = 10.0;  // metres: a blocker further along a ray does not occlude it
-  int samples = 256;       // rays per texel
+  const Mesh* mesh = nullptr;  // the receiver's (RayScene::buried tells its own faces apart)
+  double distance = 10.0;      // metres: a blocker further along a ray does not occlude it
+  int samples = 256;           // rays per texel
   std::uint64_t seed = 0;
   std::uint64_t stream = 0;                          // the receiver's index: its own random streams
   std::atomic<std::int64_t>* texels_done = nullptr;  // progress counter, may be null
@@ -26,8 +27,10 @@ struct AmbientOcclusionInputs {
 // Per covered texel, A = (1/N) Σ unoccluded(ω_i) over N = `samples` stratified cosine-weighted
 // directions ω_i about the texel's shading normal (so A → (1/π) ∫ v(ω) cos θ dω), each a segment
 // of length `distance` from the texel's lifted shadow origin, as the reference's shadow rays
-// leave; the same A in R, G and B; uncovered texels 0. Each texel has its own random stream.
-// Adds the rays traced to *rays_traced.
+// leave; the same A in R, G and B; uncovered texels 0. A texel pressed against a surface facing
+// it (RayScene::buried: the bottom of a leg standing on a floor, the floor under it) is 0, as
+// no direction is open there, though its rays would start beyond the cover and escape. Each texel
+// has its own random stream. Adds the rays traced to *rays_traced.
 Image bake_ambient_occlusion(const TexelSpace& space, const AmbientOcclusionInputs& in,
                              std::int64_t* rays_traced);
 

@@ -25,6 +25,7 @@ struct RayScene::Impl {
   Bounds3 bounds;
   double offset = 1e-4;
   std::vector<std::int64_t> first_face;  // per Embree geometry: its mesh's first face's index
+  std::vector<const Mesh*> meshes;       // per Embree geometry: its mesh
 
   ~Impl() {
     if (scene) rtcReleaseScene(scene);
@@ -46,7 +47,8 @@ Expected<RayScene> RayScene::build(const std::vector<const Mesh*>& blockers) {
   }
   impl->scene = rtcNewScene(impl->device);
   rtcSetSceneBuildQuality(impl->scene, RTC_BUILD_QUALITY_HIGH);
-  rtcSetSceneFlags(impl->scene, RTC_SCENE_FLAG_ROBUST);
+  // The context filter serves buried() alone; the other queries pass none.
+  rtcSetSceneFlags(impl->scene, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
 
   std::int64_t faces = 0;
   for (const Mesh* m : blockers) {
@@ -54,6 +56,7 @@ Expected<RayScene> RayScene::build(const std::vector<const Mesh*>& blockers) {
     faces += std::int64_t(mesh.n_faces());
     if (mesh.n_faces() == 0) continue;
     impl->first_face.push_back(faces - std::int64_t(mesh.n_faces()));
+    impl->meshes.push_back(m);
     RTCGeometry geom = rtcNewGeometry(impl->device, RTC_GEOMETRY_TYPE_TRIANGLE);
     auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
         geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.n_vertices()));
@@ -192,6 +195,62 @@ void RayScene::occluded(int count, const Vec3* origins, const Vec3* directions,
     // Embree sets tfar to -inf for each occluded ray.
     for (int i = 0; i < n; ++i) hit[start + i] = rays.tfar[i] < 0.0f ? 1 : 0;
   }
+}
+
+namespace {
+
+// buried()'s query: the intersection context Embree passes to the filter, and what the filter
+// needs to tell a covering triangle from the point's own surface.
+struct BuriedContext {
+  RTCIntersectContext base;  // first: Embree hands the filter a pointer to it
+  unsigned own_geometry = RTC_INVALID_GEOMETRY_ID;
+  Vec3 n, own_winding;
+};
+
+// Keeps a hit only where its triangle faces against the point's normal (another blocker's), or
+// against its own face's winding (its own mesh's).
+void keep_covering(const RTCFilterFunctionNArguments* args) {
+  const auto* context = reinterpret_cast<const BuriedContext*>(args->context);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] == 0) continue;
+    const Vec3 ng(RTCHitN_Ng_x(args->hit, args->N, i), RTCHitN_Ng_y(args->hit, args->N, i),
+                  RTCHitN_Ng_z(args->hit, args->N, i));
+    const bool own = RTCHitN_geomID(args->hit, args->N, i) == context->own_geometry;
+    const Vec3& against = own ? context->own_winding : context->n;
+    // Facing against it within 60°: a side face that only touches the segment's line is no
+    // cover.
+    if (!(ng.dot(against) < -0.5 * ng.norm() * against.norm())) args->valid[i] = 0;
+  }
+}
+
+}  // namespace
+
+bool RayScene::buried(const Vec3& p, const Vec3& n, const Mesh* own,
+                      const Vec3& own_winding) const {
+  BuriedContext context;
+  rtcInitIntersectContext(&context.base);
+  context.base.filter = &keep_covering;
+  for (std::size_t g = 0; g < impl_->meshes.size(); ++g)
+    if (impl_->meshes[g] == own) context.own_geometry = unsigned(g);
+  context.n = n;
+  context.own_winding = own_winding;
+  const double offset = impl_->offset;
+  const Vec3 start = p + 2.0 * offset * n;
+  RTCRay ray;
+  ray.org_x = float(start.x());
+  ray.org_y = float(start.y());
+  ray.org_z = float(start.z());
+  ray.dir_x = float(-n.x());
+  ray.dir_y = float(-n.y());
+  ray.dir_z = float(-n.z());
+  ray.tnear = 0.0f;
+  ray.tfar = float(2.25 * offset);
+  ray.time = 0.0f;
+  ray.mask = 0xFFFFFFFFu;
+  ray.id = 0;
+  ray.flags = 0;
+  rtcOccluded1(impl_->scene, &context.base, &ray);
+  return ray.tfar < 0.0f;
 }
 
 }  // namespace sb

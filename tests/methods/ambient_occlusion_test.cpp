@@ -100,5 +100,99 @@ TEST(AmbientOcclusion, BesideAWallHalfTheHemisphereIsClosed) {
   EXPECT_NEAR(mean, 1 - (std::acos(0.5) - 0.5 * std::sqrt(0.75)) / M_PI, 0.01);
 }
 
+// Texels on z = height at x ∈ [x0, x1], y = 0, facing `up` or down, their face's winding
+// `winding` (the same way as their normal unless a test says otherwise).
+TexelSpace facing_texels(double x0, double x1, int n, double height, bool up, bool winding_agrees) {
+  TexelSpace s = floor_texels(x0, x1, n);
+  const Vec3f normal = up ? Vec3f::UnitZ() : Vec3f(-Vec3f::UnitZ());
+  s.face_normals = {winding_agrees ? normal : Vec3f(-normal)};
+  for (Texel& t : s.texels) {
+    t.position.z() = float(height);
+    t.normal = normal;
+  }
+  return s;
+}
+
+// Per texel A over `blockers`, the texels' own mesh `own` (or none).
+std::vector<double> occlusion_among(const std::vector<const Mesh*>& blockers, const Mesh* own,
+                                    const TexelSpace& space, double distance) {
+  auto rays = RayScene::build(blockers);
+  EXPECT_TRUE(rays);
+  AmbientOcclusionInputs in;
+  in.rays = &*rays;
+  in.mesh = own;
+  in.distance = distance;
+  in.samples = 256;
+  in.seed = 5;
+  const Image image = bake_ambient_occlusion(space, in, nullptr);
+  std::vector<double> a;
+  for (const Texel& t : space.texels) a.push_back(image.at(t.x, t.y)[0]);
+  return a;
+}
+
+// Mirrors a square's winding (its faces seen from the other side).
+Mesh flipped(Mesh m) {
+  TriMesh t;
+  std::vector<TriMesh::VertexHandle> v;
+  for (const auto vh : m.mesh.vertices()) v.push_back(t.add_vertex(m.mesh.point(vh)));
+  for (const auto f : m.mesh.faces()) {
+    std::vector<TriMesh::VertexHandle> corners;
+    for (const auto vh : m.mesh.fv_range(f)) corners.push_back(v[std::size_t(vh.idx())]);
+    t.add_face(corners[0], corners[2], corners[1]);
+  }
+  m.mesh = t;
+  return m;
+}
+
+// The bottom of a leg standing on a floor, and the floor under it, see nothing: each is pressed
+// against a surface facing it, and their rays, which start a surface offset off the surface,
+// would start beyond that cover and escape (every one of them, under a leg's bottom on a floor
+// with nothing below it). The issue "Where engines look" found 144 such texels on the level's
+// chair at 1.0.
+TEST(AmbientOcclusion, ASurfacePressedAgainstAnotherIsClosed) {
+  // A floor (facing up, z = 0) under the texels of a leg's bottom (facing down, on it).
+  const Mesh floor = square(Vec3(0, 0, 0), Vec3::UnitX(), Vec3::UnitY(), 0.5);
+  for (double a :
+       occlusion_among({&floor}, nullptr, facing_texels(-0.4, 0.4, 16, 0, false, true), 0.1))
+    EXPECT_EQ(a, 0.0);
+  // Hovering 5 cm above it, the same texels see the floor as a ceiling: (h / d)² = 1/4.
+  double mean = 0;
+  for (double a :
+       occlusion_among({&floor}, nullptr, facing_texels(-0.4, 0.4, 16, 0.05, false, true), 0.1))
+    mean += a / 16;
+  EXPECT_NEAR(mean, 0.25, 0.03);
+  // A plate lying on the floor (facing down onto it) closes the floor's texels under it, and
+  // only those.
+  const Mesh plate = flipped(square(Vec3(0, 0, 0), Vec3::UnitX(), Vec3::UnitY(), 0.25));
+  const std::vector<double> under =
+      occlusion_among({&plate}, nullptr, facing_texels(-0.5, 0.5, 21, 0, true, true), 1.0);
+  for (std::size_t i = 0; i < under.size(); ++i) {
+    const double x = -0.5 + 0.05 * double(i);
+    if (std::abs(x) < 0.24) {
+      EXPECT_EQ(under[i], 0.0) << x;
+    } else if (std::abs(x) > 0.26) {
+      EXPECT_EQ(under[i], 1.0) << x;
+    }
+  }
+  // The same within one mesh (a leg joined to the seat above it): its faces facing against the
+  // texels' own face's winding.
+  for (double a :
+       occlusion_among({&plate}, &plate, facing_texels(-0.2, 0.2, 9, 0, true, true), 1.0))
+    EXPECT_EQ(a, 0.0);
+}
+
+// Surfaces facing the same way do not cover each other (a decal on a floor), nor does the texels'
+// own face where its winding disagrees with their normal (a mesh whose normals were flipped but
+// not its faces).
+TEST(AmbientOcclusion, NoCoverFacingTheSameWayOrFromTheTexelsOwnFace) {
+  const Mesh decal = square(Vec3(0, 0, 0), Vec3::UnitX(), Vec3::UnitY(), 0.5);
+  for (double a :
+       occlusion_among({&decal}, nullptr, facing_texels(-0.4, 0.4, 16, 0, true, true), 1.0))
+    EXPECT_EQ(a, 1.0);
+  const Mesh own = flipped(decal);
+  for (double a : occlusion_among({&own}, &own, facing_texels(-0.4, 0.4, 16, 0, true, false), 1.0))
+    EXPECT_EQ(a, 1.0);
+}
+
 }  // namespace
 }  // namespace sb
