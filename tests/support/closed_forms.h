@@ -127,6 +127,22 @@ inline double square_light_weighted_visibility(double x, double y, double bx, do
   return 1.0 - hidden / total;
 }
 
+// V = H/H0 at floor point (x, y) under a square light of half-width `light` centred above the
+// origin at height `light_height`, facing down, with a square blocker of half-width `half`
+// centred on (bx, by) at height h parallel to both: the blocker seen from (x, y) hides, on the
+// light's plane, the square of centre (x, y) + (b − (x, y))·H/h and half-width half·H/h; V is
+// the light's weight less that hidden part's, exact.
+inline double parallel_square_visibility(double x, double y, double light, double light_height,
+                                         double bx, double by, double half, double h) {
+  const double k = light_height / h;
+  const double cx = x + (bx - x) * k, cy = y + (by - y) * k, reach = half * k;
+  const double total = rectangle_weight(-light, light, -light, light, x, y, light_height);
+  const double hidden = rectangle_weight(std::max(-light, cx - reach), std::min(light, cx + reach),
+                                         std::max(-light, cy - reach), std::min(light, cy + reach),
+                                         x, y, light_height);
+  return 1.0 - hidden / total;
+}
+
 // V = H/H0 under a disk light of radius r in place of the square: exact along the light's y
 // (∫ dt/(A + t²)² in closed form), midpoint rule over its x in `steps` columns.
 inline double disk_light_weighted_visibility(double x, double y, double bx, double by, double h,
