@@ -8,17 +8,40 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <vector>
 
 #include "core/sampling.h"
 
 namespace sb {
+namespace {
+
+// Where RayScene::buried asks about texel t: its position, or, where that lies on an edge of its
+// triangle (the centre fell off it: uv_rasterizer's nearest-point rule), a few surface offsets
+// towards the triangle's centroid, so that buried()'s rays do not graze the faces meeting there
+// (the edge of a wall's bottom on a floor).
+Vec3 buried_query_point(const TexelSpace& space, std::size_t t, const Mesh* mesh, double offset) {
+  const Texel& texel = space.texels[t];
+  const Vec3 p = texel.position.cast<double>();
+  if (mesh == nullptr || std::size_t(texel.face) >= mesh->mesh.n_faces()) return p;
+  Vec3 centroid = Vec3::Zero();
+  for (const auto v : mesh->mesh.fv_range(mesh->mesh.face_handle(texel.face))) {
+    const auto& q = mesh->mesh.point(v);
+    centroid += Vec3(q[0], q[1], q[2]) / 3.0;
+  }
+  const Vec3 towards = centroid - p;
+  const double length = towards.norm();
+  return length > 0 ? Vec3(p + std::min(4.0 * offset, 0.5 * length) / length * towards) : p;
+}
+
+}  // namespace
 
 Image bake_ambient_occlusion(const TexelSpace& space, const AmbientOcclusionInputs& in,
                              std::int64_t* rays_traced) {
   Image out(space.width, space.height, 3);
   const RayScene& rays = *in.rays;
   const double offset = rays.surface_offset();
+  const int own = rays.blocker_index(in.mesh);
   std::atomic<std::int64_t> traced{0};
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, space.texels.size(), 64),
@@ -31,8 +54,9 @@ Image bake_ambient_occlusion(const TexelSpace& space, const AmbientOcclusionInpu
         std::int64_t range_traced = 0;
         for (std::size_t t = range.begin(); t != range.end(); ++t) {
           const Texel& texel = space.texels[t];
-          if (rays.buried(texel.position.cast<double>(), space.geometric_normal(t).cast<double>(),
-                          in.mesh, space.face_normals[std::size_t(texel.face)].cast<double>())) {
+          if (rays.buried(buried_query_point(space, t, in.mesh, offset),
+                          space.geometric_normal(t).cast<double>(), own,
+                          space.face_normals[std::size_t(texel.face)].cast<double>())) {
             for (int c = 0; c < 3; ++c) out.at(texel.x, texel.y)[c] = 0.0f;
             continue;
           }

@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 namespace sb {
@@ -25,7 +26,7 @@ struct RayScene::Impl {
   Bounds3 bounds;
   double offset = 1e-4;
   std::vector<std::int64_t> first_face;  // per Embree geometry: its mesh's first face's index
-  std::vector<const Mesh*> meshes;       // per Embree geometry: its mesh
+  std::vector<const Mesh*> meshes;       // per Embree geometry: its mesh (blocker_index)
 
   ~Impl() {
     if (scene) rtcReleaseScene(scene);
@@ -120,6 +121,24 @@ void fill_packet(RTCRay8& rays, int* valid, int start, int n, const Vec3* origin
   }
 }
 
+// One segment origin + t·direction, t ∈ [tnear, tfar], as Embree's single ray.
+RTCRay single_ray(const Vec3& origin, const Vec3& direction, double tnear, double tfar) {
+  RTCRay ray;
+  ray.org_x = float(origin.x());
+  ray.org_y = float(origin.y());
+  ray.org_z = float(origin.z());
+  ray.dir_x = float(direction.x());
+  ray.dir_y = float(direction.y());
+  ray.dir_z = float(direction.z());
+  ray.tnear = float(tnear);
+  ray.tfar = float(tfar);
+  ray.time = 0.0f;
+  ray.mask = 0xFFFFFFFFu;
+  ray.id = 0;
+  ray.flags = 0;
+  return ray;
+}
+
 }  // namespace
 
 double RayScene::first_hit(const Vec3& origin, const Vec3& direction, double length) const {
@@ -157,19 +176,9 @@ RayScene::Hit RayScene::first_hit_face(const Vec3& origin, const Vec3& direction
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit query;
-  query.ray.org_x = float(origin.x());
-  query.ray.org_y = float(origin.y());
-  query.ray.org_z = float(origin.z());
-  query.ray.dir_x = float(direction.x());
-  query.ray.dir_y = float(direction.y());
-  query.ray.dir_z = float(direction.z());
   // As fill_packet: the first surface_offset of the segment skipped.
-  query.ray.tnear = float(impl_->offset / std::max(direction.norm(), 1e-30));
-  query.ray.tfar = float(length);
-  query.ray.time = 0.0f;
-  query.ray.mask = 0xFFFFFFFFu;
-  query.ray.id = 0;
-  query.ray.flags = 0;
+  query.ray =
+      single_ray(origin, direction, impl_->offset / std::max(direction.norm(), 1e-30), length);
   query.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   query.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(impl_->scene, &context, &query);
@@ -223,34 +232,54 @@ void keep_covering(const RTCFilterFunctionNArguments* args) {
   }
 }
 
+// Whether the side of p that `side` (unit) points to is inside a closed surface: most of five
+// rays into that side (along it and tilted 45° towards four perpendicular directions), starting
+// beyond the cover and the point's own face, first meet a face from behind. `inverted`: the
+// point's mesh is wound against its normals, and so, it is taken, is the scene.
+bool enclosed(RTCScene scene, const Vec3& p, const Vec3& side, double skip, bool inverted) {
+  const Vec3 u = side.unitOrthogonal(), v = side.cross(u);
+  const Vec3 directions[5] = {side, (side + u).normalized(), (side - u).normalized(),
+                              (side + v).normalized(), (side - v).normalized()};
+  int behind = 0;
+  for (const Vec3& d : directions) {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRayHit query;
+    query.ray = single_ray(p, d, skip, std::numeric_limits<float>::infinity());
+    query.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    query.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(scene, &context, &query);
+    if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+    const Vec3 ng(query.hit.Ng_x, query.hit.Ng_y, query.hit.Ng_z);
+    if ((ng.dot(d) > 0) != inverted) ++behind;
+  }
+  return behind >= 3;
+}
+
 }  // namespace
 
-bool RayScene::buried(const Vec3& p, const Vec3& n, const Mesh* own,
-                      const Vec3& own_winding) const {
+int RayScene::blocker_index(const Mesh* mesh) const {
+  const auto it = std::find(impl_->meshes.begin(), impl_->meshes.end(), mesh);
+  return it == impl_->meshes.end() ? -1 : int(it - impl_->meshes.begin());
+}
+
+bool RayScene::buried(const Vec3& p, const Vec3& n, int own, const Vec3& own_winding) const {
   BuriedContext context;
   rtcInitIntersectContext(&context.base);
   context.base.filter = &keep_covering;
-  for (std::size_t g = 0; g < impl_->meshes.size(); ++g)
-    if (impl_->meshes[g] == own) context.own_geometry = unsigned(g);
+  context.own_geometry = own < 0 ? RTC_INVALID_GEOMETRY_ID : unsigned(own);
   context.n = n;
   context.own_winding = own_winding;
   const double offset = impl_->offset;
-  const Vec3 start = p + 2.0 * offset * n;
-  RTCRay ray;
-  ray.org_x = float(start.x());
-  ray.org_y = float(start.y());
-  ray.org_z = float(start.z());
-  ray.dir_x = float(-n.x());
-  ray.dir_y = float(-n.y());
-  ray.dir_z = float(-n.z());
-  ray.tnear = 0.0f;
-  ray.tfar = float(2.25 * offset);
-  ray.time = 0.0f;
-  ray.mask = 0xFFFFFFFFu;
-  ray.id = 0;
-  ray.flags = 0;
+  RTCRay ray = single_ray(p + 2.0 * offset * n, -n, 0.0, 2.25 * offset);
   rtcOccluded1(impl_->scene, &context.base, &ray);
-  return ray.tfar < 0.0f;
+  if (!(ray.tfar < 0.0f)) return false;
+  // A cover with open space on both sides of it is the other face of a two-sided sheet (a
+  // level's thin wall or card, modelled as two coplanar faces back to back), not an object
+  // resting on the point: the point is seen.
+  const bool inverted = own_winding.dot(n) < 0;
+  return enclosed(impl_->scene, p, n, 3.0 * offset, inverted) ||
+         enclosed(impl_->scene, p, -n, 3.0 * offset, inverted);
 }
 
 }  // namespace sb

@@ -55,13 +55,19 @@ class RayScene {
   // Whether the point p of a surface whose face normal, turned to the side it is seen from, is
   // n (unit) is pressed against a surface facing it: a triangle crossing the segment from
   // 2·surface_offset() in front of p along n to a quarter of it behind (the floats' error) and
-  // facing against n. That is another blocker's triangle, or one of `own`'s (the point's mesh,
-  // where it is a blocker) whose winding faces against `own_winding` (its face's normal from
-  // its corners' order): a chair's leg joined to its seat. Such a point is buried, an object
-  // resting on it or it on one; every ray leaving it would start beyond the surface that
-  // covers it, which the skipped start steps over. Two surfaces facing the same way (a decal
-  // on a wall) do not bury each other.
-  bool buried(const Vec3& p, const Vec3& n, const Mesh* own, const Vec3& own_winding) const;
+  // facing against n. That is another blocker's triangle, or one of blocker `own`'s (the point's
+  // mesh, blocker_index; -1 where it is none) whose winding faces against `own_winding` (its
+  // face's normal from its corners' order): a chair's leg joined to its seat. Such a point is
+  // buried, an object resting on it or it on one, where one side of it is inside a closed surface
+  // (most of five rays into it meet a face from behind first): every ray leaving it would start
+  // beyond the surface that covers it, which the skipped start steps over. Two surfaces facing
+  // the same way (a decal on a wall) do not bury each other, nor do the two faces of a two-sided
+  // sheet (open on both sides).
+  bool buried(const Vec3& p, const Vec3& n, int own, const Vec3& own_winding) const;
+
+  // A mesh's place among the blockers given to build that have faces (as buried() counts
+  // them), or -1 for one that is not among them.
+  int blocker_index(const Mesh* mesh) const;
 
   // The blockers' bounding box (empty when there are none).
   const Bounds3& bounds() const;
