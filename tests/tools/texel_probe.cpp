@@ -3,8 +3,8 @@
 // sample counts, the centre ray's first hit, the texel's own shaft's polygons from the whole
 // hierarchy and the estimator's value over them, and the whole method's value for the texel.
 //
-// Run: build/shadowbake_texel_probe SCENE RECEIVER LIGHT X Y [X Y ...] (SCENE: a scene file or a
-// level)
+// Run: build/shadowbake_texel_probe [--resolution N] SCENE RECEIVER LIGHT X Y [X Y ...] (SCENE: a
+// scene file or a level; --resolution as the bake's, overriding the scene's sizes)
 #include <fmt/core.h>
 
 #include <cstdlib>
@@ -21,8 +21,14 @@
 
 int main(int argc, char** argv) {
   using namespace sb;
+  int resolution = 0;
+  if (argc > 2 && std::string(argv[1]) == "--resolution") {
+    resolution = std::atoi(argv[2]);
+    argc -= 2;
+    argv += 2;
+  }
   if (argc < 6 || (argc - 4) % 2 != 0) {
-    fmt::print(stderr, "usage: {} SCENE RECEIVER LIGHT X Y [X Y ...]\n", argv[0]);
+    fmt::print(stderr, "usage: {} [--resolution N] SCENE RECEIVER LIGHT X Y [X Y ...]\n", argv[0]);
     return 2;
   }
   const std::filesystem::path file = argv[1];
@@ -30,6 +36,10 @@ int main(int argc, char** argv) {
   if (!scene) {
     fmt::print(stderr, "{}\n", scene.error().message);
     return 1;
+  }
+  if (resolution > 0) {
+    scene->bake.resolution = resolution;
+    scene->bake.texels_per_metre = 0;
   }
   const test_scenes::Built built(*scene);
   const std::vector<int> sides = lightmap_sides(*scene, built.meshes, nullptr);
