@@ -4,12 +4,19 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+
+#include "methods/terminator_fill.h"
+
 namespace sb {
 
 LightMix::LightMix(const TexelSpace& space, const std::vector<Light>& lights, Quantity quantity,
                    Order order, KeepPerLight keep)
     : space_(space), lights_(lights), quantity_(quantity), keep_(keep) {
-  out_.image = Image(space.width, space.height, 3, 0.0f);
+  // Visibility: texels where no light counts hold kNoLightCounts until finish() fills the
+  // terminators' (terminator_fill.h).
+  const float unset = quantity == Quantity::visibility ? kNoLightCounts : 0.0f;
+  out_.image = Image(space.width, space.height, 3, unset);
   // One light's visibility, set light by light: its V is the texel's value wherever it reaches
   // (H0·V / H0), so set() writes it straight into the image and nothing waits for finish() (a
   // 4096² receiver's per-light buffer alone would be 260 MB).
@@ -20,7 +27,7 @@ LightMix::LightMix(const TexelSpace& space, const std::vector<Light>& lights, Qu
     set_flags_.assign(lights.size(), std::vector<std::uint8_t>(space.texels.size(), 0));
   }
   const std::size_t outputs = output_count(lights);
-  if (keep_.values) out_.per_light.assign(outputs, Image(space.width, space.height, 3, 0.0f));
+  if (keep_.values) out_.per_light.assign(outputs, Image(space.width, space.height, 3, unset));
   if (keep_.visibility) {
     Image unreached(space.width, space.height, 2, 0.0f);
     for (std::size_t i = 0; i < unreached.pixels.size(); i += 2) unreached.pixels[i] = 1.0f;
@@ -54,7 +61,8 @@ void LightMix::keep(std::size_t light, std::size_t texel, const Vec3& h0, const 
 
 void LightMix::keep_output(std::size_t output, std::size_t texel, const Vec3& h0, const Vec3& v) {
   const Texel& t = space_.texels[texel];
-  if (keep_.values) {
+  const bool counts = h0.maxCoeff() > 0;
+  if (keep_.values && (counts || quantity_ == Quantity::irradiance)) {
     float* px = out_.per_light[output].at(t.x, t.y);
     for (int c = 0; c < 3; ++c) {
       const double value =
@@ -79,6 +87,7 @@ void LightMix::add(Sum& sum, std::size_t light, std::size_t texel, const Vec3& h
 void LightMix::write(std::size_t texel, const Sum& sum) {
   const Texel& t = space_.texels[texel];
   float* px = out_.image.at(t.x, t.y);
+  if (quantity_ == Quantity::visibility && !(sum.h0.maxCoeff() > 0)) return;  // kNoLightCounts
   for (int c = 0; c < 3; ++c) {
     double v = 0;
     if (quantity_ == Quantity::irradiance) {
@@ -106,8 +115,7 @@ void LightMix::set(std::size_t light, std::size_t texel, int x, int y, const Vec
 }
 
 MixedImages LightMix::finish() {
-  if (direct_) return std::move(out_);  // set() wrote every value
-  if (!set_values_.empty()) {
+  if (!direct_ && !set_values_.empty()) {
     // Texels are independent: the closed forms of every light at every texel, on all threads.
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, space_.texels.size(), 1024),
                       [&](const tbb::blocked_range<std::size_t>& range) {
@@ -130,6 +138,22 @@ MixedImages LightMix::finish() {
       for (int c = 0; c < 3; ++c) v[c] = sum.h0[c] > 0 ? sum.h[c] / sum.h0[c] : 0.0;
       keep_output(o, t, sum.h0, v);
     }
+  }
+  // Visibility across curved receivers' terminators, in every image of V.
+  std::vector<std::size_t> every(lights_.size());
+  for (std::size_t l = 0; l < every.size(); ++l) every[l] = l;
+  if (quantity_ == Quantity::visibility)
+    fill_terminators(space_, lights_, every, UncountedMark::value, out_.image);
+  const std::size_t outputs = std::max(out_.per_light.size(), out_.per_light_visibility.size());
+  for (std::size_t o = 0; o < outputs; ++o) {
+    std::vector<std::size_t> parts;
+    for (std::size_t l = 0; l < lights_.size(); ++l)
+      if (std::size_t(lights_[l].output()) == o) parts.push_back(l);
+    if (quantity_ == Quantity::visibility && o < out_.per_light.size())
+      fill_terminators(space_, lights_, parts, UncountedMark::value, out_.per_light[o]);
+    if (o < out_.per_light_visibility.size())
+      fill_terminators(space_, lights_, parts, UncountedMark::flag_off,
+                       out_.per_light_visibility[o]);
   }
   return std::move(out_);
 }

@@ -3,7 +3,8 @@
 // per texel and colour channel, light l's visibility V_l is weighted by its unoccluded
 // irradiance H0_l (closed form, Light::unoccluded_irradiance); a light with H0_l = 0 there, or
 // one the method leaves out at the texel (none of its samples contributes), adds nothing; then
-//   visibility  V = Σ_l H0_l·V_l / Σ_l H0_l   (0 where the sum of weights is 0),
+//   visibility  V = Σ_l H0_l·V_l / Σ_l H0_l   (0 where the sum of weights is 0, but for a
+//               texel on a smooth receiver's terminator: terminator_fill.h),
 //   irradiance  H = Σ_l H0_l·V_l              (W/m²),
 // summed in double over lights in scene order and written as float.
 #pragma once

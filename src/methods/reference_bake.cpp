@@ -23,6 +23,8 @@ MixedImages bake_reference(const TexelSpace& space, const ReferenceInputs& in,
   const RayScene& rays = *in.rays;
   LightMix mix(space, lights, in.quantity, LightMix::Order::texel_major, in.keep_per_light);
   std::atomic<std::int64_t> traced{0};
+  // Counted: the kept rows' rays (a tile's halo, traced for the terminators' neighbours, is not).
+  const auto [kept0, kept1] = kept_texels(space);
 
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, space.texels.size(), 64),
@@ -33,6 +35,7 @@ MixedImages bake_reference(const TexelSpace& space, const ReferenceInputs& in,
         std::int64_t local_rays = 0;
         for (std::size_t t = range.begin(); t != range.end(); ++t) {
           const Texel& texel = space.texels[t];
+          const std::int64_t before = local_rays;
           LightMix::Sum sum;
           for (std::size_t l = 0; l < lights.size(); ++l) {
             if (const Sky* sky = lights[l].sky()) {
@@ -56,6 +59,7 @@ MixedImages bake_reference(const TexelSpace& space, const ReferenceInputs& in,
             mix.add(sum, l, t, h0, v);
           }
           mix.write(t, sum);
+          if (t < kept0 || t >= kept1) local_rays = before;
         }
         traced += local_rays;
         if (in.texels_done) {
@@ -104,7 +108,7 @@ MethodEntry reference_method() {
           [](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {
             return std::unique_ptr<Method>(std::make_unique<ReferenceMethod>(context));
           },
-          /*tile_halo=*/0,  // each texel's rays are its own
+          /*tile_halo=*/1,  // its rays are its own; a terminator's texel reads its 8 neighbours
           nullptr};
 }
 

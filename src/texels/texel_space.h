@@ -61,6 +61,15 @@ struct TexelSpace {
   // side): two neighbouring texels farther apart than their faces' steps lie on different
   // pieces of surface (a UV chart border). 0 for a face that covers no texel.
   std::vector<float> face_texel_sizes;
+  // Per face, where some face's corners' shading normals differ (a smooth-shaded receiver; empty
+  // where none's do): its corners in texel coordinates (x = u·width, y = (1 − v)·height, texel
+  // (x, y) the unit square from (x, y)) and their shading normals, which texel normals
+  // interpolate. What a texel's square holds beyond its centre (methods/terminator_fill.h).
+  struct FaceShading {
+    Vec2f corner[3];
+    Vec3f normal[3];
+  };
+  std::vector<FaceShading> face_shading;
   // Per texel, where some texel's shadow origin is not its position (a curved mesh's, below):
   // shadow origin − position; empty where every texel's is its position.
   FreshVector<Vec3f> lifts;

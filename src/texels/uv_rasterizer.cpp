@@ -386,12 +386,24 @@ TexelSpace rasterise_texels(const Mesh& mesh, int width, int height, RowRange ro
   space.texels.resize(row_count[std::size_t(window)]);
   space.face_normals.resize(tri_mesh.n_faces(), Vec3f::Zero());
   space.face_texel_sizes.resize(tri_mesh.n_faces(), 0.0f);
-  bool lifted = false;
+  bool lifted = false, smooth = false;
   for (const FaceFootprint& fp : footprints) {
     const FaceSurface& s = surfaces[std::size_t(fp.face)];
     space.face_normals[std::size_t(fp.face)] = s.face_normal.cast<float>();
     space.face_texel_sizes[std::size_t(fp.face)] = float(texel_step(fp, s));
     lifted = lifted || s.curved;
+    smooth = smooth || s.normal[0] != s.normal[1] || s.normal[0] != s.normal[2];
+  }
+  if (smooth) {
+    space.face_shading.resize(tri_mesh.n_faces());
+    for (const FaceFootprint& fp : footprints) {
+      const FaceSurface& s = surfaces[std::size_t(fp.face)];
+      TexelSpace::FaceShading& shading = space.face_shading[std::size_t(fp.face)];
+      for (int i = 0; i < 3; ++i) {
+        shading.corner[i] = fp.texel_uv[i].cast<float>();
+        shading.normal[i] = s.normal[i].cast<float>();
+      }
+    }
   }
   if (lifted) space.lifts.resize(space.texels.size());
   std::vector<int> footprint_of_face(tri_mesh.n_faces(), -1);

@@ -3,12 +3,14 @@ cross-check of `shadowbake bake LEVEL.glb --per-light` (docs/methods.md, "Levels
 
     blender -b --factory-startup -P tests/tools/cycles_level_bake.py -- LEVEL.glb --out DIR \
         [--res 256] [--samples 256] [--receivers floor,table] [--lights bulb,ceiling_panel]
+        [--sun-angle 0.526]
         [--sky MAP.exr | --sky-preetham TURBIDITY [--sky-sun sun]] [--sky-strength S]
 
 The file is imported by Blender's own glTF importer, which is not shadowbake's reader: its lamps
 (KHR_lights_punctual) stay lamps, made points (shadow_soft_size 0, as shadowbake reads them) and
-suns of Blender's 0.526°, and its emissive meshes stay meshes that emit, which Cycles samples as
-mesh lights (so shadowbake's turning them into rectangle and disk lights is checked too), made to
+suns of Blender's 0.526° (or --sun-angle), and its emissive meshes stay meshes that emit, which
+Cycles samples as mesh lights (so shadowbake's turning them into rectangle and disk lights is
+checked too), made to
 emit from their front side alone as shadowbake's do. Emitters cast no shadows (shadowbake's lights
 are not blockers). For each receiver (a mesh with a second UV
 set) and each light alone, the visibility V = H / H0 is baked in the lightmap UVs (channel 1):
@@ -39,6 +41,8 @@ ap.add_argument("level")
 ap.add_argument("--out", required=True)
 ap.add_argument("--res", type=int, default=256)
 ap.add_argument("--samples", type=int, default=256)
+ap.add_argument("--sun-angle", type=float, default=0.526,
+                help="every sun's angular diameter, degrees (shadowbake's angle_deg)")
 ap.add_argument("--receivers")
 ap.add_argument("--lights")
 ap.add_argument("--sky", help="an equirectangular map: the world's Environment Texture, baked as "
@@ -80,7 +84,7 @@ for lamp in lamps.values():
     if lamp.data.type in ("POINT", "SPOT"):
         lamp.data.shadow_soft_size = 0.0
     elif lamp.data.type == "SUN":
-        lamp.data.angle = math.radians(0.526)
+        lamp.data.angle = math.radians(args.sun_angle)
 def front_only(obj):
     """The emitter's material made to emit from its front side alone, as shadowbake's area lights
     do (Blender's emission shaders emit from both sides): the same radiance, black behind."""
