@@ -14,6 +14,7 @@
 #include "occluders/shaft_culling.h"
 #include "pipeline/settings_json.h"
 #include "pipeline/shard_files.h"
+#include "source_hash.h"  // generated at build time (CMakeLists.txt, script mode)
 
 namespace sb {
 
@@ -159,6 +160,7 @@ Expected<std::vector<ReceiverKey>> receiver_keys(const KeyInputs& in,
   {
     Hash h;
     h.text(SHADOWBAKE_VERSION);
+    h.text(SHADOWBAKE_SOURCE_HASH);  // another build's code may give other values
     h.text(settings_to_json(scene.bake, scene.output).dump());
     h.number(in.keep_per_light.values ? 1 : 0);
     h.number(in.keep_per_light.visibility ? 1 : 0);
