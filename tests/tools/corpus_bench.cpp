@@ -24,7 +24,7 @@
 //      [--truth-only 1] [--levels ../shared/assets/godot/zdm2.toml@5,...]
 //      [--variants backprojection,reference-64,reference-256]
 // The truths are cached under out/corpus-truth/ (keyed by the scene file's bytes, its size,
-// samples and the reference's version), so later runs only bake the variants.
+// samples and the library's sources), so later runs of the same build only bake the variants.
 #include <fmt/core.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -47,6 +47,7 @@
 #include "pipeline/bake.h"
 #include "scene/level_file.h"
 #include "scene/scene.h"
+#include "source_hash.h"  // generated at build time (CMakeLists.txt, script mode)
 #include "support/image_errors.h"
 
 namespace {
@@ -272,10 +273,11 @@ int main(int argc, char** argv) {
                                      ? fmt::format("level/{}", spec.texels_per_metre.value_or(0))
                                      : std::to_string(resolution);
 
-    // The truth, cached by the scene file's bytes (and the reference's own version: its samples
-    // cover the part of a light above the horizon since version 2).
-    const std::size_t key = std::hash<std::string>{}(
-        slurp(file) + size_key + "/" + std::to_string(truth_samples) + "/reference-2");
+    // The truth, cached by the scene file's bytes and the build's sources (a change to the
+    // reference, or to what every method shares, changes the truth).
+    const std::size_t key =
+        std::hash<std::string>{}(slurp(file) + size_key + "/" + std::to_string(truth_samples) +
+                                 "/" + SHADOWBAKE_SOURCE_HASH);
     const fs::path truth_dir = cache / fmt::format("{:016x}", key);
     std::map<std::string, sb::Image> truth;
     for (const auto& obj : scene.objects) {
