@@ -24,12 +24,8 @@ Vec3 buried_query_point(const TexelSpace& space, std::size_t t, const Mesh* mesh
   const Texel& texel = space.texels[t];
   const Vec3 p = texel.position.cast<double>();
   if (mesh == nullptr || std::size_t(texel.face) >= mesh->mesh.n_faces()) return p;
-  Vec3 centroid = Vec3::Zero();
-  for (const auto v : mesh->mesh.fv_range(mesh->mesh.face_handle(texel.face))) {
-    const auto& q = mesh->mesh.point(v);
-    centroid += Vec3(q[0], q[1], q[2]) / 3.0;
-  }
-  const Vec3 towards = centroid - p;
+  const Triangle tri = triangle(mesh->mesh, mesh->mesh.face_handle(texel.face));
+  const Vec3 towards = (tri.p[0] + tri.p[1] + tri.p[2]) / 3.0 - p;
   const double length = towards.norm();
   return length > 0 ? Vec3(p + std::min(4.0 * offset, 0.5 * length) / length * towards) : p;
 }

@@ -14,8 +14,8 @@ namespace sb {
 namespace {
 
 // Half the side of the square of a texel whose points count, in texels: Blender's bake samples a
-// texel over the middle quarter of its area (bake_differentials in Blender's object_bake_api.cc
-// halves the UV derivatives Cycles jitters its samples by).
+// texel over the middle quarter of its area (bake_differentials, beside RE_bake_pixels_populate
+// in Blender's render/intern/bake, halves the UV derivatives Cycles jitters its samples by).
 constexpr double kFootprintHalfSide = 0.25;
 
 bool counted(const float* px, UncountedMark mark) {
