@@ -10,8 +10,9 @@
 // only when
 //   1. its five samples are all valued (covered, reached by the light);
 //   2. the centre's exact V is within `tolerance` of the mean of the corners, the bilinear
-//      prediction there (a kink — the edge of a penumbra or umbra — crossing the cell moves the
-//      centre by at least half the error it causes anywhere in the cell);
+//      prediction there (a kink — the edge of a penumbra or umbra — crossing a cell where the
+//      field is otherwise flat moves the centre by at least half the error it causes anywhere
+//      in the cell; 5 covers a field that is not flat);
 //   3. its texels lie on one smooth piece of surface: its sides on the surface within a factor 3
 //      of each other, each texel within `position_texels` (of the shorter side's texels) of the
 //      bilinear surface through the corners' positions and with a normal within 15° of the
@@ -26,6 +27,12 @@
 //      the light from every texel's ray origin (PairSource::ball_hides): a convex blocker's
 //      umbra under a convex light is convex, so every texel between them lies in it, however
 //      near.
+//   5. where the penumbra bound of 4 is under `midpoint_cells` cells (a penumbra's edge may be
+//      near), its four edge midpoints are evaluated too, each within `tolerance` of the mean of
+//      its edge's corners: a kink along one axis can cancel at the centre against the field's
+//      curvature along the other (measured: a centre 0.0018 from its prediction over a texel
+//      0.012 off), but not at both midpoints of the edges it crosses as well. A cell that
+//      splits reuses them as its children's corners.
 // Inside a cell that passes, V is interpolated linearly over the four triangles the centre makes
 // with the cell's sides, so it is exact at all five samples and continuous across cells. Texels
 // of a cell that fails at S = 2 are each evaluated. Every decision depends on exact values and
@@ -209,8 +216,10 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
         for (int x = 0; x < kTile; x += top) cells.push_back({tx * kTile + x, ty * kTile + y, top});
     }
 
-  // Whether cell c may interpolate the texels it owns (the file's opening comment, 1–4).
-  const auto passes = [&](const Cell& c) {
+  // Whether cell c may interpolate the texels it owns (the file's opening comment, 1–4): kFail,
+  // kPass, or kMidpoints where it may once its edge midpoints agree (5).
+  enum Verdict : std::uint8_t { kFail, kPass, kMidpoints };
+  const auto passes = [&](const Cell& c) -> Verdict {
     const int s = c.size, h = s / 2;
     const std::array<int, 5> xs = {c.x0, c.x0 + s, c.x0, c.x0 + s, c.x0 + h};
     const std::array<int, 5> ys = {c.y0, c.y0, c.y0 + s, c.y0 + s, c.y0 + h};
@@ -218,12 +227,12 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
     std::array<std::int64_t, 5> places;
     for (std::size_t k = 0; k < 5; ++k) {
       at[k] = grid.texel(xs[k], ys[k]);
-      if (at[k] < 0 || !reached[std::size_t(at[k])]) return false;
+      if (at[k] < 0 || !reached[std::size_t(at[k])]) return kFail;
       places[k] = place(xs[k], ys[k]);
-      if (!valued(places[k])) return false;
+      if (!valued(places[k])) return kFail;
     }
     const auto v = [&](int k) { return visibility(xs[std::size_t(k)], ys[std::size_t(k)]); };
-    if (std::abs(v(4) - 0.25 * (v(0) + v(1) + v(2) + v(3))) > settings.tolerance) return false;
+    if (std::abs(v(4) - 0.25 * (v(0) + v(1) + v(2) + v(3))) > settings.tolerance) return kFail;
     // One smooth piece of surface.
     const auto pos = [&](int k) {
       return Vec3(space.texels[std::size_t(at[std::size_t(k)])].position.cast<double>());
@@ -234,13 +243,13 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
         std::min({(p10 - p00).norm(), (p01 - p00).norm(), (p11 - p10).norm(), (p11 - p01).norm()});
     const double side_max =
         std::max({(p10 - p00).norm(), (p01 - p00).norm(), (p11 - p10).norm(), (p11 - p01).norm()});
-    if (!(side_max <= 3 * side_min)) return false;
+    if (!(side_max <= 3 * side_min)) return kFail;
     const double texel_size = side_min / s, texel_extent = side_max / s;
     const Vec3f centre_normal = space.texels[std::size_t(at[4])].normal;
     for (int k = 0; k < 4; ++k)
       if (space.texels[std::size_t(at[std::size_t(k)])].normal.dot(centre_normal) <
           settings.normal_cos)
-        return false;
+        return kFail;
     Bounds3 box;
     for (int k = 0; k < 5; ++k) box.extend(pos(k));
     for (int y = c.y0; y < c.y0 + s; ++y)
@@ -251,8 +260,8 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
         const double u = double(x - c.x0) / s, w = double(y - c.y0) / s;
         const Vec3 bilinear = (1 - w) * ((1 - u) * p00 + u * p10) + w * ((1 - u) * p01 + u * p11);
         const Vec3 p = tx.position.cast<double>();
-        if ((p - bilinear).norm() > settings.position_texels * texel_size) return false;
-        if (tx.normal.dot(centre_normal) < settings.normal_cos) return false;
+        if ((p - bilinear).norm() > settings.position_texels * texel_size) return kFail;
+        if (tx.normal.dot(centre_normal) < settings.normal_cos) return kFail;
         box.extend(p);
       }
     // In the umbra of one convex solid (or one polygon) at all five samples: so is every point
@@ -262,7 +271,7 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
     bool one_umbra = umbra != none.umbra;
     for (std::size_t k = 1; k < 5; ++k)
       one_umbra = one_umbra && sample_at(places[k]).umbra == umbra;
-    if (one_umbra) return true;
+    if (one_umbra) return kPass;
     // Every blocker the samples saw, far enough away for penumbrae at least feature_cells wide:
     // a texel of the cell lies at most its diagonal nearer to a blocker than the sample that saw
     // it (and every blocker of the cell's texels is one a sample saw, below).
@@ -289,19 +298,43 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
     // the umbra of one triangle of what they saw (a crown's facet over its shadow): whatever
     // the distance, as above.
     if (v(0) == 0 && v(1) == 0 && v(2) == 0 && v(3) == 0 && v(4) == 0) {
-      if (source.ball_hides(inside, seen)) return true;
+      if (source.ball_hides(inside, seen)) return kPass;
       std::array<std::size_t, 5> points;
       for (std::size_t k = 0; k < 5; ++k) points[k] = std::size_t(at[k]);
-      if (source.one_triangle_hides(points, seen)) return true;
+      if (source.one_triangle_hides(points, seen)) return kPass;
     }
-    if (std::isfinite(distance) &&
-        (distance - box.diagonal()) * width < settings.feature_cells * s * texel_extent)
-      return false;
+    // The narrowest penumbra a blocker the samples saw may cast on the cell, in cells.
+    const double penumbra_cells = std::isfinite(distance)
+                                      ? (distance - box.diagonal()) * width / (s * texel_extent)
+                                      : std::numeric_limits<double>::infinity();
+    if (penumbra_cells < settings.feature_cells) return kFail;
+    const Verdict near = penumbra_cells < settings.midpoint_cells ? kMidpoints : kPass;
     // A sample traced past the estimator's budget lists nothing: the distance bound above is
     // all there is to go on.
     for (std::size_t k = 0; k < 5; ++k)
-      if (!sample_at(places[k]).listed) return true;
-    return !source.sees_unlisted(inside, seen);
+      if (!sample_at(places[k]).listed) return near;
+    return source.sees_unlisted(inside, seen) ? kFail : near;
+  };
+
+  // A cell's edge midpoints (5), each with its edge's two corners: (x, y) of the three.
+  const auto edges = [](const Cell& c) {
+    const int s = c.size, h = s / 2, x0 = c.x0, y0 = c.y0;
+    return std::array<std::array<int, 6>, 4>{{{x0 + h, y0, x0, y0, x0 + s, y0},
+                                              {x0, y0 + h, x0, y0, x0, y0 + s},
+                                              {x0 + s, y0 + h, x0 + s, y0, x0 + s, y0 + s},
+                                              {x0 + h, y0 + s, x0, y0 + s, x0 + s, y0 + s}}};
+  };
+  // Whether each edge midpoint is valued and within `tolerance` of its edge's corners' mean,
+  // the interpolation's value there (linear along the cell's sides).
+  const auto midpoints_agree = [&](const Cell& c) {
+    for (const auto& [mx, my, ax, ay, bx, by] : edges(c)) {
+      const std::int32_t t = grid.texel(mx, my);
+      if (t < 0 || !reached[std::size_t(t)] || !valued(place(mx, my))) return false;
+      if (std::abs(visibility(mx, my) - 0.5 * (visibility(ax, ay) + visibility(bx, by))) >
+          settings.tolerance)
+        return false;
+    }
+    return true;
   };
 
   // Linear over the four triangles the centre makes with the cell's sides.
@@ -359,9 +392,31 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
     }
     evaluate_all(queue);
     // Each cell interpolates what it owns, or splits.
-    std::vector<std::uint8_t> pass(cells.size(), 0);
+    std::vector<std::uint8_t> pass(cells.size(), kFail);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 4), [&](const auto& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i) pass[i] = passes(cells[i]);
+    });
+    // The edge midpoints of the cells that ask for them, each evaluated once (exactly: an
+    // interpolated one is evaluated again), then their check.
+    std::vector<Queued> midpoints;
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      if (pass[i] != kMidpoints) continue;
+      for (const auto& e : edges(cells[i])) {
+        const std::int32_t t = grid.texel(e[0], e[1]);
+        if (t < 0 || !reached[std::size_t(t)]) continue;
+        const std::int64_t at = place(e[0], e[1]);
+        if (at < 0 || state[std::size_t(at)] == kQueued) continue;
+        if (state[std::size_t(at)] == kValued &&
+            field.route[std::size_t(at)] != TexelRoute::interpolated)
+          continue;
+        state[std::size_t(at)] = kQueued;
+        midpoints.push_back({std::size_t(t), std::size_t(at)});
+      }
+    }
+    evaluate_all(midpoints);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 16), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i)
+        if (pass[i] == kMidpoints) pass[i] = midpoints_agree(cells[i]) ? kPass : kFail;
     });
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 16), [&](const auto& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i)

@@ -154,6 +154,7 @@ struct RefinementSettings {
   double normal_cos = std::cos(15.0 * 3.14159265358979 / 180.0);  // normals of one smooth piece
   double position_texels = 1.0;  // a texel's distance from the cell's bilinear surface, in texels
   double feature_cells = 2.0;    // the narrowest penumbra allowed, in cells
+  double midpoint_cells = 4.0;   // under this, the cell's edge midpoints are checked too
 };
 
 // One light's visibility at every covered texel of a receiver, and the route each came by, by
