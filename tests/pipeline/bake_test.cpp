@@ -3,6 +3,8 @@
 // so a flipped or transposed lightmap cannot pass.
 #include <gtest/gtest.h>
 
+#include <chrono>
+
 #include <cmath>
 
 #include "pipeline/bake.h"
@@ -45,13 +47,23 @@ TEST(Bake, ParallelSceneMatchesClosedFormWithOffsetBlocker) {
   EXPECT_EQ(img.at(20, 9)[0], 0.0f);
 }
 
+// The times are the stages' own: each positive, the receiver's within the bake's, the bake's
+// within the call's wall time.
 TEST(Bake, ReportsRaysAndTimes) {
   Scene scene = parallel_scene(16, 16);
+  const auto start = std::chrono::steady_clock::now();
   auto result = bake(scene);
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ASSERT_TRUE(result) << result.error().message;
   EXPECT_GT(result->shadow_rays, 0);
-  EXPECT_EQ(result->receivers[0].covered_texels, 16 * 16);
-  EXPECT_GE(result->bake_seconds, 0.0);
+  const ReceiverBake& r = result->receivers[0];
+  EXPECT_EQ(r.covered_texels, 16 * 16);
+  EXPECT_GT(r.seconds_method, 0.0);
+  EXPECT_GE(r.seconds, r.seconds_texels + r.seconds_method);
+  EXPECT_GE(result->bake_seconds, r.seconds);
+  EXPECT_GT(result->load_seconds, 0.0);
+  EXPECT_LE(result->load_seconds + result->bake_seconds, wall);
 }
 
 // Ambient occlusion through the whole pipeline, with the scene's light taken away: at the floor's

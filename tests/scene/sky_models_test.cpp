@@ -3,6 +3,7 @@
 // file around its sun, and baked through a sky light as the sky's own integral says.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -111,7 +112,8 @@ TEST(Sky, APreethamSkyBakesToItsIntegral) {
 // The scene file: model = "preetham" around the scene's one sun, the sun it names or the
 // direction it gives; what does not fit is refused at the sky's line.
 TEST(Sky, SceneFileReadsAPreethamSkyAroundItsSun) {
-  const auto dir = std::filesystem::temp_directory_path() / "shadowbake_preetham_test";
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("shadowbake_preetham_test_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   std::ofstream(dir / "m.obj").flush();
   const std::string object = "[[object]]\nname = \"floor\"\nmesh = \"m.obj\"\n";

@@ -4,6 +4,7 @@
 // form says: under a blocker, a uniform sky's visibility is 1 minus the blocker's form factor,
 // by the reference's rays over the sky and by every route of its parts.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -238,7 +239,8 @@ TEST(Sky, UnderABlockerVisibilityIsOneMinusItsFormFactor) {
 }
 
 TEST(Sky, SceneFileReadsASkyAndRejectsWhatDoesNotApply) {
-  const auto dir = std::filesystem::temp_directory_path() / "shadowbake_sky_test";
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("shadowbake_sky_test_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   ASSERT_TRUE(write_image(dir / "sky.exr", *gradient_map(32, 16), PixelFormat::float32));
   std::ofstream(dir / "m.obj").flush();

@@ -3,6 +3,7 @@
 // partition the hard shadow, and on the subdivision scenes (table, posts, bracket) the bake
 // stays close to the reference, shadows itself and hardens at contact.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -243,7 +244,8 @@ TEST(ConvolutionPlan, ObjectShadowsItself) {
 // texels from 0.2 m past the foot (the acceptance test; nearer the foot see below).
 // 10–90 % widths across the shadow, at 512², with a 512-triple budget.
 TEST(ConvolutionPlan, PostShadowHardensAtContact) {
-  const auto dir = std::filesystem::temp_directory_path() / "sb_contact_hardening";
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("sb_contact_hardening_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   {
     // An 8 cm square post 1 m tall standing at x = 0.2 on the 2 x 2 m floor of scenes/parallel.
