@@ -172,10 +172,10 @@ int bake_scene(const BakeArgs& args, const std::string& scene_file, const std::s
   if (args.no_atlas) output.atlas.reset();
   if (args.samples) settings.samples = *args.samples;
   if (args.seed) settings.seed = *args.seed;
-  if (args.error_texels) settings.error_texels = *args.error_texels;
+  if (args.error_texels) settings.set("error_texels", *args.error_texels);
   if (args.max_memory) settings.max_memory = *args.max_memory;
-  if (args.no_trace) settings.trace = false;
-  if (args.no_convolve) settings.convolve = false;
+  if (args.no_trace) settings.set("trace", false);
+  if (args.no_convolve) settings.set("convolve", false);
   if (args.no_seams) settings.seams = false;
 
   // The output folder is locked and its names checked before the bake, so a bake that could not

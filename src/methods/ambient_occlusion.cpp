@@ -110,15 +110,17 @@ class AmbientOcclusionMethod final : public Method {
 }  // namespace
 
 MethodEntry ambient_occlusion_method() {
-  return {"ambient-occlusion",
-          {"samples", "seed", "ao_distance"},
-          [](const BakeSettings&) { return MethodNeeds{.rays = true}; },
-          nullptr,
-          [](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {
-            return std::unique_ptr<Method>(std::make_unique<AmbientOcclusionMethod>(context));
-          },
-          /*tile_halo=*/0,  // each texel's rays are its own
-          nullptr};
+  MethodEntry e;
+  e.name = "ambient-occlusion";
+  e.settings = {"samples", "seed", "ao_distance"};
+  e.needs = [](const BakeSettings&) { return MethodNeeds{.rays = true}; };
+  e.make = [](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {
+    return std::unique_ptr<Method>(std::make_unique<AmbientOcclusionMethod>(context));
+  };
+  e.tile_halo = 0;  // each texel's rays are its own
+  e.local = true;
+  e.only_quantity = Quantity::ambient_occlusion;
+  return e;
 }
 
 }  // namespace sb

@@ -43,45 +43,51 @@ class BaselineMethod final : public Method {
 std::vector<MemoryItem> shadow_map_memory(const Scene& scene, double texels) {
   const BakeSettings& b = scene.bake;
   const double lights = double(scene.lights.size());
-  const double map = double(b.shadow_map) * double(b.shadow_map) * 4;
+  const double side = double(b.whole("shadow_map")), map = side * side * 4;
   return {{"shadow maps", map * lights * 6},
           {"per-light visibility", texels * lights * (sizeof(Vec3f) + 1)}};
 }
 
-MethodEntry baseline_entry(std::string name, std::vector<std::string> settings, bool rays,
-                           BaselineMethod::Bake bake,
+MethodEntry baseline_entry(std::string name, std::vector<std::string> settings,
+                           std::vector<SettingSpec> own, bool rays, BaselineMethod::Bake bake,
                            std::function<std::vector<MemoryItem>(const Scene&, double)> memory) {
-  return {std::move(name),
-          std::move(settings),
-          [rays](const BakeSettings&) { return MethodNeeds{.rays = rays}; },
-          std::move(memory),
-          [bake](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {
-            return std::unique_ptr<Method>(std::make_unique<BaselineMethod>(context, bake));
-          },
-          /*tile_halo=*/-1,  // shadow maps and clusters fitted to the whole receiver
-          nullptr};
+  MethodEntry e;
+  e.name = std::move(name);
+  e.settings = std::move(settings);
+  e.own_settings = std::move(own);
+  e.needs = [rays](const BakeSettings&) { return MethodNeeds{.rays = rays}; };
+  e.memory = std::move(memory);
+  e.make = [bake](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {
+    return std::unique_ptr<Method>(std::make_unique<BaselineMethod>(context, bake));
+  };
+  e.tile_halo = -1;  // shadow maps and clusters fitted to the whole receiver
+  e.local = false;   // and to the whole scene
+  return e;
 }
 
 }  // namespace
 
 MethodEntry accumulation_method() {
-  return baseline_entry("accumulation", {"samples", "seed"}, true, bake_accumulation, nullptr);
+  return baseline_entry("accumulation", {"samples", "seed"}, {}, true, bake_accumulation, nullptr);
 }
 
 MethodEntry erosion_method() {
   return baseline_entry(
-      "erosion", {"erosion_factor"}, true,
+      "erosion", {}, {word_setting("erosion_factor", "pcf", {"pcf", "distance"})}, true,
       [](const TexelSpace& space, const BaselineInputs& in, MethodStats* stats,
          std::int64_t* rays) { return bake_erosion(space, in, stats, rays); },
       shadow_map_memory);
 }
 
 MethodEntry shadow_map_method(const std::string& name) {
-  std::vector<std::string> settings = {"shadow_map"};
-  if (name == "pcf") settings.push_back("pcf_radius");
-  if (name == "adaptive-pcf") settings.insert(settings.end(), {"samples", "seed"});
+  std::vector<std::string> settings;
+  std::vector<SettingSpec> own = {whole_setting("shadow_map", 2048, 64, 16384)};
+  if (name == "pcf")
+    own.push_back(
+        number_setting("pcf_radius", 2.0, "a number >= 0", [](double x) { return x >= 0; }));
+  if (name == "adaptive-pcf") settings = {"samples", "seed"};
   return baseline_entry(
-      name, settings, false,
+      name, settings, own, false,
       [](const TexelSpace& space, const BaselineInputs& in, MethodStats* stats, std::int64_t*) {
         return bake_shadow_map_filter(space, in, stats);
       },

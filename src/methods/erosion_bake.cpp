@@ -467,7 +467,7 @@ class ErosionBake {
   }
 
   void erode(std::size_t l, LightMix& mix, Figures& figures) {
-    const bool by_distance = in_.settings->erosion_factor == ErosionFactor::distance;
+    const bool by_distance = in_.settings->word("erosion_factor") == "distance";
     if (!by_distance) build_tables();
     const EdgeIndex index(edges_, W_, H_);
     std::atomic<std::int64_t> penumbra{0};

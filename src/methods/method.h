@@ -12,6 +12,7 @@
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -107,9 +108,15 @@ inline constexpr int kTileRows = 32;
 
 struct MethodEntry {
   std::string name;
-  // The [bake] keys it reads beyond those of every bake (resolution, method, quantity, margin,
-  // max_memory); others given in the scene are reported as ignored.
+  // The [bake] keys it shares with other methods beyond those of every bake (resolution, method,
+  // quantity, margin, max_memory): samples, seed, ao_distance; with own_settings, what it reads
+  // (others given in the scene are reported as ignored).
   std::vector<std::string> settings;
+  // Its own [bake] keys: their defaults, types and checks (scene/scene.h's SettingSpec). The
+  // scene reader, the manifest and the shard files take them from here, and the method reads
+  // them with BakeSettings::flag/whole/number/word; a key may be declared by several methods
+  // alike (the shadow-map baselines' `shadow_map`).
+  std::vector<SettingSpec> own_settings;
   std::function<MethodNeeds(const BakeSettings&)> needs;
   // Its own large arrays for a bake of `scene` whose largest receiver has `texels` texels, beyond
   // texel space and the lightmaps (counted by pipeline/memory_budget.cpp), estimated before
@@ -124,7 +131,32 @@ struct MethodEntry {
   int tile_halo = -1;
   // Fills a report's stats and explain from its tallies; empty: the method reports no stats.
   std::function<void(MethodReport&)> summarise;
+  // Whether a receiver's result depends on nothing of the scene but the lights that may reach
+  // it and the blockers in their shafts (pipeline/bake_cache.h keys it by those alone); false
+  // where the method fits something to the whole scene (shadow maps, clusters).
+  bool local = false;
+  // What `shadowbake plan` prints for one receiver, without baking; empty: the method has no
+  // plan to show.
+  std::function<Expected<std::string>(const BakeContext&, const ReceiverInput&)> plan;
+  // The one quantity it bakes where it bakes no other (ambient occlusion's); the scene reader
+  // pairs that quantity with it.
+  std::optional<Quantity> only_quantity;
+  // Its own settings the manifest records at its top level, as baked.
+  std::vector<std::string> manifest_settings;
+  // Whether it reads the [bake] key `key` (settings or own_settings).
+  bool reads(std::string_view key) const;
 };
+
+// A method's own settings (MethodEntry::own_settings), by type: a switch; a whole number in
+// [lo, hi] (`requirement` and `valid` for a further check); a number `valid` accepts
+// (`requirement` says which); a word among `words` (the first of which need not be the default).
+SettingSpec flag_setting(std::string key, bool fallback);
+SettingSpec whole_setting(std::string key, std::int64_t fallback, std::int64_t lo, std::int64_t hi,
+                          std::string requirement = {},
+                          std::function<bool(std::int64_t)> valid = nullptr);
+SettingSpec number_setting(std::string key, double fallback, std::string requirement,
+                           std::function<bool(double)> valid);
+SettingSpec word_setting(std::string key, std::string fallback, std::vector<std::string> words);
 
 // Every method of this build, in the order docs/methods.md lists them.
 const std::vector<MethodEntry>& method_registry();

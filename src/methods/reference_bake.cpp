@@ -101,15 +101,16 @@ class ReferenceMethod final : public Method {
 }  // namespace
 
 MethodEntry reference_method() {
-  return {"reference",
-          {"samples", "seed"},
-          [](const BakeSettings&) { return MethodNeeds{.rays = true}; },
-          nullptr,
-          [](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {
-            return std::unique_ptr<Method>(std::make_unique<ReferenceMethod>(context));
-          },
-          /*tile_halo=*/1,  // its rays are its own; a terminator's texel reads its 8 neighbours
-          nullptr};
+  MethodEntry e;
+  e.name = "reference";
+  e.settings = {"samples", "seed"};
+  e.needs = [](const BakeSettings&) { return MethodNeeds{.rays = true}; };
+  e.make = [](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {
+    return std::unique_ptr<Method>(std::make_unique<ReferenceMethod>(context));
+  };
+  e.tile_halo = 1;  // its rays are its own; a terminator's texel reads its 8 neighbours
+  e.local = true;
+  return e;
 }
 
 }  // namespace sb

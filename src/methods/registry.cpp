@@ -1,4 +1,6 @@
 // The registry of bake methods: a new method adds its entry here (one line) and its own files.
+#include <algorithm>
+
 #include "methods/ambient_occlusion.h"
 #include "methods/backprojection/backprojection_method.h"
 #include "methods/baselines.h"
@@ -33,6 +35,90 @@ const std::vector<std::string>& known_methods() {
     return out;
   }();
   return names;
+}
+
+bool MethodEntry::reads(std::string_view key) const {
+  for (const std::string& k : settings)
+    if (k == key) return true;
+  for (const SettingSpec& spec : own_settings)
+    if (spec.key == key) return true;
+  return false;
+}
+
+SettingSpec flag_setting(std::string key, bool fallback) {
+  SettingSpec spec;
+  spec.key = std::move(key);
+  spec.fallback = fallback;
+  return spec;
+}
+
+SettingSpec whole_setting(std::string key, std::int64_t fallback, std::int64_t lo, std::int64_t hi,
+                          std::string requirement, std::function<bool(std::int64_t)> valid) {
+  SettingSpec spec;
+  spec.key = std::move(key);
+  spec.fallback = fallback;
+  spec.lo = lo, spec.hi = hi;
+  spec.requirement = std::move(requirement);
+  if (valid)
+    spec.valid = [valid = std::move(valid)](const SettingValue& v) {
+      return valid(std::get<std::int64_t>(v));
+    };
+  return spec;
+}
+
+SettingSpec number_setting(std::string key, double fallback, std::string requirement,
+                           std::function<bool(double)> valid) {
+  SettingSpec spec;
+  spec.key = std::move(key);
+  spec.fallback = fallback;
+  spec.requirement = std::move(requirement);
+  spec.valid = [valid = std::move(valid)](const SettingValue& v) {
+    return valid(std::get<double>(v));
+  };
+  return spec;
+}
+
+SettingSpec word_setting(std::string key, std::string fallback, std::vector<std::string> words) {
+  SettingSpec spec;
+  spec.key = std::move(key);
+  spec.fallback = std::move(fallback);
+  for (std::size_t i = 0; i < words.size(); ++i)
+    spec.requirement += (i == 0                  ? ""
+                         : i + 1 == words.size() ? " or "
+                                                 : ", ") +
+                        ("\"" + words[i] + "\"");
+  spec.valid = [words = std::move(words)](const SettingValue& v) {
+    return std::find(words.begin(), words.end(), std::get<std::string>(v)) != words.end();
+  };
+  return spec;
+}
+
+// The rest are declared in scene/scene.h, for the scene reader.
+std::string default_method() { return method_registry().front().name; }
+
+std::string method_baking_only(Quantity q) {
+  for (const MethodEntry& entry : method_registry())
+    if (entry.only_quantity == q) return entry.name;
+  return {};
+}
+
+const std::vector<SettingSpec>& method_setting_specs() {
+  static const std::vector<SettingSpec> specs = [] {
+    std::vector<SettingSpec> out;
+    for (const MethodEntry& entry : method_registry())
+      for (const SettingSpec& spec : entry.own_settings)
+        if (std::none_of(out.begin(), out.end(),
+                         [&](const SettingSpec& s) { return s.key == spec.key; }))
+          out.push_back(spec);
+    return out;
+  }();
+  return specs;
+}
+
+const SettingSpec* find_method_setting(std::string_view key) {
+  for (const SettingSpec& spec : method_setting_specs())
+    if (spec.key == key) return &spec;
+  return nullptr;
 }
 
 }  // namespace sb

@@ -12,6 +12,7 @@
 #include <set>
 
 #include "occluders/shaft_culling.h"
+#include "pipeline/bake_stages.h"
 #include "pipeline/settings_json.h"
 #include "pipeline/shard_files.h"
 #include "source_hash.h"  // generated at build time (CMakeLists.txt, script mode)
@@ -142,10 +143,6 @@ json key_json(const ReceiverKey& k) {
 
 }  // namespace
 
-bool method_is_local(const std::string& method) {
-  return method == "backprojection" || method == "reference" || method == "ambient-occlusion";
-}
-
 Expected<std::vector<ReceiverKey>> receiver_keys(const KeyInputs& in,
                                                  const std::vector<std::size_t>& objects,
                                                  const std::vector<int>& sides,
@@ -154,7 +151,7 @@ Expected<std::vector<ReceiverKey>> receiver_keys(const KeyInputs& in,
   const std::vector<Light>& lights = *in.lights;
   const std::vector<const Mesh*>& blockers = *in.blockers;
   const bool ambient_occlusion = scene.bake.quantity == Quantity::ambient_occlusion;
-  const bool local = method_is_local(scene.bake.method);
+  const bool local = in.local;
 
   std::string settings;
   {
@@ -405,6 +402,44 @@ void prune_cache(const fs::path& output_dir, const BakeResult& result) {
     if (e.is_regular_file(error) && !keep.count(name)) stale.push_back(e.path());
   }
   for (const fs::path& p : stale) fs::remove(p, error);
+}
+
+Expected<Reuse> reuse_from_cache(const Scene& scene, const MethodEntry& method,
+                                 const LoadedScene& loaded, const BakeOptions& options) {
+  const std::size_t n = loaded.receivers.size();
+  Reuse reuse;
+  reuse.keys.resize(n);
+  reuse.reused.resize(n);
+  reuse.why.resize(n);
+  if (!options.keys) return reuse;
+  // The keys' shaft tests: the method's culler, or one of their own for a local method.
+  std::optional<ShaftCuller> own_culler;
+  const ShaftCuller* culler = loaded.shafts ? &*loaded.shafts : nullptr;
+  if (!culler && scene.bake.quantity != Quantity::ambient_occlusion && method.local) {
+    own_culler.emplace(loaded.blockers);
+    culler = &*own_culler;
+  }
+  KeyInputs in;
+  in.scene = &scene;
+  in.local = method.local;
+  in.meshes = &loaded.meshes;
+  in.lights = &loaded.lights;
+  in.blockers = &loaded.blockers;
+  in.culler = culler;
+  in.keep_per_light = options.keep_per_light;
+  in.keep_per_light.values |= scene.output.per_light;
+  in.keep_per_light.visibility |= scene.output.shadowmask;
+  std::vector<std::vector<int>> reaching;
+  auto keys = receiver_keys(in, loaded.receivers, loaded.sides, &reaching);
+  if (!keys) return keys.error();
+  reuse.keys = std::move(*keys);
+  auto decided = decide_reuse(scene, loaded.receivers, reuse.keys, reaching, options);
+  if (!decided) return decided.error();
+  for (std::size_t r = 0; r < n; ++r) {
+    reuse.reused[r] = std::move((*decided)[r].reused);
+    reuse.why[r] = std::move((*decided)[r].why);
+  }
+  return reuse;
 }
 
 }  // namespace sb

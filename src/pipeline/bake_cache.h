@@ -14,8 +14,8 @@
 //   blockers  — each blocker that may lie in a shaft from the receiver to one of those lights
 //               (ShaftCuller::tile_candidates with the receiver's whole box as the tile), or
 //               within ao_distance of it for ambient occlusion, in scene order: its name and mesh.
-// Blockers and lights keep their relative order when others are added or removed, and the
-// methods marked local (backprojection, reference, ambient-occlusion) read nothing of the scene
+// Blockers and lights keep their relative order when others are added or removed, and a
+// method whose registry entry is marked local (MethodEntry::local) reads nothing of the scene
 // beyond them, so a reused result is byte for byte what baking again would give; for the other
 // methods (their shadow maps and clusters are fitted to the whole scene) every blocker counts.
 #pragma once
@@ -26,7 +26,7 @@
 #include <vector>
 
 #include "core/error.h"
-#include "pipeline/bake.h"
+#include "pipeline/bake_types.h"
 #include "pipeline/output_folder.h"
 #include "scene/lights.h"
 #include "scene/mesh.h"
@@ -38,14 +38,11 @@ class ShaftCuller;
 // The cache's folder inside an output folder.
 inline constexpr const char* kCacheFolder = ".shadowbake-cache";
 
-// Whether a method's result for a receiver depends only on the lights and blockers its key
-// names (see above).
-bool method_is_local(const std::string& method);
-
 // What the keys are computed from; `culler` holds `blockers` (may be null for ambient
 // occlusion or a method that is not local).
 struct KeyInputs {
   const Scene* scene = nullptr;
+  bool local = false;                         // the method's MethodEntry::local
   const std::vector<Mesh>* meshes = nullptr;  // per object
   const std::vector<Light>* lights = nullptr;
   const std::vector<const Mesh*>* blockers = nullptr;

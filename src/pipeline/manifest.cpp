@@ -400,8 +400,8 @@ json manifest_to_json(const Manifest& m) {
   out["samples"] = m.samples;
   out["seed"] = m.seed;
   out["margin"] = m.margin;
-  if (m.trace) out["trace"] = *m.trace;
-  if (m.convolve) out["convolve"] = *m.convolve;
+  for (const auto& [key, value] : m.method_settings)
+    std::visit([&, &key = key](const auto& v) { out[key] = v; }, value);
   out["output"] = output_to_json(m.output);
   out["lights"] = json::array();
   for (const auto& l : m.lights) {
@@ -446,8 +446,13 @@ Expected<Manifest> manifest_from_json(const json& json_manifest, const std::stri
   fields.read("samples", m.samples);
   fields.read("seed", m.seed);
   fields.read("margin", m.margin);
-  fields.read_optional("trace", m.trace);
-  fields.read_optional("convolve", m.convolve);
+  // The method's settings it records: any method's own keys present (MethodEntry).
+  for (const SettingSpec& spec : method_setting_specs()) {
+    if (!json_manifest.is_object() || !json_manifest.contains(spec.key)) continue;
+    SettingValue value = spec.fallback;
+    std::visit([&](auto& v) { fields.read(spec.key.c_str(), v); }, value);
+    m.method_settings.emplace_back(spec.key, std::move(value));
+  }
   read_output(fields, where, m.output, status);
   if (const json* lights = fields.array("lights")) {
     read_objects(*lights, "lights", where, status, [&](const json& entry, const std::string& path) {

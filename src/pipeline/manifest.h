@@ -118,8 +118,9 @@ struct Manifest {
   std::optional<double> texels_per_metre;  // when the lightmaps were sized by density
   std::uint64_t seed = 0;
   int margin = 0;
-  std::optional<bool> trace, convolve;  // the convolution's switches; only for it
-  OutputSettings output;                // [output] as the bake ran
+  // The method's own settings it records (MethodEntry::manifest_settings), in its order.
+  std::vector<std::pair<std::string, SettingValue>> method_settings;
+  OutputSettings output;  // [output] as the bake ran
   std::vector<ManifestLight> lights;
   std::optional<double> png_white_point;  // irradiance only: W/m² the previews map to white
   std::vector<ManifestAtlas> atlases;     // with [output] atlas

@@ -378,10 +378,13 @@ Status write_outputs(OutputFolder& folder, const Scene& scene, const BakeSetting
   manifest.samples = effective.samples;
   manifest.seed = effective.seed;
   manifest.margin = effective.margin;
-  if (effective.method == "convolution") {
-    manifest.trace = effective.trace;
-    manifest.convolve = effective.convolve;
-  }
+  if (const MethodEntry* entry = find_method(effective.method))
+    for (const std::string& key : entry->manifest_settings) {
+      const SettingSpec* spec = find_method_setting(key);
+      const auto given = effective.own.find(key);
+      manifest.method_settings.emplace_back(
+          key, given != effective.own.end() ? given->second : spec->fallback);
+    }
   manifest.output = out;
   for (std::size_t l = 0; l < scene.lights.size(); ++l) {
     ManifestLight& light = manifest.lights.emplace_back();

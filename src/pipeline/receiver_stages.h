@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "core/error.h"
-#include "pipeline/bake.h"
+#include "pipeline/bake_types.h"
 #include "scene/lights.h"
 #include "scene/mesh.h"
 #include "scene/scene.h"

@@ -11,12 +11,6 @@ namespace {
 
 using json = nlohmann::ordered_json;
 
-const char* to_string(BlockerCombine b) { return b == BlockerCombine::sum ? "sum" : "product"; }
-const char* to_string(ConvolutionWeighting w) {
-  return w == ConvolutionWeighting::irradiance ? "irradiance" : "emission";
-}
-const char* to_string(ErosionFactor e) { return e == ErosionFactor::pcf ? "pcf" : "distance"; }
-
 // Reads keys of one object, keeping the first problem.
 class Reader {
  public:
@@ -71,23 +65,13 @@ json settings_to_json(const BakeSettings& b, const OutputSettings& o) {
                {"ao_distance", b.ao_distance},
                {"margin", b.margin},
                {"seams", b.seams},
-               {"seed", b.seed},
-               {"error_texels", b.error_texels},
-               {"max_image", b.max_image},
-               {"max_triples", b.max_triples},
-               {"light_parts", b.light_parts},
-               {"trace", b.trace},
-               {"convolve", b.convolve},
-               {"trace_error_texels", b.trace_error_texels},
-               {"blocker_combine", to_string(b.blocker_combine)},
-               {"weighting", to_string(b.weighting)},
-               {"shadow_map", b.shadow_map},
-               {"pcf_radius", b.pcf_radius},
-               {"erosion_factor", to_string(b.erosion_factor)},
-               {"light_rows", b.light_rows},
-               {"max_polygons", b.max_polygons},
-               {"max_cell", b.max_cell},
-               {"interpolation_tolerance", b.interpolation_tolerance}};
+               {"seed", b.seed}};
+  // Each method's own settings, as set or by default (SettingSpec).
+  for (const SettingSpec& spec : method_setting_specs()) {
+    const auto given = b.own.find(spec.key);
+    const SettingValue& v = given != b.own.end() ? given->second : spec.fallback;
+    std::visit([&](const auto& value) { bake[spec.key] = value; }, v);
+  }
   json output = {{"encoding", to_string(o.encoding)},
                  {"per_light", o.per_light},
                  {"shadowmask", o.shadowmask},
@@ -114,23 +98,11 @@ Status settings_from_json(const json& j, const std::string& where, BakeSettings&
   r.read("margin", b.margin);
   r.read("seams", b.seams);
   r.read("seed", b.seed);
-  r.read("error_texels", b.error_texels);
-  r.read("max_image", b.max_image);
-  r.read("max_triples", b.max_triples);
-  r.read("light_parts", b.light_parts);
-  r.read("trace", b.trace);
-  r.read("convolve", b.convolve);
-  r.read("trace_error_texels", b.trace_error_texels);
-  r.read_enum("blocker_combine", b.blocker_combine, {BlockerCombine::sum, BlockerCombine::product});
-  r.read_enum("weighting", b.weighting,
-              {ConvolutionWeighting::irradiance, ConvolutionWeighting::emission});
-  r.read("shadow_map", b.shadow_map);
-  r.read("pcf_radius", b.pcf_radius);
-  r.read_enum("erosion_factor", b.erosion_factor, {ErosionFactor::pcf, ErosionFactor::distance});
-  r.read("light_rows", b.light_rows);
-  r.read("max_polygons", b.max_polygons);
-  r.read("max_cell", b.max_cell);
-  r.read("interpolation_tolerance", b.interpolation_tolerance);
+  for (const SettingSpec& spec : method_setting_specs()) {
+    SettingValue v = spec.fallback;
+    std::visit([&](auto& value) { r.read(spec.key.c_str(), value); }, v);
+    if (status) b.set(spec.key, std::move(v));
+  }
   Reader out(j["output"], where, status);
   const std::initializer_list<Encoding> encodings = {Encoding::linear_exr, Encoding::half_exr,
                                                      Encoding::png, Encoding::rgbm_png};

@@ -14,7 +14,7 @@
 #include <string>
 
 #include "core/error.h"
-#include "pipeline/bake.h"
+#include "pipeline/bake_types.h"
 
 namespace sb {
 

@@ -14,6 +14,7 @@
 #include <set>
 #include <sstream>
 
+#include "pipeline/bake_stages.h"
 #include "pipeline/settings_json.h"
 #include "pipeline/shard_files.h"
 #include "pipeline/tiles.h"

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "core/error.h"
-#include "pipeline/bake.h"
+#include "pipeline/bake_types.h"
 #include "pipeline/output_folder.h"
 #include "scene/scene.h"
 

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "core/error.h"
-#include "pipeline/bake.h"
+#include "pipeline/bake_types.h"
 #include "scene/lights.h"
 #include "scene/mesh.h"
 #include "scene/scene.h"
@@ -40,6 +40,10 @@ std::vector<double> row_block_costs(const Mesh& mesh, int side, const std::vecto
 std::vector<ShardUnit> shard_units(const std::vector<std::vector<double>>& block_costs,
                                    const std::vector<int>& sides, bool split,
                                    const ShardSpec& spec);
+
+// The items a shard bakes (indices into `costs`, in order): `costs` per item (a receiver, or a
+// tile) dealt to `spec.count` shards as spec.balance says. The same costs give the same shards.
+std::vector<std::size_t> shard_receivers(const std::vector<double>& costs, const ShardSpec& spec);
 
 // The rows a tile's bake rasterises: its own and `halo` on each side, within the lightmap.
 RowRange tile_window(RowRange rows, int halo, int side);

@@ -5,10 +5,13 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <limits>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <variant>
 #include <vector>
 
 #include "core/error.h"
@@ -21,19 +24,6 @@ namespace sb {
 // part (methods/ambient_occlusion.h; baked by the method of that name alone).
 enum class Quantity { visibility, irradiance, ambient_occlusion };
 
-// How the occluded fractions O_i of different blocker clusters over one texel combine
-// (docs/design.md §5): `product` takes V = ∏(1 − O_i), clusters hiding independent parts of the
-// light; `sum` takes V = 1 − Σ O_i, clusters hiding disjoint parts. docs/methods.md has the
-// measurement that chose the default.
-enum class BlockerCombine { product, sum };
-
-// What the convolution's V averages the light's points by: `irradiance` (cos·cos/r², to first
-// order across the light, as the reference) or `emission` (V_u, exact for parallel planes).
-enum class ConvolutionWeighting { irradiance, emission };
-
-// How erosion turns the distance to a hard-shadow edge into a shadow factor.
-enum class ErosionFactor { pcf, distance };
-
 // Whether `name` can stand in a file name on every platform outputs travel to: letters, digits,
 // '_', '.', '-', not starting with '.' (object names, and light names with per-light files).
 bool is_file_name_part(std::string_view name);
@@ -42,12 +32,39 @@ bool is_file_name_char(char c);  // one character of such a name
 // Names of the methods this build knows, in the order docs/methods.md lists them.
 const std::vector<std::string>& known_methods();
 
+// What the scene reader asks of the methods' registry without depending on the methods
+// (methods/registry.cpp defines these): the default method, and the method that alone bakes `q`
+// where one does (ambient occlusion's), else empty.
+std::string default_method();
+std::string method_baking_only(Quantity q);
+
+// A method's own [bake] setting's value: a switch, a whole number, a number or a word.
+using SettingValue = std::variant<bool, std::int64_t, double, std::string>;
+
+// One [bake] key that a method reads beyond the keys of every bake, as its registry entry
+// declares it (MethodEntry::own_settings): its default, which also gives the value's type, and
+// how a value is checked. The scene reader, the command line, the manifest and the shard files
+// know a method's settings only through these.
+struct SettingSpec {
+  std::string key;
+  SettingValue fallback;
+  std::int64_t lo = 0, hi = 0;  // a whole number's range
+  // What a valid number or word is, for errors ("a number > 0", "\"product\" or \"sum\"").
+  std::string requirement;
+  std::function<bool(const SettingValue&)> valid;  // beyond the type and range; may be empty
+};
+
+// Every method's own settings, each key once, in the registry's order (methods/registry.cpp).
+const std::vector<SettingSpec>& method_setting_specs();
+// The one for `key`, or null.
+const SettingSpec* find_method_setting(std::string_view key);
+
 struct BakeSettings {
   int resolution = 512;  // texels per side of each receiver's lightmap
   // When > 0, each receiver's lightmap side instead follows from its surface area: this many
   // texels per metre of its surface (texels/lightmap_sizes.h), times its lightmap_scale.
   double texels_per_metre = 0;
-  std::string method = "backprojection";
+  std::string method = default_method();
   Quantity quantity = Quantity::visibility;
   int samples = 256;  // light samples per texel, for sampling methods (rays, for ambient occlusion)
   // ambient occlusion: metres along a ray within which a blocker occludes it (Blender's default)
@@ -59,35 +76,16 @@ struct BakeSettings {
   std::uint64_t seed = 0;  // sampling seed; same seed, same bytes
   // Bytes the bake may use (memory_budget.h); 0: the default, 3/4 of the physical memory.
   std::uint64_t max_memory = 0;
-  // convolution: the penumbra error ε allowed per (light part, blocker cluster, receiver part)
-  // triple, in receiver texels, and the largest convolution image side, pixels
-  double error_texels = 1.0;
-  int max_image = 4096;
-  int max_triples = 128;  // leaf triples per light: the convolution's work budget
-  int light_parts = 2;    // convolution: each rectangular light split into at least this many
-  // convolution: trace `samples` shadow rays per light at the (light, texel) pairs whose leaves'
-  // penumbra error exceeds trace_error_texels, or which a blocker may shadow unaccounted for
-  // (traced_convolution.h); false: the convolution's values stand everywhere
-  bool trace = true;
-  // convolution: false skips the convolution, so that the shaft test's clear pairs are V = 1 and
-  // every other pair is traced (needs trace): what the convolution contributes is measured
-  // against this (docs/performance.md)
-  bool convolve = true;
-  double trace_error_texels = 1.0;
-  BlockerCombine blocker_combine = BlockerCombine::sum;
-  ConvolutionWeighting weighting = ConvolutionWeighting::irradiance;
-  // backprojection: rows of cells across each light; the blocker polygons a texel's shaft may
-  // hold before it is traced instead; the adaptive sampling's coarsest cell (texels; 1: every
-  // texel evaluated) and the largest |V| error it lets a cell's centre have before it refines
-  int light_rows = 32;
-  int max_polygons = 256;
-  int max_cell = 8;
-  double interpolation_tolerance = 2e-3;
-  // shadow-map baselines (pcf, pcss, adaptive-pcf, chun-oh, erosion): the shadow map's side in
-  // pixels, PCF's fixed filter radius in shadow-map pixels, and erosion's shadow factor
-  int shadow_map = 2048;
-  double pcf_radius = 2.0;
-  ErosionFactor erosion_factor = ErosionFactor::pcf;
+  // Each method's own [bake] keys (SettingSpec) that the scene file or the command line set; a
+  // key not here has its method's default. Read with the getters below, set with set().
+  std::map<std::string, SettingValue, std::less<>> own;
+  bool flag(std::string_view key) const;
+  std::int64_t whole(std::string_view key) const;
+  double number(std::string_view key) const;  // a whole number's value too
+  std::string word(std::string_view key) const;
+  // Sets a method's own setting, a whole number made a number where the key takes one; not
+  // checked against its range (the scene reader checks what a file gives).
+  void set(std::string_view key, SettingValue value);
 };
 
 struct ObjectDesc {

@@ -16,6 +16,7 @@
 #include <numbers>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -58,9 +59,47 @@ const char* to_string(LightShape s) {
   return "?";
 }
 
+namespace {
+
+const SettingSpec& spec_of(std::string_view key) {
+  const SettingSpec* spec = find_method_setting(key);
+  if (!spec) throw std::logic_error("no method reads the [bake] key " + std::string(key));
+  return *spec;
+}
+
+const SettingValue& value_of(const BakeSettings& bake, std::string_view key) {
+  const auto given = bake.own.find(key);
+  return given != bake.own.end() ? given->second : spec_of(key).fallback;
+}
+
+}  // namespace
+
+bool BakeSettings::flag(std::string_view key) const { return std::get<bool>(value_of(*this, key)); }
+
+std::int64_t BakeSettings::whole(std::string_view key) const {
+  return std::get<std::int64_t>(value_of(*this, key));
+}
+
+double BakeSettings::number(std::string_view key) const {
+  const SettingValue& v = value_of(*this, key);
+  if (const auto* w = std::get_if<std::int64_t>(&v)) return double(*w);
+  return std::get<double>(v);
+}
+
+std::string BakeSettings::word(std::string_view key) const {
+  return std::get<std::string>(value_of(*this, key));
+}
+
+void BakeSettings::set(std::string_view key, SettingValue value) {
+  const SettingSpec& spec = spec_of(key);
+  if (std::holds_alternative<double>(spec.fallback))
+    if (const auto* w = std::get_if<std::int64_t>(&value)) value = double(*w);
+  own.insert_or_assign(std::string(key), std::move(value));
+}
+
 Status pair_quantity_and_method(BakeSettings& bake, bool quantity_given, bool method_given,
                                 const std::string& where) {
-  constexpr const char* ao = "ambient-occlusion";
+  const std::string ao = method_baking_only(Quantity::ambient_occlusion);
   const bool ao_quantity = bake.quantity == Quantity::ambient_occlusion;
   const bool ao_method = bake.method == ao;
   if (ao_quantity == ao_method) return Ok{};
@@ -74,8 +113,8 @@ Status pair_quantity_and_method(BakeSettings& bake, bool quantity_given, bool me
   }
   return scene_error(fmt::format(
       "{}: quantity '{}' and method '{}' do not go together: ambient occlusion is baked by "
-      "method 'ambient-occlusion', which bakes nothing else",
-      where, to_string(bake.quantity), bake.method));
+      "method '{}', which bakes nothing else",
+      where, to_string(bake.quantity), bake.method, ao));
 }
 
 Affine3 object_transform(const Vec3& translate, const Vec3& rotate_deg, const Vec3& scale) {

@@ -9,32 +9,12 @@ namespace sb {
 
 Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::table& table) {
   TableReader r(file, table, "[bake]");
-  r.check_known_keys({"resolution",
-                      "texels_per_metre",
-                      "method",
-                      "quantity",
-                      "samples",
-                      "ao_distance",
-                      "margin",
-                      "seams",
-                      "seed",
-                      "max_memory",
-                      "error_texels",
-                      "max_image",
-                      "max_triples",
-                      "light_parts",
-                      "trace",
-                      "convolve",
-                      "trace_error_texels",
-                      "blocker_combine",
-                      "weighting",
-                      "shadow_map",
-                      "pcf_radius",
-                      "erosion_factor",
-                      "light_rows",
-                      "max_polygons",
-                      "max_cell",
-                      "interpolation_tolerance"});
+  // Every bake's keys, then each method's own (SettingSpec, from the registry).
+  std::vector<std::string_view> known = {"resolution", "texels_per_metre", "method", "quantity",
+                                         "samples",    "ao_distance",      "margin", "seams",
+                                         "seed",       "max_memory"};
+  for (const SettingSpec& spec : method_setting_specs()) known.push_back(spec.key);
+  r.check_known_keys(known);
   BakeSettings bake;
   const int int_max = std::numeric_limits<int>::max();
   if (auto v = r.integer("resolution", 1, 16384)) bake.resolution = static_cast<int>(*v);
@@ -88,60 +68,28 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
       r.fail_got("max_memory", requirement);
     }
   }
-  if (auto v = r.number("error_texels", "a number > 0", is_positive)) bake.error_texels = *v;
-  if (auto v = r.boolean("trace")) bake.trace = *v;
-  if (auto v = r.boolean("convolve")) bake.convolve = *v;
-  if (auto v = r.number("trace_error_texels", "a number >= 0",
-                        [](double x) { return std::isfinite(x) && x >= 0; })) {
-    bake.trace_error_texels = *v;
-  }
-  if (auto v = r.integer("max_image", 64, 16384)) bake.max_image = static_cast<int>(*v);
-  if (auto v = r.string("blocker_combine")) {
-    if (*v == "product" || *v == "sum") {
-      bake.blocker_combine = *v == "sum" ? BlockerCombine::sum : BlockerCombine::product;
-    } else {
-      r.fail_got("blocker_combine", "\"product\" or \"sum\"");
-    }
-  }
-  if (auto v = r.string("weighting")) {
-    if (*v == "irradiance" || *v == "emission") {
-      bake.weighting =
-          *v == "irradiance" ? ConvolutionWeighting::irradiance : ConvolutionWeighting::emission;
-    } else {
-      r.fail_got("weighting", "\"irradiance\" or \"emission\"");
-    }
-  }
-  if (auto v = r.integer("max_triples", 1, 1 << 20)) bake.max_triples = static_cast<int>(*v);
-  if (auto v = r.integer("light_parts", 1, 4)) {
-    if (*v == 3) {
-      r.fail_got("light_parts", "1, 2 or 4");
-    } else {
-      bake.light_parts = static_cast<int>(*v);
-    }
-  }
-  if (auto v = r.integer("light_rows", 4, 64)) bake.light_rows = static_cast<int>(*v);
-  if (auto v = r.integer("max_polygons", 0, 1 << 20)) bake.max_polygons = static_cast<int>(*v);
-  if (auto v = r.integer("max_cell", 1, 8)) {
-    if (*v != 1 && *v != 2 && *v != 4 && *v != 8) {
-      r.fail_got("max_cell", "1, 2, 4 or 8");
-    } else {
-      bake.max_cell = static_cast<int>(*v);
-    }
-  }
-  if (auto v = r.number("interpolation_tolerance", "a number >= 0 and < 1",
-                        [](double x) { return std::isfinite(x) && x >= 0 && x < 1; })) {
-    bake.interpolation_tolerance = *v;
-  }
-  if (auto v = r.integer("shadow_map", 64, 16384)) bake.shadow_map = static_cast<int>(*v);
-  if (auto v = r.number("pcf_radius", "a number >= 0",
-                        [](double x) { return std::isfinite(x) && x >= 0; })) {
-    bake.pcf_radius = *v;
-  }
-  if (auto v = r.string("erosion_factor")) {
-    if (*v == "pcf" || *v == "distance") {
-      bake.erosion_factor = *v == "pcf" ? ErosionFactor::pcf : ErosionFactor::distance;
-    } else {
-      r.fail_got("erosion_factor", "\"pcf\" or \"distance\"");
+  // Each method's own keys, by their type, range and check.
+  for (const SettingSpec& spec : method_setting_specs()) {
+    if (!r.find(spec.key)) continue;
+    const auto valid = [&](const SettingValue& v) { return !spec.valid || spec.valid(v); };
+    if (std::holds_alternative<bool>(spec.fallback)) {
+      if (auto v = r.boolean(spec.key)) bake.set(spec.key, *v);
+    } else if (std::holds_alternative<std::int64_t>(spec.fallback)) {
+      if (auto v = r.integer(spec.key, spec.lo, spec.hi)) {
+        if (valid(*v))
+          bake.set(spec.key, *v);
+        else
+          r.fail_got(spec.key, spec.requirement);
+      }
+    } else if (std::holds_alternative<double>(spec.fallback)) {
+      if (auto v = r.number(spec.key, spec.requirement,
+                            [&](double x) { return std::isfinite(x) && valid(x); }))
+        bake.set(spec.key, *v);
+    } else if (auto v = r.string(spec.key)) {
+      if (valid(*v))
+        bake.set(spec.key, *v);
+      else
+        r.fail_got(spec.key, spec.requirement);
     }
   }
   if (r.failed()) return r.error();

@@ -124,9 +124,9 @@ TEST(ErosionBake, BothShadowFactorsNearReference) {
   ref_scene.bake.samples = 1024;
   const BakeResult reference = bake_or_fail(ref_scene);
   Scene scene = load("parallel", 256, "erosion");
-  scene.bake.erosion_factor = ErosionFactor::pcf;
+  scene.bake.set("erosion_factor", "pcf");
   const BakeResult pcf = bake_or_fail(scene);
-  scene.bake.erosion_factor = ErosionFactor::distance;
+  scene.bake.set("erosion_factor", "distance");
   const BakeResult distance = bake_or_fail(scene);
   const Errors e_pcf = errors(pcf, reference), e_distance = errors(distance, reference);
   std::printf("parallel 256²: pcf RMSE %.4f max %.4f; distance RMSE %.4f max %.4f\n", e_pcf.rmse,
@@ -186,7 +186,7 @@ TEST(ErosionBake, LineFitRemovesStaircaseOnSlantedEdge) {
   const int res = 128;
   const double angle = 30.0 * 3.14159265358979 / 180.0;
   Scene scene = load("parallel", res, "erosion");
-  scene.bake.erosion_factor = ErosionFactor::distance;
+  scene.bake.set("erosion_factor", "distance");
   object(scene, "blocker").transform = Affine3(Eigen::AngleAxisd(angle, Vec3::UnitZ()));
   ErosionOptions fit, no_fit;
   no_fit.line_distance = false;
@@ -245,10 +245,9 @@ TEST(ErosionBake, ShowcaseNearReference) {
     s.bake.samples = 256;
     return bake_or_fail(s);
   }();
-  for (const auto& [factor, name] :
-       {std::pair{ErosionFactor::pcf, "pcf"}, std::pair{ErosionFactor::distance, "distance"}}) {
+  for (const char* name : {"pcf", "distance"}) {
     Scene scene = load("showcase", 64, "erosion");
-    scene.bake.erosion_factor = factor;
+    scene.bake.set("erosion_factor", name);
     const BakeResult result = bake_or_fail(scene);
     const Errors e = errors(result, ref);
     std::printf("showcase 64², %s: RMSE %.4f, max %.4f\n", name, e.rmse, e.max);

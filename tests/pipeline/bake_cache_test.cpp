@@ -6,6 +6,7 @@
 // a ceiling above the light, all receivers; a 1 m panel at x = -1.5, 2.5 m up, shining down; a
 // crate between the light and the wall, whose shadow falls on the wall from across the room.
 #include "pipeline/bake_cache.h"
+#include "pipeline/bake.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

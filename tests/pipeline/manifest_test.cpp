@@ -28,8 +28,7 @@ Manifest full_manifest() {
   m.samples = 256;
   m.seed = 18446744073709551615ull;
   m.margin = 4;
-  m.trace = true;
-  m.convolve = false;
+  m.method_settings = {{"trace", true}, {"convolve", false}};
   m.lights = {{"panel", LightShape::rectangle, 0}, {"bulb", LightShape::sphere, -1}};
   m.png_white_point = 12.5;
   ManifestReceiver& r = m.receivers.emplace_back();
@@ -90,7 +89,7 @@ TEST(Manifest, RoundTripsEveryKey) {
   EXPECT_EQ(read->quantity, Quantity::irradiance);
   EXPECT_EQ(read->lights[1].shape, LightShape::sphere);
   EXPECT_EQ(read->png_white_point, 12.5);
-  EXPECT_EQ(read->convolve, false);
+  EXPECT_EQ(read->method_settings, written.method_settings);  // trace true, convolve false
   ASSERT_EQ(read->receivers.size(), 1u);
   const ManifestReceiver& r = read->receivers[0];
   ASSERT_TRUE(r.files);
@@ -129,7 +128,7 @@ TEST(Manifest, KeepsTheFilesKeyOrder) {
 
 TEST(Manifest, LeavesOutWhatDoesNotApply) {
   Manifest m = full_manifest();
-  m.trace = m.convolve = std::nullopt;
+  m.method_settings.clear();
   m.png_white_point = std::nullopt;
   m.receivers[0].method_stats.clear();
   m.receivers[0].method_entries = json::object();
@@ -138,7 +137,7 @@ TEST(Manifest, LeavesOutWhatDoesNotApply) {
   EXPECT_FALSE(j["receivers"][0].contains("method_stats"));
   auto read = manifest_from_json(j, "m.json");
   ASSERT_TRUE(read) << read.error().message;
-  EXPECT_FALSE(read->trace);
+  EXPECT_TRUE(read->method_settings.empty());
   EXPECT_FALSE(read->png_white_point);
   EXPECT_TRUE(read->receivers[0].method_stats.empty());
   EXPECT_TRUE(read->receivers[0].method_entries.empty());

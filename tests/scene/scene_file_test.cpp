@@ -274,15 +274,18 @@ TEST_F(SceneFile, ReadsAndChecksMethodSettings) {
       "blocker_combine = \"product\"\nweighting = \"emission\"\nshadow_map = 1024\npcf_radius = 3\n"
       "erosion_factor = \"distance\"\n" +
       object_floor + light_panel);
-  EXPECT_EQ(scene.bake.error_texels, 0.5);
-  EXPECT_EQ(scene.bake.max_image, 2048);
-  EXPECT_EQ(scene.bake.max_triples, 32);
-  EXPECT_EQ(scene.bake.light_parts, 2);
-  EXPECT_EQ(scene.bake.blocker_combine, BlockerCombine::product);
-  EXPECT_EQ(scene.bake.weighting, ConvolutionWeighting::emission);
-  EXPECT_EQ(scene.bake.shadow_map, 1024);
-  EXPECT_EQ(scene.bake.pcf_radius, 3.0);
-  EXPECT_EQ(scene.bake.erosion_factor, ErosionFactor::distance);
+  EXPECT_EQ(scene.bake.number("error_texels"), 0.5);
+  EXPECT_EQ(scene.bake.whole("max_image"), 2048);
+  EXPECT_EQ(scene.bake.whole("max_triples"), 32);
+  EXPECT_EQ(scene.bake.whole("light_parts"), 2);
+  EXPECT_EQ(scene.bake.word("blocker_combine"), "product");
+  EXPECT_EQ(scene.bake.word("weighting"), "emission");
+  EXPECT_EQ(scene.bake.whole("shadow_map"), 1024);
+  EXPECT_EQ(scene.bake.number("pcf_radius"), 3.0);
+  EXPECT_EQ(scene.bake.word("erosion_factor"), "distance");
+  // Keys not given take their method's default.
+  EXPECT_EQ(scene.bake.whole("light_rows"), 32);
+  EXPECT_TRUE(scene.bake.flag("trace"));
   // The keys given, with their lines, for the bake to report those its method ignores.
   ASSERT_EQ(scene.bake_keys.size(), 9u);
   EXPECT_EQ(scene.bake_keys[0].key, "error_texels");

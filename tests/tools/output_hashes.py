@@ -22,7 +22,8 @@ import subprocess
 import sys
 import tempfile
 
-METHODS = ["convolution", "reference", "accumulation", "pcf", "pcss", "adaptive-pcf", "erosion",
+METHODS = ["backprojection", "convolution", "reference", "accumulation", "pcf", "pcss",
+           "adaptive-pcf", "erosion",
            "chun-oh"]
 
 
@@ -55,7 +56,7 @@ def main():
                 proc = subprocess.run(
                     [str(exe), "bake", scene, "-o", str(out), "--method", method, "-q",
                      "--resolution", str(args.resolution), "--samples", str(args.samples),
-                     "--threads", "2"],
+                     "--threads", "2", "--no-cache"],
                     cwd=root, capture_output=True, text=True)
                 if proc.returncode != 0:
                     last = (proc.stderr.strip().splitlines() or ["?"])[-1]

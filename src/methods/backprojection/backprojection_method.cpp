@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include <cstdint>
 #include <string>
 
 #include "methods/backprojection/backprojection_bake.h"
@@ -54,10 +55,10 @@ class BackprojectionMethod final : public Method {
     in.culler = context_.shafts;
     in.rays = context_.rays;
     in.quantity = settings.quantity;
-    in.light_rows = settings.light_rows;
-    in.max_polygons = settings.max_polygons;
-    in.refinement.max_cell = settings.max_cell;
-    in.refinement.tolerance = settings.interpolation_tolerance;
+    in.light_rows = int(settings.whole("light_rows"));
+    in.max_polygons = int(settings.whole("max_polygons"));
+    in.refinement.max_cell = int(settings.whole("max_cell"));
+    in.refinement.tolerance = settings.number("interpolation_tolerance");
     in.samples = settings.samples;
     in.seed = settings.seed;
     in.stream = receiver.stream;
@@ -82,15 +83,26 @@ class BackprojectionMethod final : public Method {
 }  // namespace
 
 MethodEntry backprojection_method() {
-  return {"backprojection",
-          {"light_rows", "max_polygons", "max_cell", "interpolation_tolerance", "samples", "seed"},
-          [](const BakeSettings&) { return MethodNeeds{.rays = true, .shafts = true}; },
-          nullptr,
-          [](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {
-            return std::unique_ptr<Method>(std::make_unique<BackprojectionMethod>(context));
-          },
-          kBackprojectionHalo,
-          summarise_routes};
+  const BackprojectionInputs defaults;  // the defaults of every key but samples and seed
+  MethodEntry e;
+  e.name = "backprojection";
+  e.settings = {"samples", "seed"};
+  e.own_settings = {
+      whole_setting("light_rows", defaults.light_rows, 4, 64),
+      whole_setting("max_polygons", defaults.max_polygons, 0, 1 << 20),
+      whole_setting(
+          "max_cell", defaults.refinement.max_cell, 1, 8, "1, 2, 4 or 8",
+          [](std::int64_t cell) { return cell == 1 || cell == 2 || cell == 4 || cell == 8; }),
+      number_setting("interpolation_tolerance", defaults.refinement.tolerance,
+                     "a number >= 0 and < 1", [](double x) { return x >= 0 && x < 1; })};
+  e.needs = [](const BakeSettings&) { return MethodNeeds{.rays = true, .shafts = true}; };
+  e.make = [](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {
+    return std::unique_ptr<Method>(std::make_unique<BackprojectionMethod>(context));
+  };
+  e.tile_halo = kBackprojectionHalo;
+  e.summarise = summarise_routes;
+  e.local = true;
+  return e;
 }
 
 }  // namespace sb

@@ -85,10 +85,10 @@ PlanInputs plan_inputs(const BakeContext& context, const Mesh* receiver,
   in.receiver = receiver;
   in.blockers = context.blockers;
   in.clusters = context.clusters;
-  in.error_texels = settings.error_texels;
-  in.max_image = settings.max_image;
-  in.max_triples = settings.max_triples;
-  in.light_parts = settings.light_parts;
+  in.error_texels = settings.number("error_texels");
+  in.max_image = int(settings.whole("max_image"));
+  in.max_triples = int(settings.whole("max_triples"));
+  in.light_parts = int(settings.whole("light_parts"));
   in.backend = backend;
   return in;
 }
@@ -106,17 +106,18 @@ class ConvolutionMethod final : public Method {
     ConvolutionInputs in;
     in.plan = plan_inputs(context_, receiver.mesh, &fft_);
     in.quantity = settings.quantity;
-    in.combine = settings.blocker_combine;
-    in.weighted = settings.weighting == ConvolutionWeighting::irradiance;
+    in.combine =
+        settings.word("blocker_combine") == "sum" ? BlockerCombine::sum : BlockerCombine::product;
+    in.weighted = settings.word("weighting") == "irradiance";
     in.memory_for_images = context_.memory_for_images;
     in.fft = &fft_;
     TracedConvolutionInputs traced;
     traced.convolution = in;
     traced.culler = context_.shafts;
     traced.rays = context_.rays;
-    traced.convolve = settings.convolve;
+    traced.convolve = settings.flag("convolve");
     traced.samples = settings.samples;
-    traced.trace_error_texels = settings.trace_error_texels;
+    traced.trace_error_texels = settings.number("trace_error_texels");
     traced.seed = settings.seed;
     traced.stream = receiver.stream;
     traced.keep_per_light = context_.keep_per_light;
@@ -167,34 +168,56 @@ class ConvolutionMethod final : public Method {
 }  // namespace
 
 MethodEntry convolution_method() {
-  return {
-      "convolution",
-      {"error_texels", "max_image", "max_triples", "light_parts", "trace", "convolve",
-       "trace_error_texels", "blocker_combine", "weighting", "samples", "seed"},
-      [](const BakeSettings& s) {
-        // The planner's clusters serve the convolution (and the buried-texel test); with
-        // convolve = false and rays, no leaf is planned.
-        return MethodNeeds{.rays = s.trace, .clusters = s.convolve || !s.trace, .shafts = true};
-      },
-      [](const Scene& scene, double texels) {
-        // Parts of a light: at least light_parts; a sphere light's receiver may be seen
-        // through up to six cube faces, each a frame of its own.
-        const BakeSettings& b = scene.bake;
-        const double parts = double(scene.lights.size()) * std::max(b.light_parts, 1);
-        return std::vector<MemoryItem>{
-            {"convolution texel arrays",
-             texels * (kConvolutionBytesPerTexel + kConvolutionBytesPerTexelAndLightPart * parts)}};
-      },
-      [](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {
-        const BakeSettings& s = context.scene->bake;
-        if (!s.convolve && !s.trace)
-          return scene_error(context.scene->file.string() +
-                             ": [bake]: convolve = false needs trace = true (with neither, "
-                             "nothing would compute the shadows)");
-        return std::unique_ptr<Method>(std::make_unique<ConvolutionMethod>(context));
-      },
-      /*tile_halo=*/-1,  // its images span the receiver
-      nullptr};
+  const PlanInputs plan;
+  const TracedConvolutionInputs traced;
+  MethodEntry e;
+  e.name = "convolution";
+  e.settings = {"samples", "seed"};
+  e.own_settings = {number_setting("error_texels", plan.error_texels, "a number > 0",
+                                   [](double x) { return x > 0; }),
+                    whole_setting("max_image", plan.max_image, 64, 16384),
+                    whole_setting("max_triples", plan.max_triples, 1, 1 << 20),
+                    whole_setting("light_parts", plan.light_parts, 1, 4, "1, 2 or 4",
+                                  [](std::int64_t parts) { return parts != 3; }),
+                    flag_setting("trace", true),
+                    flag_setting("convolve", traced.convolve),
+                    number_setting("trace_error_texels", traced.trace_error_texels, "a number >= 0",
+                                   [](double x) { return x >= 0; }),
+                    word_setting("blocker_combine", "sum", {"product", "sum"}),
+                    word_setting("weighting", "irradiance", {"irradiance", "emission"})};
+  // The switches the manifest records, for a reader to tell a convolution without rays.
+  e.manifest_settings = {"trace", "convolve"};
+  e.needs = [](const BakeSettings& s) {
+    // The planner's clusters serve the convolution (and the buried-texel test); with
+    // convolve = false and rays, no leaf is planned.
+    const bool trace = s.flag("trace"), convolve = s.flag("convolve");
+    return MethodNeeds{.rays = trace, .clusters = convolve || !trace, .shafts = true};
+  };
+  e.memory = [](const Scene& scene, double texels) {
+    // Parts of a light: at least light_parts; a sphere light's receiver may be seen through up
+    // to six cube faces, each a frame of its own.
+    const double parts =
+        double(scene.lights.size()) * std::max<double>(double(scene.bake.whole("light_parts")), 1);
+    return std::vector<MemoryItem>{
+        {"convolution texel arrays",
+         texels * (kConvolutionBytesPerTexel + kConvolutionBytesPerTexelAndLightPart * parts)}};
+  };
+  e.make = [](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {
+    const BakeSettings& s = context.scene->bake;
+    if (!s.flag("convolve") && !s.flag("trace"))
+      return scene_error(context.scene->file.string() +
+                         ": [bake]: convolve = false needs trace = true (with neither, nothing "
+                         "would compute the shadows)");
+    return std::unique_ptr<Method>(std::make_unique<ConvolutionMethod>(context));
+  };
+  e.tile_halo = -1;  // its images span the receiver
+  e.local = false;   // its clusters span the scene's blockers
+  e.plan = [](const BakeContext& context, const ReceiverInput& receiver) -> Expected<std::string> {
+    const FftConvolver fft;
+    return describe_plan(
+        plan_convolution(*receiver.space, plan_inputs(context, receiver.mesh, &fft)));
+  };
+  return e;
 }
 
 }  // namespace sb

@@ -25,6 +25,12 @@
 
 namespace sb {
 
+// How the occluded fractions O_i of different blocker clusters over one texel combine
+// (docs/design.md §5): `product` takes V = ∏(1 − O_i), clusters hiding independent parts of the
+// light; `sum` takes V = 1 − Σ O_i, clusters hiding disjoint parts ([bake] blocker_combine;
+// docs/methods.md has the measurement that chose the default).
+enum class BlockerCombine { product, sum };
+
 struct ClusterTree;
 
 struct PlanInputs {

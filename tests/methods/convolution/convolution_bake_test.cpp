@@ -60,7 +60,7 @@ TEST(ConvolutionBake, ParallelSquareLightMatchesClosedForm) {
     const Errors weighted = floor_errors(bake_floor(scene), 0, [&](double x, double y) {
       return closed_forms::square_light_weighted_visibility(x, y, bx, by, height);
     });
-    scene.bake.weighting = ConvolutionWeighting::emission;
+    scene.bake.set("weighting", "emission");
     const Errors e = floor_errors(bake_floor(scene), 0, [&](double x, double y) {
       return closed_forms::square_light_unweighted_visibility(x, y, bx, by, height);
     });
@@ -85,7 +85,7 @@ TEST(ConvolutionBake, ParallelDiskLightMatchesClosedForm) {
           return closed_forms::disk_light_weighted_visibility(x, y, 0, 0, height, 0.25);
         },
         4);
-    scene.bake.weighting = ConvolutionWeighting::emission;
+    scene.bake.set("weighting", "emission");
     const Errors e = floor_errors(
         bake_floor(scene), 0,
         [&](double x, double y) {
@@ -109,7 +109,7 @@ TEST(ConvolutionBake, AgreesWithReferenceWithinTheWeightingSplit) {
   Scene ref = load("parallel", 256, "reference");
   ref.bake.samples = 256;
   const Image weighted = bake_floor(conv);
-  conv.bake.weighting = ConvolutionWeighting::emission;
+  conv.bake.set("weighting", "emission");
   const Image c = bake_floor(conv), r = bake_floor(ref);
   const Errors against_reference = image_errors(c, r);
   const Errors weighted_against_reference = image_errors(weighted, r);

@@ -1,0 +1,44 @@
+// The last stage of a bake (bake_stages.h), and of the merge of shards (shards.cpp): what needs
+// every receiver.
+#include <fmt/format.h>
+
+#include "lightmaps/shadowmask.h"
+#include "pipeline/bake_stages.h"
+
+namespace sb {
+
+void finish_bake(const Scene& scene, BakeResult& result, bool whole) {
+  std::vector<std::string> warnings = result.setup_warnings;
+  for (const ReceiverBake& r : result.receivers)
+    warnings.insert(warnings.end(), r.uv_warnings.begin(), r.uv_warnings.end());
+  // A light that reaches no receiver texel (facing away, or below every texel's horizon) is
+  // most often a normal pointing the wrong way: say so.
+  std::int64_t texels = 0;
+  for (const ReceiverBake& r : result.receivers) texels += r.covered_texels;
+  const bool lit = scene.bake.quantity != Quantity::ambient_occlusion;
+  for (std::size_t l = 0; whole && lit && texels > 0 && l < scene.lights.size(); ++l) {
+    bool reached = false;
+    for (const ReceiverBake& r : result.receivers)
+      reached = reached || (l < r.lights_reached.size() && r.lights_reached[l]);
+    if (reached) continue;
+    const LightDesc& d = scene.lights[l];
+    warnings.push_back(fmt::format(
+        "{}:{}: light '{}': reaches no texel of any receiver (is its 'normal' the right way, or "
+        "its 'position' behind the receivers?); it adds nothing",
+        scene.file.string(), d.line, d.name));
+  }
+  for (const ReceiverBake& r : result.receivers)
+    warnings.insert(warnings.end(), r.report.warnings.begin(), r.report.warnings.end());
+  result.shadowmask_channels.clear();
+  if (whole && scene.output.shadowmask) {
+    LightOverlaps overlaps(scene.lights.size());
+    for (const ReceiverBake& r : result.receivers)
+      add_overlaps(r.per_light_visibility, r.covered, overlaps);
+    ShadowmaskChannels channels = assign_shadowmask_channels(overlaps, scene.lights, scene.file);
+    result.shadowmask_channels = std::move(channels.channel);
+    for (std::string& w : channels.warnings) warnings.push_back(std::move(w));
+  }
+  result.warnings = std::move(warnings);
+}
+
+}  // namespace sb
