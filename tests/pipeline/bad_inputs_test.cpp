@@ -228,7 +228,7 @@ pid_t start_slow_bake(const fs::path& out, const fs::path& err) {
     std::freopen(err_arg.c_str(), "w", stderr);
     std::freopen("/dev/null", "w", stdout);
     ::execl(SB_CLI, SB_CLI, "bake", scene.c_str(), "-o", out_arg.c_str(), "--resolution", "1024",
-            "--samples", "256", "-q", static_cast<char*>(nullptr));
+            "--samples", "256", "--method", "reference", "-q", static_cast<char*>(nullptr));
     ::_exit(127);
   }
   return pid;
