@@ -59,6 +59,7 @@ class BackprojectionMethod final : public Method {
     in.max_polygons = int(settings.whole("max_polygons"));
     in.refinement.max_cell = int(settings.whole("max_cell"));
     in.refinement.tolerance = settings.number("interpolation_tolerance");
+    in.refinement.midpoint_cells = settings.number("midpoint_cells");
     in.samples = settings.samples;
     in.seed = settings.seed;
     in.stream = receiver.stream;
@@ -94,7 +95,9 @@ MethodEntry backprojection_method() {
           "max_cell", defaults.refinement.max_cell, 1, 8, "1, 2, 4 or 8",
           [](std::int64_t cell) { return cell == 1 || cell == 2 || cell == 4 || cell == 8; }),
       number_setting("interpolation_tolerance", defaults.refinement.tolerance,
-                     "a number >= 0 and < 1", [](double x) { return x >= 0 && x < 1; })};
+                     "a number >= 0 and < 1", [](double x) { return x >= 0 && x < 1; }),
+      number_setting("midpoint_cells", defaults.refinement.midpoint_cells, "a number >= 0",
+                     [](double x) { return x >= 0; })};
   e.needs = [](const BakeSettings&) { return MethodNeeds{.rays = true, .shafts = true}; };
   e.make = [](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {
     return std::unique_ptr<Method>(std::make_unique<BackprojectionMethod>(context));

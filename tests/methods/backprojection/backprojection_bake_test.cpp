@@ -5,8 +5,12 @@
 // shape).
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -109,6 +113,51 @@ TEST(BackprojectionBake, RandomParallelConfigurationsAreWithinTheClosedForm) {
 // Two hundred more (another seed), by label: `ctest -L stress` (docs/testing.md).
 TEST(BackprojectionBake, RandomParallelConfigurationsStress) {
   expect_random_parallel_configurations(20261207, 200);
+}
+
+// midpoint_cells, the method's own [bake] key: read from a scene file and checked there; 0
+// turns check 5 off, which on a configuration where it matters (a low wide blocker under a wide
+// light) leaves more of the pairs interpolated and the worst texel further from the closed form.
+TEST(BackprojectionBake, MidpointCellsIsReadAndHonoured) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("sb_midpoint_cells_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string parallel = std::string(SB_SOURCE_DIR) + "/scenes/parallel/";
+  const auto write = [&](const std::string& value) {
+    std::ofstream(dir / "scene.toml")
+        << "[bake]\nresolution = 256\nmargin = 0\nmidpoint_cells = " << value << "\n"
+        << "[[object]]\nname = \"floor\"\nmesh = \"" << parallel << "floor.obj\"\n"
+        << "[[object]]\nname = \"blocker\"\nmesh = \"" << parallel
+        << "blocker.obj\"\nreceiver = false\nscale = [1.166667, 1.166667, 1]\n"
+        << "translate = [0, 0, -0.32]\n"
+        << "[[light]]\nname = \"panel\"\nshape = \"rectangle\"\nposition = [0, 0, 1.32]\n"
+        << "normal = [0, 0, -1]\nsize = [1.03, 1.03]\npower = 100.0\n";
+    return load_scene(dir / "scene.toml");
+  };
+  auto refused = write("-1");
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().message.find("midpoint_cells"), std::string::npos)
+      << refused.error().message;
+  double interpolated[2], worst[2];
+  for (int on = 0; on < 2; ++on) {
+    auto scene = write(on ? "4" : "0");
+    ASSERT_TRUE(scene) << scene.error().message;
+    EXPECT_EQ(scene->bake.number("midpoint_cells"), on ? 4.0 : 0.0);
+    auto result = bake(*scene);
+    ASSERT_TRUE(result) << result.error().message;
+    const Image& img = result->receivers[0].image;
+    worst[on] = image_errors::errors_against(img, 0, [&](int x, int y) {
+                  const double u = (x + 0.5) / img.width, v = 1.0 - (y + 0.5) / img.height;
+                  return closed_forms::parallel_square_visibility(2 * u - 1, 2 * v - 1, 0.515, 1.32,
+                                                                  0, 0, 0.35, 0.18);
+                }).max;
+    interpolated[on] = stat(result->receivers[0], "interpolated_fraction");
+  }
+  std::printf("midpoint_cells 0: interpolated %.4f, max %.4f; 4: %.4f, %.4f\n", interpolated[0],
+              worst[0], interpolated[1], worst[1]);
+  EXPECT_GT(interpolated[0], interpolated[1]);
+  EXPECT_GE(worst[0], worst[1]);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(BackprojectionBake, SameBytesForAnyThreadCountAndRun) {
