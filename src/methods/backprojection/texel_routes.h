@@ -13,9 +13,6 @@
 //                 the light's centre meets, or one of the patch's candidates; or, for one texel,
 //                 the triangle the ray from its origin to the light's centre meets hides all of
 //                 the light from it. V = 0 exactly, nothing else is computed.
-//   convolved     The convolution (methods/convolution) where it is exact: a planar receiver
-//                 parallel to the light and blockers in planes parallel to both, so its penumbra
-//                 error bound is zero and its value stands in the penumbra too.
 //   exact         The back-projection estimator (penumbra_estimator.cpp): the blockers of the
 //                 texel's own shaft projected onto the light and integrated with the irradiance
 //                 weight in closed form; no noise.
@@ -40,15 +37,14 @@ enum class TexelRoute : std::uint8_t {
   none,  // the light does not reach the texel (H0 = 0), or the texel is not covered
   clear,
   umbra,
-  convolved,
   exact,
   interpolated,
   traced
 };
 
-constexpr std::array<TexelRoute, 6> kTexelRoutes = {TexelRoute::clear,        TexelRoute::umbra,
-                                                    TexelRoute::convolved,    TexelRoute::exact,
-                                                    TexelRoute::interpolated, TexelRoute::traced};
+constexpr std::array<TexelRoute, 5> kTexelRoutes = {TexelRoute::clear, TexelRoute::umbra,
+                                                    TexelRoute::exact, TexelRoute::interpolated,
+                                                    TexelRoute::traced};
 
 constexpr std::string_view to_string(TexelRoute r) {
   switch (r) {
@@ -58,8 +54,6 @@ constexpr std::string_view to_string(TexelRoute r) {
       return "clear";
     case TexelRoute::umbra:
       return "umbra";
-    case TexelRoute::convolved:
-      return "convolved";
     case TexelRoute::exact:
       return "exact";
     case TexelRoute::interpolated:
