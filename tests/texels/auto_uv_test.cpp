@@ -3,6 +3,8 @@
 // density gives, the mesh's faces and texture UVs kept, and a side too small for the charts.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -27,6 +29,83 @@ Mesh corpus_mesh(const std::string& file) {
   auto mesh = import_mesh(obj, std::string(SB_SOURCE_DIR) + "/scenes/scene.toml");
   EXPECT_TRUE(mesh) << mesh.error().message;
   return mesh ? std::move(*mesh) : Mesh{};
+}
+
+// Pairs of lightmap-UV triangles whose interiors overlap by more than `eps` (UV units) across
+// every separating axis (their six edge normals): the layout judged without uv_checks.cpp, whose
+// texel counts the other checks use. Triangles sharing an edge or a corner touch, and are apart.
+int overlapping_uv_triangles(const Mesh& mesh, double eps = 1e-7) {
+  std::vector<std::array<Vec2, 3>> tris;
+  for (const auto f : mesh.mesh.faces()) {
+    const Triangle t = triangle(mesh.mesh, f);
+    tris.push_back({t.uv[0], t.uv[1], t.uv[2]});
+  }
+  const auto apart = [&](const std::array<Vec2, 3>& a, const std::array<Vec2, 3>& b) {
+    for (const auto* t : {&a, &b})
+      for (int e = 0; e < 3; ++e) {
+        const Vec2 d = (*t)[(e + 1) % 3] - (*t)[e];
+        const Vec2 n = Vec2(-d.y(), d.x());
+        if (n.norm() == 0) return true;  // a degenerate triangle covers nothing
+        double a_lo = 1e300, a_hi = -1e300, b_lo = 1e300, b_hi = -1e300;
+        for (const Vec2& p : a)
+          a_lo = std::min(a_lo, n.dot(p) / n.norm()), a_hi = std::max(a_hi, n.dot(p) / n.norm());
+        for (const Vec2& p : b)
+          b_lo = std::min(b_lo, n.dot(p) / n.norm()), b_hi = std::max(b_hi, n.dot(p) / n.norm());
+        if (a_hi - b_lo < eps || b_hi - a_lo < eps) return true;
+      }
+    return false;
+  };
+  // A grid of 64² cells over [0, 1]²; a pair is tested in the cell of its boxes' overlap's
+  // lower corner only.
+  constexpr int kGrid = 64;
+  const auto cell = [](double x) { return std::clamp(int(x * kGrid), 0, kGrid - 1); };
+  std::vector<std::vector<std::size_t>> grid(kGrid * kGrid);
+  std::vector<std::array<double, 4>> boxes;  // u_lo, v_lo, u_hi, v_hi
+  for (std::size_t i = 0; i < tris.size(); ++i) {
+    std::array<double, 4> box = {1e300, 1e300, -1e300, -1e300};
+    for (const Vec2& p : tris[i])
+      box = {std::min(box[0], p.x()), std::min(box[1], p.y()), std::max(box[2], p.x()),
+             std::max(box[3], p.y())};
+    boxes.push_back(box);
+    for (int y = cell(box[1]); y <= cell(box[3]); ++y)
+      for (int x = cell(box[0]); x <= cell(box[2]); ++x)
+        grid[std::size_t(y * kGrid + x)].push_back(i);
+  }
+  int overlaps = 0;
+  for (int c = 0; c < kGrid * kGrid; ++c)
+    for (std::size_t k = 0; k < grid[std::size_t(c)].size(); ++k)
+      for (std::size_t l = k + 1; l < grid[std::size_t(c)].size(); ++l) {
+        const std::size_t i = grid[std::size_t(c)][k], j = grid[std::size_t(c)][l];
+        const double lo_u = std::max(boxes[i][0], boxes[j][0]),
+                     lo_v = std::max(boxes[i][1], boxes[j][1]);
+        if (lo_u > std::min(boxes[i][2], boxes[j][2]) || lo_v > std::min(boxes[i][3], boxes[j][3]))
+          continue;                                          // the boxes are apart
+        if (cell(lo_v) * kGrid + cell(lo_u) != c) continue;  // tested in another cell
+        overlaps += !apart(tris[i], tris[j]);
+      }
+  return overlaps;
+}
+
+// The check above finds what it is for: two triangles laid over each other in UV, and not two
+// that share an edge.
+TEST(AutoUv, TheIndependentOverlapCheckFindsAnOverlap) {
+  for (const bool folded : {true, false}) {
+    Mesh m;
+    m.name = "pair";
+    const auto vertex = [&](double x, double y, double u, double v) {
+      const auto h = m.mesh.add_vertex(TriMesh::Point(x, y, 0));
+      m.mesh.set_normal(h, TriMesh::Normal(0, 0, 1));
+      m.mesh.set_texcoord2D(h, TriMesh::TexCoord2D(u, v));
+      return h;
+    };
+    std::vector<Vec2> unused;
+    const auto a = vertex(0, 0, 0.1, 0.1), b = vertex(1, 0, 0.6, 0.1), c = vertex(0, 1, 0.1, 0.6);
+    const auto d = folded ? vertex(1, 1, 0.05, 0.05) : vertex(1, 1, 0.6, 0.6);
+    add_triangle(m.mesh, a, b, c, unused);
+    add_triangle(m.mesh, b, d, c, unused);
+    m.has_uv = true;
+    EXPECT_EQ(overlapping_uv_triangles(m), folded ? 1 : 0) << folded;
+  }
 }
 
 AutoUvTarget side_target(int side, int margin = 4) {
@@ -99,6 +178,7 @@ TEST(AutoUv, EveryCorpusReceiverPacksApartWithoutOverlap) {
     const UvLayoutReport layout = check_uv_layout(mesh, space, 4);
     EXPECT_EQ(layout.charts, made->charts);
     EXPECT_EQ(layout.overlapping_texels, 0);
+    EXPECT_EQ(overlapping_uv_triangles(mesh), 0);
     EXPECT_EQ(layout.texels_near_other_charts, 0);
     EXPECT_LT(layout.uv_area_outside, 1e-12);  // rounding of the area clipped to [0, 1]²
     EXPECT_LT(layout.stretch, 1.02);
