@@ -368,27 +368,29 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
   };
 
   for (int s = top; s >= 2 && !cells.empty(); s /= 2) {
-    // Their samples, each evaluated once; an interpolated one is evaluated now, being a corner.
+    // Queues the texel at (x, y) for evaluation unless it is queued or valued exactly already:
+    // an interpolated one is evaluated now, and, where a sample's blockers are needed beside V
+    // (a cell's corners and centre), an umbra tile's too. A clear tile's is skipped: valued, and
+    // holding what a sample would.
+    const auto enqueue = [&](int x, int y, bool umbra_too, std::vector<Queued>& queue) {
+      const std::int32_t t = grid.texel(x, y);
+      if (t < 0 || !reached[std::size_t(t)]) return;
+      const std::int64_t at = place(x, y);
+      if (at < 0 || state[std::size_t(at)] == kQueued) return;
+      const TexelRoute route = field.route[std::size_t(at)];
+      if (state[std::size_t(at)] == kValued && route != TexelRoute::interpolated &&
+          !(umbra_too && route == TexelRoute::umbra))
+        return;
+      state[std::size_t(at)] = kQueued;
+      queue.push_back({std::size_t(t), std::size_t(at)});
+    };
+    // Their samples, each evaluated once.
     std::vector<Queued> queue;
     for (const Cell& c : cells) {
       const int h = c.size / 2;
       const int xs[5] = {c.x0, c.x0 + c.size, c.x0, c.x0 + c.size, c.x0 + h};
       const int ys[5] = {c.y0, c.y0, c.y0 + c.size, c.y0 + c.size, c.y0 + h};
-      for (int k = 0; k < 5; ++k) {
-        const std::int32_t t = grid.texel(xs[k], ys[k]);
-        if (t < 0 || !reached[std::size_t(t)]) continue;
-        const std::int64_t at = place(xs[k], ys[k]);
-        if (at < 0) continue;  // a clear tile's: valued, and holding what a sample would
-        const std::size_t i = std::size_t(at);
-        if (state[i] == kQueued) continue;
-        // Valued already, but for what a sample must hold beside V: interpolated texels, and an
-        // umbra tile's (a neighbouring cell's corners), are evaluated.
-        if (state[i] == kValued && field.route[i] != TexelRoute::interpolated &&
-            field.route[i] != TexelRoute::umbra)
-          continue;
-        state[i] = kQueued;
-        queue.push_back({std::size_t(t), i});
-      }
+      for (int k = 0; k < 5; ++k) enqueue(xs[k], ys[k], true, queue);
     }
     evaluate_all(queue);
     // Each cell interpolates what it owns, or splits.
@@ -396,23 +398,12 @@ LightField refine_light(const TexelSpace& space, const TexelGrid& grid, const Ti
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 4), [&](const auto& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i) pass[i] = passes(cells[i]);
     });
-    // The edge midpoints of the cells that ask for them, each evaluated once (exactly: an
-    // interpolated one is evaluated again), then their check.
+    // The edge midpoints of the cells that ask for them, each evaluated once (V alone is read
+    // there), then their check.
     std::vector<Queued> midpoints;
-    for (std::size_t i = 0; i < cells.size(); ++i) {
-      if (pass[i] != kMidpoints) continue;
-      for (const auto& e : edges(cells[i])) {
-        const std::int32_t t = grid.texel(e[0], e[1]);
-        if (t < 0 || !reached[std::size_t(t)]) continue;
-        const std::int64_t at = place(e[0], e[1]);
-        if (at < 0 || state[std::size_t(at)] == kQueued) continue;
-        if (state[std::size_t(at)] == kValued &&
-            field.route[std::size_t(at)] != TexelRoute::interpolated)
-          continue;
-        state[std::size_t(at)] = kQueued;
-        midpoints.push_back({std::size_t(t), std::size_t(at)});
-      }
-    }
+    for (std::size_t i = 0; i < cells.size(); ++i)
+      if (pass[i] == kMidpoints)
+        for (const auto& e : edges(cells[i])) enqueue(e[0], e[1], false, midpoints);
     evaluate_all(midpoints);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 16), [&](const auto& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i)
