@@ -30,9 +30,9 @@
 //   5. where the penumbra bound of 4 is under `midpoint_cells` cells (a penumbra's edge may be
 //      near), its four edge midpoints are evaluated too, each within `tolerance` of the mean of
 //      its edge's corners: a kink along one axis can cancel at the centre against the field's
-//      curvature along the other (measured: a centre 0.0018 from its prediction over a texel
-//      0.012 off), but not at both midpoints of the edges it crosses as well. A cell that
-//      splits reuses them as its children's corners.
+//      curvature along the other (the cells simulated on the closed form: a centre 0.0018 from its
+//      prediction over a texel 0.012 off), but not at both midpoints of the edges it crosses as
+//      well. A cell that splits reuses them as its children's corners.
 // Inside a cell that passes, V is interpolated linearly over the four triangles the centre makes
 // with the cell's sides, so it is exact at all five samples and continuous across cells. Texels
 // of a cell that fails at S = 2 are each evaluated. Every decision depends on exact values and
