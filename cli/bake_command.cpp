@@ -29,10 +29,13 @@ namespace sbcli {
 
 namespace {
 
-// A one-line progress bar on stderr, redrawn at most ten times a second; any thread may call.
+// Progress on stderr, at most ten updates a second; any thread may call. On a terminal a one-line
+// bar, redrawn in place; with --progress-lines one line `progress F` per update (F the fraction
+// done, 0 to 1, four decimals), whether stderr is a terminal or not, for a program that reads it
+// (the Blender add-on, blender/). The last update is always 1.
 class ProgressBar {
  public:
-  explicit ProgressBar(std::string label) : label_(std::move(label)) {}
+  ProgressBar(std::string label, bool lines) : label_(std::move(label)), lines_(lines) {}
   void update(double fraction) {
     const bool final_update = fraction >= 1.0;
     // The final update must not be lost to a busy lock; the others may be.
@@ -47,16 +50,24 @@ class ProgressBar {
     if (!final_update && now - last_ < std::chrono::milliseconds(100)) return;
     last_ = now;
     finished_ = final_update;
-    constexpr int kWidth = 40;
-    const int filled = int(fraction * kWidth + 0.5);
-    std::fprintf(stderr, "\r%s [%s%s] %3d%%", label_.c_str(), std::string(filled, '#').c_str(),
-                 std::string(kWidth - filled, ' ').c_str(), int(fraction * 100 + 0.5));
-    if (fraction >= 1.0) std::fprintf(stderr, "\n");
+    fraction = std::clamp(fraction, 0.0, 1.0);
+    if (lines_) {
+      std::fprintf(stderr, "progress %.4f\n", fraction);
+    } else {
+      constexpr int kWidth = 40;
+      const int filled = int(fraction * kWidth + 0.5);
+      std::fprintf(stderr, "\r%s [%s%s] %3d%%", label_.c_str(), std::string(filled, '#').c_str(),
+                   std::string(kWidth - filled, ' ').c_str(), int(fraction * 100 + 0.5));
+      if (fraction >= 1.0) std::fprintf(stderr, "\n");
+    }
     std::fflush(stderr);
   }
+  // Ends the updates with 1 if the bake never reported it (every receiver taken from the cache).
+  void finish() { update(1.0); }
 
  private:
   std::string label_;
+  bool lines_;
   std::mutex mutex_;
   std::chrono::steady_clock::time_point last_{};
   bool finished_ = false;
@@ -81,6 +92,7 @@ struct BakeArgs {
   std::optional<std::uint64_t> max_memory;
   int threads = 0;
   bool quiet = false;
+  bool progress_lines = false;  // --progress-lines: `progress F` lines on stderr
   bool explain = false;
   bool no_trace = false;
   bool no_convolve = false;
@@ -189,8 +201,8 @@ int bake_scene(const BakeArgs& args, const std::string& scene_file, const std::s
     if (sb::Status targets = folder->check_targets(sb::output_names(*scene)); !targets)
       return fail(targets.error());
 
-  const bool show_progress = !args.quiet && ::isatty(STDERR_FILENO);
-  ProgressBar bar("baking " + settings.method);
+  const bool show_progress = args.progress_lines || (!args.quiet && ::isatty(STDERR_FILENO));
+  ProgressBar bar("baking " + settings.method, args.progress_lines);
   sb::BakeOptions options;
   options.threads = args.threads;
   options.shard = shard;
@@ -205,6 +217,7 @@ int bake_scene(const BakeArgs& args, const std::string& scene_file, const std::s
 
   auto result = sb::bake(*scene, options);
   if (!result) return fail(result.error());
+  if (show_progress) bar.finish();
   for (const auto& w : result->warnings)
     std::fprintf(stderr, "shadowbake: warning: %s\n", w.c_str());
 
@@ -457,6 +470,9 @@ Runner add_bake_command(CLI::App& app) {
   bake->add_option("--threads", o->args.threads, "worker threads (0: all cores)")
       ->check(CLI::Range(0, 1024));
   bake->add_flag("-q,--quiet", o->args.quiet, "no progress bar and no summary");
+  bake->add_flag("--progress-lines", o->args.progress_lines,
+                 "print progress as lines 'progress F' (F from 0 to 1) on stderr, at most ten a "
+                 "second and a last one of 1, even with --quiet or when stderr is no terminal");
   bake->add_flag("--no-trace", o->args.no_trace,
                  "convolution: trace no shadow rays, even where it cannot vouch for its values "
                  "(overrides [bake] trace)");
