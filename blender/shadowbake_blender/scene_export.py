@@ -26,6 +26,7 @@ Background Strength is the sky's radiance scale (`strength`, "Blender's Backgrou
 
 import math
 import os
+import struct
 
 import bpy
 import mathutils
@@ -38,11 +39,24 @@ def to_level(v):
     return (v[0], v[2], -v[1])
 
 
+def _float32(x):
+    return struct.unpack("<f", struct.pack("<f", x))[0]
+
+
 def _number(x):
+    """`x` in the fewest digits that give back its 32-bit float: Blender keeps its values (and
+    mathutils computes) in 32 bits, so 0.2 is written 0.2, not 0.20000000298023224."""
     x = float(x)
     if not math.isfinite(x):
         raise ValueError(f"not a finite number: {x}")
-    return repr(x)
+    if abs(x) >= 3e38:
+        return repr(x)
+    target = _float32(x)
+    for digits in range(6, 10):
+        text = f"{x:.{digits}g}"
+        if _float32(float(text)) == target:
+            break
+    return text if any(c in text for c in ".e") else text + ".0"  # a TOML float
 
 
 def _vector(v):
