@@ -150,6 +150,12 @@ class SHADOWBAKE_OT_bake(bpy.types.Operator):
             context.workspace.status_text_set(None)
         SHADOWBAKE_OT_bake.running = False
 
+    def cancel(self, context):
+        """Blender ends the modal operator (the window closes, another file loads): the bake
+        is stopped as by Esc."""
+        self.process.cancel()
+        self._end(context)
+
     def modal(self, context, event):
         if event.type == "ESC":
             self.process.cancel()

@@ -247,7 +247,10 @@ def _world_table(world, export):
         colour = tuple(background.inputs["Color"].default_value)[:3]
     if strength <= 0:
         return None
-    lines = ['name = "world"', 'shape = "sky"', "up = [0.0, 1.0, 0.0]",  # a level is Y up
+    name = "world"
+    while name in export.names.to_blender:  # a Blender light may have that name already
+        name += "_sky"
+    lines = [f"name = {_string(name)}", 'shape = "sky"', "up = [0.0, 1.0, 0.0]",  # Y up
              f"strength = {_number(strength)}"]
     if source is None:
         if max(colour) <= 0:
