@@ -14,8 +14,8 @@ import mathutils
 
 from . import glb
 from .names import shadowbake_name
+from .scene_export import GENERATED_UV_MAP
 
-GENERATED_UV_MAP = "shadowbake"
 IMAGE_NODE = "shadowbake_image"
 UV_NODE = "shadowbake_uv"
 GROUP_NODE = "shadowbake_lightmap"
@@ -92,6 +92,9 @@ def _copy_generated_uvs(obj, triangles):
     uv_layer = mesh.uv_layers.get(GENERATED_UV_MAP) or mesh.uv_layers.new(name=GENERATED_UV_MAP)
     if uv_layer is None:
         return f'"{obj.name}": it has 8 UV maps, Blender\'s most; no room for the generated one'
+    # The export leaves this map out (scene_export._hold_generated_uvs), so that shadowbake
+    # generates the same UVs again and reuses the receiver.
+    mesh["shadowbake_generated_uvs"] = True
     unmatched = 0
     for triangle, tri in zip(mesh.loop_triangles, corners):
         mapped = [frame(p) for p in tri]
@@ -277,12 +280,15 @@ def load(context, settings, folder):
                 warnings.append(problem)
             uv_map = GENERATED_UV_MAP
         else:
+            # The export's UV channels: the mesh's UV maps less the generated one it holds back.
+            exported = [layer.name for layer in mesh.uv_layers
+                        if layer.name != GENERATED_UV_MAP or not mesh.get("shadowbake_generated_uvs")]
             channel = receiver.get("uv_channel", 1)
-            if channel >= len(mesh.uv_layers):
+            if channel >= len(exported):
                 warnings.append(f'"{obj.name}": the bake read UV channel {channel}, which it no '
                                 "longer has; bake again")
                 continue
-            uv_map = mesh.uv_layers[channel].name
+            uv_map = exported[channel]
         image = _image(f"shadowbake {name}", path)
         # An 8-bit irradiance lightmap holds value / scale (docs/cli.md, "Encodings").
         strength = settings.preview_strength * float(lightmap.get("scale", 1.0))

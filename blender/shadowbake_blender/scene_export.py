@@ -24,6 +24,7 @@ it); a sun's Strength is the irradiance on a surface facing it, W/m² (`irradian
 Background Strength is the sky's radiance scale (`strength`, "Blender's Background Strength").
 """
 
+import array
 import math
 import os
 import struct
@@ -32,6 +33,8 @@ import bpy
 import mathutils
 
 from .names import NameMap
+
+GENERATED_UV_MAP = "shadowbake"  # the UV map the load puts generated lightmap UVs in
 
 
 def to_level(v):
@@ -311,7 +314,11 @@ def write_scene(context, settings, folder):
         raise ExportError("the scene has no visible light with power (and no world light)")
     export.receivers = [blender for blender, _ in receivers]
 
-    _export_glb(context, export.glb)
+    held = _hold_generated_uvs(meshes)
+    try:
+        _export_glb(context, export.glb)
+    finally:
+        _restore_generated_uvs(held)
 
     lines = ["# Written by the shadowbake Blender add-on (blender/, docs/blender.md) from "
              f"{bpy.data.filepath or 'an unsaved file'}, scene {context.scene.name}.",
@@ -344,6 +351,31 @@ def write_scene(context, settings, folder):
     with open(export.toml, "w", encoding="utf-8") as out:
         out.write("\n".join(lines) + "\n")
     return export
+
+
+def _hold_generated_uvs(meshes):
+    """Takes the UV maps that hold UVs shadowbake generated (GENERATED_UV_MAP on a mesh
+    the load marked) out of their meshes until the export is written, so that the export
+    is the one shadowbake generated them from: it generates the same UVs again and its cache
+    reuses the receiver, instead of reading them back as new lightmap UVs and baking it anew."""
+    held = []
+    for mesh in {obj.data for obj in meshes}:
+        layer = mesh.uv_layers.get(GENERATED_UV_MAP)
+        if layer is None or not mesh.get("shadowbake_generated_uvs"):
+            continue
+        uvs = array.array("f", [0.0]) * (2 * len(mesh.loops))
+        layer.data.foreach_get("uv", uvs)
+        held.append((mesh, uvs, layer.active, layer.active_render))
+        mesh.uv_layers.remove(layer)
+    return held
+
+
+def _restore_generated_uvs(held):
+    for mesh, uvs, active, active_render in held:
+        layer = mesh.uv_layers.new(name=GENERATED_UV_MAP, do_init=False)
+        layer.data.foreach_set("uv", uvs)
+        layer.active = active
+        layer.active_render = active_render
 
 
 def _export_glb(context, path):
