@@ -60,9 +60,13 @@ class SHADOWBAKE_OT_bake(bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     running = False  # one bake at a time
+    # How the last bake ended: "finished", "cancelled" (Esc), or "failed: <message>"; for scripts
+    # and tests/blender/modal_test.py, which cannot read Blender's reports.
+    outcome = ""
 
     def _start(self, context):
         """Exports and starts the bake; False (after a report) when it cannot."""
+        SHADOWBAKE_OT_bake.outcome = "failed: not started"
         settings = context.scene.shadowbake
         preferences = context.preferences.addons[__package__].preferences
         executable = bake_process.find_executable(preferences.executable)
@@ -95,12 +99,15 @@ class SHADOWBAKE_OT_bake(bpy.types.Operator):
             self.report({"WARNING"}, "shadowbake: " +
                         bake_process.in_blender_words(warning, self.export.names))
         if process.returncode != 0:
-            self.report({"ERROR"}, "shadowbake: " + process.failure(self.export.names) +
-                        " (the folder keeps its earlier bake)")
+            message = process.failure(self.export.names)
+            SHADOWBAKE_OT_bake.outcome = f"failed: {message}"
+            self.report({"ERROR"}, f"shadowbake: {message} (the folder keeps its earlier bake)")
             return {"CANCELLED"}
         result = _load_and_report(self, context, self.folder)
         if result is None:
+            SHADOWBAKE_OT_bake.outcome = "failed: the load failed"
             return {"CANCELLED"}
+        SHADOWBAKE_OT_bake.outcome = "finished"
         loaded, manifest = result
         receivers = manifest.get("receivers", [])
         reused = sum(1 for r in receivers if r.get("bake", {}).get("reused"))
@@ -160,6 +167,7 @@ class SHADOWBAKE_OT_bake(bpy.types.Operator):
         if event.type == "ESC":
             self.process.cancel()
             self._end(context)
+            SHADOWBAKE_OT_bake.outcome = "cancelled"
             self.report({"WARNING"}, "shadowbake: bake cancelled; the folder keeps its earlier "
                         "bake")
             return {"CANCELLED"}

@@ -35,9 +35,12 @@ import shutil
 import subprocess
 import sys
 import time
-import zipfile
 
 import bpy
+
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import addon_install  # noqa: E402  (beside this file)
 
 try:
     import numpy
@@ -46,8 +49,6 @@ except ImportError:
           "(Debian: apt-get install python3-numpy)")
     sys.exit(77)
 
-REPO = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
-ADDON = "shadowbake_blender"
 
 ap = argparse.ArgumentParser(prog="addon_test.py")
 ap.add_argument("--shadowbake", required=True, help="the shadowbake executable")
@@ -68,25 +69,11 @@ def step(message):
     print(f"addon_test: [{time.monotonic() - started:5.1f} s] {message}", flush=True)
 
 
-def make_zip():
-    """The add-on as a user installs it: a zip holding the package folder."""
-    path = os.path.join(WORK, f"{ADDON}.zip")
-    source = os.path.join(REPO, "blender", ADDON)
-    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
-        for name in sorted(os.listdir(source)):
-            if name.endswith(".py"):
-                z.write(os.path.join(source, name), f"{ADDON}/{name}")
-    return path
-
-
 def install_addon():
-    bpy.ops.preferences.addon_install(filepath=make_zip(), overwrite=True)
-    bpy.ops.preferences.addon_enable(module=ADDON)
-    if ADDON not in bpy.context.preferences.addons:
-        fail("the add-on did not enable")
-    bpy.context.preferences.addons[ADDON].preferences.executable = SHADOWBAKE
-    if not hasattr(bpy.ops.shadowbake, "bake"):
-        fail("bpy.ops.shadowbake.bake is not registered")
+    try:
+        addon_install.install_addon(WORK, SHADOWBAKE)
+    except RuntimeError as error:
+        fail(str(error))
 
 
 def box_mesh(name, boxes, uv=True):
