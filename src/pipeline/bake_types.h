@@ -14,6 +14,7 @@
 #include "core/image.h"
 #include "lightmaps/gltf_export.h"
 #include "methods/method.h"
+#include "pipeline/receiver_record.h"
 #include "texels/atlas_packing.h"
 #include "texels/seams.h"
 #include "texels/texel_space.h"
@@ -66,7 +67,8 @@ struct BakeOptions {
   std::vector<std::string> relight;
 };
 
-struct ReceiverBake {
+// A receiver's bake: its record (what every file that keeps it says) and its images.
+struct ReceiverBake : ReceiverRecord {
   std::size_t object = 0;  // its index among the scene's objects
   std::string name;
   int uv_channel = 0;
@@ -76,13 +78,8 @@ struct ReceiverBake {
   std::optional<RowRange> tile;
   Image image;  // RGB, the receiver's side² (resolution, or its texels_per_metre size), dilated
   std::vector<std::uint8_t> covered;  // width × height: 1 where a triangle covers the texel
-  std::int64_t covered_texels = 0;
-  UvLayoutReport uv;   // the lightmap UV layout's checks
-  double seconds = 0;  // texel space + method + dilation + seams, this receiver only
+  double seconds = 0;                 // texel space + method + dilation + seams, this receiver only
   double seconds_texels = 0, seconds_method = 0, seconds_dilate = 0, seconds_seams = 0;
-  // Its UV seams: how many, the texels stitched, and the largest difference of the two sides'
-  // lookups before and after (texels/seams.h; after = before when [bake] seams is false).
-  SeamReport seams;
   // Per light, in scene order, when kept: its own V (or H0·V), dilated like the image; and what
   // its shadow mask needs (MixedImages::per_light_visibility, its influence cleared beyond its
   // shadowmask_range), dilated too.

@@ -3,6 +3,8 @@
 #include "pipeline/manifest.h"
 
 #include "lightmaps/shadowmask.h"
+#include "pipeline/json_fields.h"
+#include "pipeline/receiver_record.h"
 
 #include <fstream>
 #include <limits>
@@ -24,121 +26,6 @@ const std::set<std::string, std::less<>>& receiver_schema_keys() {
       "method_stats", "bake"};
   return keys;
 }
-
-template <typename Enum>
-bool parse_enum(const std::string& text, std::initializer_list<Enum> values, Enum& out) {
-  for (const Enum value : values) {
-    if (text != to_string(value)) continue;
-    out = value;
-    return true;
-  }
-  return false;
-}
-
-// Reads the keys of one JSON object of the manifest, keeping the first problem as an error that
-// names the file and the key's path (e.g. receivers[0].files.exr).
-class FieldReader {
- public:
-  FieldReader(const json& object, const std::string& where, std::string path, Status& status)
-      : object_(object), where_(where), path_(std::move(path)), status_(status) {}
-
-  void read(const char* key, std::string& out) {
-    if (const json* v = find(key, &json::is_string, "a string")) out = v->get<std::string>();
-  }
-  void read(const char* key, bool& out) {
-    if (const json* v = find(key, &json::is_boolean, "true or false")) out = v->get<bool>();
-  }
-  void read(const char* key, double& out) {
-    if (const json* v = find(key, &json::is_number, "a number")) out = v->get<double>();
-  }
-  void read(const char* key, int& out) {
-    const json* v = find(key, &json::is_number_integer, "an integer");
-    if (!v) return;
-    const std::int64_t value = v->get<std::int64_t>();
-    if (value < std::numeric_limits<int>::min() || value > std::numeric_limits<int>::max() ||
-        (v->is_number_unsigned() && v->get<std::uint64_t>() > std::uint64_t(value))) {
-      fail(key, "an integer of at most 32 bits");
-      return;
-    }
-    out = int(value);
-  }
-  void read(const char* key, std::int64_t& out) {
-    const json* v = find(key, &json::is_number_integer, "an integer");
-    if (!v) return;
-    if (v->is_number_unsigned() &&
-        v->get<std::uint64_t>() > std::uint64_t(std::numeric_limits<std::int64_t>::max())) {
-      fail(key, "an integer of at most 63 bits");
-      return;
-    }
-    out = v->get<std::int64_t>();
-  }
-  void read(const char* key, std::uint64_t& out) {
-    if (const json* v = find(key, &json::is_number_unsigned, "an integer ≥ 0"))
-      out = v->get<std::uint64_t>();
-  }
-  void read(const char* key, Quantity& out) {
-    std::string text;
-    read(key, text);
-    if (status_ &&
-        !parse_enum(text, {Quantity::visibility, Quantity::irradiance, Quantity::ambient_occlusion},
-                    out))
-      fail(key, "\"visibility\", \"irradiance\" or \"ambient-occlusion\"");
-  }
-  void read(const char* key, Encoding& out) {
-    std::string text;
-    read(key, text);
-    if (status_ &&
-        !parse_enum(text,
-                    {Encoding::linear_exr, Encoding::half_exr, Encoding::png, Encoding::rgbm_png},
-                    out))
-      fail(key, "\"linear-exr\", \"half-exr\", \"png\" or \"rgbm-png\"");
-  }
-  void read(const char* key, LightShape& out) {
-    std::string text;
-    read(key, text);
-    if (status_ && !parse_enum(text,
-                               {LightShape::rectangle, LightShape::disk, LightShape::sphere,
-                                LightShape::polygon, LightShape::mesh, LightShape::sky},
-                               out))
-      fail(key, "\"rectangle\", \"disk\", \"sphere\", \"polygon\", \"mesh\" or \"sky\"");
-  }
-  template <typename T>
-  void read_optional(const char* key, std::optional<T>& out) {
-    if (!object_.contains(key)) return;
-    out.emplace();
-    read(key, *out);
-  }
-
-  // The value of `key` when it is an object (an array), else null with the error kept.
-  const json* object(const char* key) { return find(key, &json::is_object, "an object"); }
-  const json* array(const char* key) { return find(key, &json::is_array, "an array"); }
-
-  // The path of the entry `key` names, for a FieldReader of a nested object.
-  std::string path_of(const std::string& key) const { return path_ + key; }
-
- private:
-  const json* find(const char* key, bool (json::*is_kind)() const noexcept, const char* kind) {
-    if (!status_) return nullptr;
-    const auto it = object_.find(key);
-    if (it == object_.end()) {
-      status_ = input_error(where_ + ": no " + path_ + key + " in the bake's manifest");
-      return nullptr;
-    }
-    if (!((*it).*is_kind)()) {
-      fail(key, kind);
-      return nullptr;
-    }
-    return &*it;
-  }
-  void fail(const char* key, const std::string& kind) {
-    status_ = input_error(where_ + ": " + path_ + key + " in the bake's manifest is not " + kind);
-  }
-
-  const json& object_;
-  const std::string& where_;
-  std::string path_;
-  Status& status_;
-};
 
 json file_to_json(const ManifestFile& f) {
   return {{"file", f.file},
@@ -243,27 +130,9 @@ json receiver_to_json(const ManifestReceiver& r) {
       {"method", r.method},
       {"quantity", to_string(r.quantity)},
       {"samples", r.samples},
-      {"covered_texels", r.covered_texels},
-      {"uv_layout",
-       {{"charts", r.uv_layout.charts},
-        {"uv_area", r.uv_layout.uv_area},
-        {"uv_area_outside", r.uv_layout.uv_area_outside},
-        {"overlapping_texels", r.uv_layout.overlapping_texels},
-        {"texels_near_other_charts", r.uv_layout.texels_near_other_charts},
-        {"margin", r.uv_layout.margin},
-        {"stretch", r.uv_layout.stretch},
-        {"density_spread", r.uv_layout.density_spread},
-        {"generated", r.uv_layout.generated}}},
-      {"seams",
-       {{"edges", r.seams.edges},
-        {"stitched", r.seams.stitched},
-        {"texels", r.seams.texels},
-        {"largest_difference_before", r.seams.largest_difference_before},
-        {"largest_difference_after", r.seams.largest_difference_after},
-        {"visible_before", r.seams.visible_before},
-        {"visible_after", r.seams.visible_after}}},
-      {"seconds", r.seconds},
   });
+  write_record(r, out);
+  out["seconds"] = r.seconds;
   if (r.bake) out["bake"] = {{"reused", r.bake->reused}, {"why", r.bake->why}};
   if (!r.method_stats.empty()) {
     json& stats = out["method_stats"] = json::object();
@@ -322,32 +191,7 @@ void read_receiver(const json& entry, const std::string& where, const std::strin
   fields.read("method", r.method);
   fields.read("quantity", r.quantity);
   fields.read("samples", r.samples);
-  fields.read("covered_texels", r.covered_texels);
-  if (const json* layout = fields.object("uv_layout")) {
-    FieldReader layout_fields(*layout, where, fields.path_of("uv_layout."), status);
-    layout_fields.read("charts", r.uv_layout.charts);
-    layout_fields.read("uv_area", r.uv_layout.uv_area);
-    layout_fields.read("uv_area_outside", r.uv_layout.uv_area_outside);
-    layout_fields.read("overlapping_texels", r.uv_layout.overlapping_texels);
-    layout_fields.read("texels_near_other_charts", r.uv_layout.texels_near_other_charts);
-    layout_fields.read("margin", r.uv_layout.margin);
-    // Absent from manifests written before the layout's quality was measured.
-    if (layout->contains("stretch")) layout_fields.read("stretch", r.uv_layout.stretch);
-    if (layout->contains("density_spread"))
-      layout_fields.read("density_spread", r.uv_layout.density_spread);
-    if (layout->contains("generated")) layout_fields.read("generated", r.uv_layout.generated);
-  }
-  // Absent from manifests written before seams were measured.
-  if (const json* seams = entry.contains("seams") ? fields.object("seams") : nullptr) {
-    FieldReader seam_fields(*seams, where, fields.path_of("seams."), status);
-    seam_fields.read("edges", r.seams.edges);
-    seam_fields.read("stitched", r.seams.stitched);
-    seam_fields.read("texels", r.seams.texels);
-    seam_fields.read("largest_difference_before", r.seams.largest_difference_before);
-    seam_fields.read("largest_difference_after", r.seams.largest_difference_after);
-    seam_fields.read("visible_before", r.seams.visible_before);
-    seam_fields.read("visible_after", r.seams.visible_after);
-  }
+  read_record(fields, entry, r);
   if (const json* reuse = entry.contains("bake") ? fields.object("bake") : nullptr) {
     FieldReader reuse_fields(*reuse, where, fields.path_of("bake."), status);
     // Assigned, not emplace()d: clang 14 (the fuzzing build's) does not count a nested struct

@@ -15,6 +15,7 @@
 
 #include "core/error.h"
 #include "methods/method.h"
+#include "pipeline/receiver_record.h"
 #include "scene/scene.h"
 
 namespace sb {
@@ -61,29 +62,9 @@ struct ManifestAtlas {
   ManifestFiles files;
 };
 
-// The receiver's lightmap UV layout checks (UvLayoutReport, texels/uv_checks.h).
-struct ManifestUvLayout {
-  int charts = 0;
-  double uv_area = 0, uv_area_outside = 0;
-  std::int64_t overlapping_texels = 0, texels_near_other_charts = 0;
-  int margin = 0;  // texels
-  // Layout quality (UvLayoutReport); absent from manifests written before they were measured.
-  double stretch = 0, density_spread = 0;
-  bool generated = false;  // the bake made the UVs: they are the glTF output's TEXCOORD_1
-};
-
-// The receiver's UV seams (SeamReport, texels/seams.h): the largest difference between the
-// bilinear lookups on a seam's two sides, in the lightmap's own units, and the share of seam
-// samples where it exceeds 1/255 (of 1 for visibility, of the largest value for irradiance),
-// before and after stitching.
-struct ManifestSeams {
-  std::int64_t edges = 0, texels = 0;
-  bool stitched = false;
-  double largest_difference_before = 0, largest_difference_after = 0;
-  double visible_before = 0, visible_after = 0;
-};
-
-struct ManifestReceiver {
+// A receiver's entry: its record (receiver_record.h: covered_texels, uv_layout, seams, written
+// after `samples`) and what the bake wrote of it.
+struct ManifestReceiver : ReceiverRecord {
   std::string name;
   std::optional<ManifestFiles> files;           // its own files (no atlas)
   std::optional<ManifestAtlasPlacement> atlas;  // or its place in an atlas
@@ -92,9 +73,6 @@ struct ManifestReceiver {
   std::string method;
   Quantity quantity = Quantity::visibility;
   int samples = 0;
-  std::int64_t covered_texels = 0;
-  ManifestUvLayout uv_layout;
-  ManifestSeams seams;
   double seconds = 0;
   // Incremental bakes: whether it was taken from the earlier bake's cache, and why it was or
   // was not (pipeline/bake_cache.h); absent for a shard's or a merge's receivers.

@@ -81,7 +81,7 @@ Status bake_receivers(const Scene& scene, const MethodEntry& method, const Loade
     if (loaded.tiles[r]) {
       crop_to_tile(out, texels.spaces[r], *loaded.tiles[r]);  // the rest at the join
     } else {
-      out.uv = texels.layouts[r];
+      out.uv_layout = texels.layouts[r];
       finish_receiver(scene, loaded.meshes[object], texels.spaces[r], loaded.lights, out);
     }
     texels.spaces[r] = TexelSpace();  // its memory back before the next receiver's

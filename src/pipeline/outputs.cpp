@@ -185,23 +185,7 @@ ManifestReceiver describe_receiver(const ReceiverBake& r, const BakeSettings& ef
   entry.method = effective.method;
   entry.quantity = effective.quantity;
   entry.samples = effective.samples;
-  entry.covered_texels = r.covered_texels;
-  entry.uv_layout = {.charts = r.uv.charts,
-                     .uv_area = r.uv.uv_area,
-                     .uv_area_outside = r.uv.uv_area_outside,
-                     .overlapping_texels = r.uv.overlapping_texels,
-                     .texels_near_other_charts = r.uv.texels_near_other_charts,
-                     .margin = r.uv.margin,
-                     .stretch = r.uv.stretch,
-                     .density_spread = r.uv.density_spread,
-                     .generated = r.uv.generated};
-  entry.seams = {.edges = r.seams.edges,
-                 .texels = r.seams.texels,
-                 .stitched = effective.seams,
-                 .largest_difference_before = r.seams.before.largest,
-                 .largest_difference_after = r.seams.after.largest,
-                 .visible_before = r.seams.before.visible,
-                 .visible_after = r.seams.after.visible};
+  static_cast<ReceiverRecord&>(entry) = r;
   entry.seconds = r.seconds;
   if (!r.reuse.empty()) entry.bake = ManifestReceiver::Reuse{r.reuse == "reused", r.reuse_why};
   entry.method_stats = r.report.stats;

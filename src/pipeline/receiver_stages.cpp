@@ -196,6 +196,7 @@ void finish_receiver(const Scene& scene, const Mesh& mesh, const TexelSpace& spa
     out.seams = stitch_seams(seams, space.covered, seam_images(scene, out, space, lights),
                              seam_scale(scene, out.image), scene.bake.seams);
   }
+  out.seams.stitched = scene.bake.seams;
   out.seconds_seams = seconds_since(seams_start);
   out.covered_texels = std::int64_t(space.texels.size());
   out.covered = space.covered;

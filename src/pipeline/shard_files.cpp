@@ -1,6 +1,9 @@
 // A shard's receivers on disk (shard_files.h).
 #include "pipeline/shard_files.h"
 
+#include "pipeline/json_fields.h"
+#include "pipeline/receiver_record.h"
+
 #include <fmt/format.h>
 #include <xxhash.h>
 
@@ -18,8 +21,9 @@ using json = nlohmann::ordered_json;
 
 constexpr std::uint32_t kReceiverMagic = 0x52535342;  // "SBSR"
 constexpr std::uint32_t kMeshMagic = 0x4D535342;      // "SBSM"
-// 2: receivers' seams; 3: UV stretch, density spread; 4: tiles, the method's tallies.
-constexpr std::uint32_t kVersion = 4;
+// 2: receivers' seams; 3: UV stretch, density spread; 4: tiles, the method's tallies; 5: the
+// receiver's record as the manifest writes it (receiver_record.h).
+constexpr std::uint32_t kVersion = 5;
 // A lightmap side no bake makes (resolution ≤ 16384), so that a damaged header cannot make the
 // reader allocate terabytes.
 constexpr std::uint64_t kMaxSide = 16384;
@@ -126,39 +130,24 @@ json receiver_metadata(const ReceiverBake& r) {
   for (const auto& [key, value] : r.report.stats) stats.push_back({key, value});
   json tallies = json::array();
   for (const auto& [key, value] : r.report.tallies) tallies.push_back({key, value});
-  return {{"object", r.object},
-          {"name", r.name},
-          {"uv_channel", r.uv_channel},
-          {"side", r.image.width},
-          {"tile", r.tile ? json::array({r.tile->begin, r.tile->end}) : json()},
-          {"covered_texels", r.covered_texels},
-          {"uv_layout",
-           {{"covered_texels", r.uv.covered_texels},
-            {"uv_area", r.uv.uv_area},
-            {"uv_area_outside", r.uv.uv_area_outside},
-            {"overlapping_texels", r.uv.overlapping_texels},
-            {"charts", r.uv.charts},
-            {"margin", r.uv.margin},
-            {"texels_near_other_charts", r.uv.texels_near_other_charts},
-            {"stretch", r.uv.stretch},
-            {"density_spread", r.uv.density_spread},
-            {"generated", r.uv.generated}}},
-          {"seams",
-           {{"edges", r.seams.edges},
-            {"texels", r.seams.texels},
-            {"before", {r.seams.before.largest, r.seams.before.visible}},
-            {"after", {r.seams.after.largest, r.seams.after.visible}}}},
-          {"rays", r.rays},
-          {"uv_warnings", r.uv_warnings},
-          {"lights_reached", r.lights_reached},
-          {"method_stats", stats},
-          {"method_tallies", tallies},
-          {"method_entries", r.report.manifest},
-          {"explain", r.report.explain},
-          {"method_warnings", r.report.warnings},
-          {"per_light", r.per_light.size()},
-          {"per_light_visibility", r.per_light_visibility.size()},
-          {"gltf_mesh", bool(r.gltf_mesh)}};
+  json out = {{"object", r.object},
+              {"name", r.name},
+              {"uv_channel", r.uv_channel},
+              {"side", r.image.width},
+              {"tile", r.tile ? json::array({r.tile->begin, r.tile->end}) : json()}};
+  write_record(r, out);
+  out.update(json{{"rays", r.rays},
+                  {"uv_warnings", r.uv_warnings},
+                  {"lights_reached", r.lights_reached},
+                  {"method_stats", stats},
+                  {"method_tallies", tallies},
+                  {"method_entries", r.report.manifest},
+                  {"explain", r.report.explain},
+                  {"method_warnings", r.report.warnings},
+                  {"per_light", r.per_light.size()},
+                  {"per_light_visibility", r.per_light_visibility.size()},
+                  {"gltf_mesh", bool(r.gltf_mesh)}});
+  return out;
 }
 
 std::string receiver_data(const ReceiverBake& r) {
@@ -188,24 +177,6 @@ Expected<ReceiverBake> read_receiver(const json& meta, const std::filesystem::pa
     side = meta.at("side").get<int>();
     if (const json& tile = meta.at("tile"); !tile.is_null())
       r.tile = RowRange{tile.at(0).get<int>(), tile.at(1).get<int>()};
-    r.covered_texels = meta.at("covered_texels").get<std::int64_t>();
-    const json& uv = meta.at("uv_layout");
-    r.uv.covered_texels = uv.at("covered_texels").get<std::int64_t>();
-    r.uv.uv_area = uv.at("uv_area").get<double>();
-    r.uv.uv_area_outside = uv.at("uv_area_outside").get<double>();
-    r.uv.overlapping_texels = uv.at("overlapping_texels").get<std::int64_t>();
-    r.uv.charts = uv.at("charts").get<int>();
-    r.uv.margin = uv.at("margin").get<int>();
-    r.uv.texels_near_other_charts = uv.at("texels_near_other_charts").get<std::int64_t>();
-    r.uv.stretch = uv.at("stretch").get<double>();
-    r.uv.density_spread = uv.at("density_spread").get<double>();
-    r.uv.generated = uv.at("generated").get<bool>();
-    const json& seams = meta.at("seams");
-    r.seams.edges = seams.at("edges").get<std::int64_t>();
-    r.seams.texels = seams.at("texels").get<std::int64_t>();
-    r.seams.before = {seams.at("before").at(0).get<double>(),
-                      seams.at("before").at(1).get<double>()};
-    r.seams.after = {seams.at("after").at(0).get<double>(), seams.at("after").at(1).get<double>()};
     r.rays = meta.at("rays").get<std::int64_t>();
     r.uv_warnings = meta.at("uv_warnings").get<std::vector<std::string>>();
     r.lights_reached = meta.at("lights_reached").get<std::vector<std::uint8_t>>();
@@ -223,6 +194,10 @@ Expected<ReceiverBake> read_receiver(const json& meta, const std::filesystem::pa
   } catch (const json::exception& e) {
     return damaged(where, std::string("a receiver's entry: ") + e.what());
   }
+  Status fields_read = Ok{};
+  FieldReader fields(meta, where, "", fields_read, "the shard's data");
+  read_record(fields, meta, r);
+  if (!fields_read) return input_error(fields_read.error().message + "; bake the shard again");
   if (side <= 0 || std::uint64_t(side) > kMaxSide || per_light > 4096 || visibility > 4096 ||
       (r.tile && (r.tile->begin < 0 || r.tile->end <= r.tile->begin || r.tile->end > side)))
     return damaged(where, "receiver '" + r.name + "' has impossible sizes");

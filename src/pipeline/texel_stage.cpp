@@ -23,7 +23,7 @@ Expected<Texels> build_texels(const Scene& scene, const MethodEntry& method,
     if (reuse.reused[r]) {  // taken from the cache: nothing to rasterise, its layout as it was
       out.spaces.emplace_back();
       out.seconds.push_back(0);
-      out.layouts.push_back(reuse.reused[r]->uv);
+      out.layouts.push_back(reuse.reused[r]->uv_layout);
       out.reached[r] = reuse.reused[r]->lights_reached;
       covered = reuse.reused[r]->covered_texels;
     } else if (loaded.tiles[r]) {  // its rows and the method's halo; the rest at the join

@@ -217,8 +217,9 @@ Expected<std::vector<ReceiverBake>> join_tiles(const Scene& scene,
     if (space.covered != covered)
       return fail("cover other texels than its UVs do (a shard baked another mesh or build)");
     const ObjectDesc& obj = scene.objects[object];
-    out.uv = check_uv_layout(mesh, space, scene.bake.margin);
-    auto warnings = layout_warnings(scene, obj, out.uv, std::int64_t(space.texels.size()), side);
+    out.uv_layout = check_uv_layout(mesh, space, scene.bake.margin);
+    auto warnings =
+        layout_warnings(scene, obj, out.uv_layout, std::int64_t(space.texels.size()), side);
     if (!warnings) return warnings.error();
     out.uv_warnings = std::move(*warnings);
     out.lights_reached = lights_reaching(scene, space, *lights);

@@ -42,6 +42,9 @@ struct SeamReport {
   std::int64_t edges = 0;
   std::int64_t texels = 0;  // the texels the seams' lookups read: those the solve may change
   SeamDifference before, after;
+  // Whether the bake's seams pass was on ([bake] seams): after = before when not, and for a
+  // receiver without seams either way.
+  bool stitched = false;
 };
 
 // One image of a receiver to stitch, with its arbitrary texels: covered texels whose value means

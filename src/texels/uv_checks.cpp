@@ -133,7 +133,6 @@ UvQuality uv_quality(const Mesh& mesh) {
 
 UvLayoutReport check_uv_layout(const Mesh& mesh, const TexelSpace& space, int margin) {
   UvLayoutReport report;
-  report.covered_texels = std::int64_t(space.texels.size());
   report.overlapping_texels = space.overlapping_texels;
   report.margin = margin;
   report.generated = mesh.uv_generated;

@@ -1,7 +1,7 @@
 // Checks of a receiver's lightmap UV layout, reported per receiver in the manifest and as
-// warnings (uv_checks.cpp): how many texels it covers, how much of its UV area lies outside the
-// lightmap, texels two charts claim, and texels so close to another chart that bilinear
-// filtering and the margin's dilation mix the two.
+// warnings (uv_checks.cpp): how much of its UV area lies outside the lightmap, texels two charts
+// claim, and texels so close to another chart that bilinear filtering and the margin's dilation mix
+// the two.
 #pragma once
 
 #include <cstdint>
@@ -14,7 +14,6 @@
 namespace sb {
 
 struct UvLayoutReport {
-  std::int64_t covered_texels = 0;
   double uv_area = 0;                   // Σ of the UV triangles' areas (the unit square is 1)
   double uv_area_outside = 0;           // the part of it outside [0, 1]², which gets no texels
   std::int64_t overlapping_texels = 0;  // TexelSpace::overlapping_texels

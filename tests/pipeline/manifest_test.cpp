@@ -44,19 +44,17 @@ Manifest full_manifest() {
   r.quantity = Quantity::irradiance;
   r.samples = 256;
   r.covered_texels = 2000;
-  r.uv_layout = {.charts = 3,
-                 .uv_area = 0.75,
-                 .uv_area_outside = 0.125,
-                 .overlapping_texels = 7,
-                 .texels_near_other_charts = 11,
-                 .margin = 4};
-  r.seams = {.edges = 12,
-             .texels = 300,
-             .stitched = true,
-             .largest_difference_before = 0.5,
-             .largest_difference_after = 0.001,
-             .visible_before = 0.25,
-             .visible_after = 0.0};
+  r.uv_layout.charts = 3;
+  r.uv_layout.uv_area = 0.75;
+  r.uv_layout.uv_area_outside = 0.125;
+  r.uv_layout.overlapping_texels = 7;
+  r.uv_layout.texels_near_other_charts = 11;
+  r.uv_layout.margin = 4;
+  r.seams.edges = 12;
+  r.seams.texels = 300;
+  r.seams.stitched = true;
+  r.seams.before = {.largest = 0.5, .visible = 0.25};
+  r.seams.after = {.largest = 0.001, .visible = 0.0};
   r.seconds = 0.25;
   r.method_stats = {{"clear_fraction", 0.5}, {"rays_per_texel", 3.0}};
   r.method_entries["penumbra_error"] = {{"metres", 0.01}, {"texels", 2.5}};
@@ -100,9 +98,9 @@ TEST(Manifest, RoundTripsEveryKey) {
   EXPECT_EQ(r.seams.edges, 12);
   EXPECT_EQ(r.seams.texels, 300);
   EXPECT_TRUE(r.seams.stitched);
-  EXPECT_EQ(r.seams.largest_difference_before, 0.5);
-  EXPECT_EQ(r.seams.largest_difference_after, 0.001);
-  EXPECT_EQ(r.seams.visible_before, 0.25);
+  EXPECT_EQ(r.seams.before.largest, 0.5);
+  EXPECT_EQ(r.seams.after.largest, 0.001);
+  EXPECT_EQ(r.seams.before.visible, 0.25);
   EXPECT_EQ(r.method_stats, written.receivers[0].method_stats);
   EXPECT_EQ(r.method_entries, written.receivers[0].method_entries);
   EXPECT_EQ(read->shadow_rays, 123456789012);

@@ -346,7 +346,7 @@ TEST(AutoUv, BakeOfTheSeamsSceneWithGeneratedUvs) {
   EXPECT_TRUE(baked->warnings.empty()) << baked->warnings.front();
   for (const ReceiverBake& r : baked->receivers) {
     SCOPED_TRACE(r.name);
-    EXPECT_TRUE(r.uv.generated);
+    EXPECT_TRUE(r.uv_layout.generated);
     EXPECT_EQ(r.uv_channel, 1);
     EXPECT_GT(r.covered_texels, 0.3 * 128 * 128);
     if (r.name == "cylinder") {
