@@ -9,8 +9,9 @@ Run it before and after a change that must not change outputs and diff the two l
     diff /tmp/before.txt /tmp/after.txt && echo identical
 
 Each line is `scene method file sha256`. Image files are hashed as written; the manifest is hashed
-with its timings (every key naming seconds) left out, since those differ on every run. Scenes bake
-at --resolution (default 96) and --samples (default 16) so that the whole grid takes a few minutes.
+in its own key order with its timings (every key naming seconds) left out, since those differ on
+every run. Scenes bake at --resolution (default 96) and --samples (default 16) so that the whole
+grid takes a few minutes.
 """
 import argparse
 import hashlib
@@ -66,8 +67,7 @@ def main():
                 for f in sorted(os.listdir(out)):
                     data = (out / f).read_bytes()
                     if f == "manifest.json":
-                        data = json.dumps(without_timings(json.loads(data)),
-                                          sort_keys=True).encode()
+                        data = json.dumps(without_timings(json.loads(data))).encode()
                     print(scene, method, f, hashlib.sha256(data).hexdigest())
                 sys.stdout.flush()
     return 0
