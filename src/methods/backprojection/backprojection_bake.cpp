@@ -50,6 +50,50 @@ struct TileBlockers {
   std::vector<std::vector<int>> cut_faces;         // per solid: faces across the slab's planes
 };
 
+// The solid's edges that may lie on its silhouette from some point of the box `origins`: those
+// between faces that do not face the same way from all of it.
+std::vector<int> edges_on_some_silhouette(const BlockerSolid& solid, const Bounds3& origins) {
+  const Vec3 centre = origins.centre(), half = 0.5 * (origins.hi - origins.lo);
+  // Each face's side of the whole box: 1 facing it from all of it, -1 from none, 0 mixed.
+  std::vector<std::int8_t> side(solid.faces.size());
+  for (std::size_t f = 0; f < solid.faces.size(); ++f) {
+    const Vec3& n = solid.normals[f];
+    const double mid = n.dot(centre - solid.corners[std::size_t(solid.faces[f][0])]);
+    const double spread = half.dot(n.cwiseAbs());
+    side[f] = mid - spread > 0 ? 1 : mid + spread < 0 ? -1 : 0;
+  }
+  std::vector<int> edges;
+  for (std::size_t e = 0; e < solid.edges.size(); ++e) {
+    const std::int8_t a = side[std::size_t(solid.edges[e][2])];
+    const std::int8_t b = side[std::size_t(solid.edges[e][3])];
+    if (a == 0 || b == 0 || a != b) edges.push_back(int(e));
+  }
+  return edges;
+}
+
+// The solid's faces that may cross the light's plane (at the rays' offset) or the height of some
+// origin of the box `origins`: those that cut the outline of the solid's part in a texel's slab.
+std::vector<int> faces_across_slab(const Light& light, const BlockerSolid& solid,
+                                   const Bounds3& origins, double offset) {
+  std::vector<int> cuts;
+  double h_lo = std::numeric_limits<double>::infinity(), h_hi = -h_lo;
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 p = origins.corner(c);
+    const double h = light.normal().dot(p - light.centre());
+    h_lo = std::min(h_lo, h * (1 - 1e-9)), h_hi = std::max(h_hi, h);
+  }
+  for (std::size_t f = 0; f < solid.faces.size(); ++f) {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (int j = 0; j < 3; ++j) {
+      const double h = light.normal().dot(
+          solid.corners[std::size_t(solid.faces[f][std::size_t(j)])] - light.centre());
+      lo = std::min(lo, h), hi = std::max(hi, h);
+    }
+    if ((lo < offset && hi > offset) || (lo < h_hi && hi > h_lo)) cuts.push_back(int(f));
+  }
+  return cuts;
+}
+
 TileBlockers tile_blockers(const ShaftCuller& culler, const Light& light,
                            const std::vector<std::uint32_t>& candidates, const Bounds3& origins,
                            double offset) {
@@ -137,42 +181,10 @@ TileBlockers tile_blockers(const ShaftCuller& culler, const Light& light,
         continue;
       }
     }
-    // Each face's side of the whole tile: 1 facing it from all of it, -1 from none, 0 mixed.
-    std::vector<std::int8_t> side(solid.faces.size());
-    for (std::size_t f = 0; f < solid.faces.size(); ++f) {
-      const Vec3& n = solid.normals[f];
-      const double mid = n.dot(centre - solid.corners[std::size_t(solid.faces[f][0])]);
-      const double spread = half.dot(n.cwiseAbs());
-      side[f] = mid - spread > 0 ? 1 : mid + spread < 0 ? -1 : 0;
-    }
-    std::vector<int> edges;
-    for (std::size_t e = 0; e < solid.edges.size(); ++e) {
-      const std::int8_t a = side[std::size_t(solid.edges[e][2])];
-      const std::int8_t b = side[std::size_t(solid.edges[e][3])];
-      if (a == 0 || b == 0 || a != b) edges.push_back(int(e));
-    }
-    out.edges.push_back(std::move(edges));
-    // The faces that may cross the light's plane (at the rays' offset) or the height of some
-    // origin of the tile: those that cut the outline of the solid's part in a texel's slab.
-    std::vector<int> cuts;
-    if (light.shape() != LightShape::sphere) {
-      double h_lo = std::numeric_limits<double>::infinity(), h_hi = -h_lo;
-      for (int c = 0; c < 8; ++c) {
-        const Vec3 p = origins.corner(c);
-        const double h = light.normal().dot(p - light.centre());
-        h_lo = std::min(h_lo, h * (1 - 1e-9)), h_hi = std::max(h_hi, h);
-      }
-      for (std::size_t f = 0; f < solid.faces.size(); ++f) {
-        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-        for (int j = 0; j < 3; ++j) {
-          const double h = light.normal().dot(
-              solid.corners[std::size_t(solid.faces[f][std::size_t(j)])] - light.centre());
-          lo = std::min(lo, h), hi = std::max(hi, h);
-        }
-        if ((lo < offset && hi > offset) || (lo < h_hi && hi > h_lo)) cuts.push_back(int(f));
-      }
-    }
-    out.cut_faces.push_back(std::move(cuts));
+    out.edges.push_back(edges_on_some_silhouette(solid, origins));
+    out.cut_faces.push_back(light.shape() != LightShape::sphere
+                                ? faces_across_slab(light, solid, origins, offset)
+                                : std::vector<int>());
     std::vector<BlockerPolygon> faces;
     for (std::uint32_t i : candidates)
       if (culler.blocker_key(i) == keys[k])
