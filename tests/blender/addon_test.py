@@ -11,18 +11,21 @@ and checks that
 1. `shadowbake.bake` bakes and loads: each receiver's image in Blender is byte for byte (its file)
    and value for value (its pixels) a `shadowbake bake` of the exported level.glb and scene.toml
    into another folder, and the chair got the generated UV map;
-2. a second bake of the unchanged scene reuses every receiver (the chair's generated UVs held out
+2. the materials show the lightmap multiplied into the base colour, or as emission, which the next
+   export must not carry (the bake still sees one light and reuses everything);
+3. a second bake of the unchanged scene reuses every receiver (the chair's generated UVs held out
    of the export, so that shadowbake generates the same again); after the chair moves, a bake
-   rebakes the chair and the floor under it and reuses the
-   crate (manifest.json's `bake.reused`), still equal to a fresh bake of the new export, and
-   replaces the images and materials instead of adding copies;
-3. the area light as the add-on exports it bakes what the same light written by hand in a scene
-   file bakes, within 1e-6 at every texel;
-4. a bake stopped by SIGINT (what Esc sends) and a bake that fails on a mesh of no area leave the
+   rebakes the chair and the floor under it and reuses the crate (manifest.json's
+   `bake.reused`), still equal to a fresh bake of the new export, and replaces the images and
+   materials instead of adding copies;
+4. area lights as the add-on exports them bake what the same lights written by hand in a scene
+   file bake: within 1e-6 at every texel for lights Blender holds exactly, 1e-4 for the turned
+   one (below, check_area_lights);
+5. a bake stopped by SIGINT (what Esc sends) and a bake that fails on a mesh of no area leave the
    folder's earlier bake as it was, the failure naming the Blender object;
-5. a point, a spot, a sun, an elliptic area light and the world export into a scene file that
+6. a point, a spot, a sun, an elliptic area light and the world export into a scene file that
    bakes;
-6. with --picture, renders the baked scene with Cycles, the lightmaps shown as emission, to that
+7. with --picture, renders the baked scene with Cycles, the lightmaps shown as emission, to that
    PNG (the README's picture).
 
 Exits 1 with a message on the first failure, 77 where Blender lacks what the add-on needs.
@@ -187,12 +190,24 @@ def check_equal_to_cli(manifest, cli_out):
                  f"{receiver['resolution'][0]}")
 
 
-def check_wired(obj):
+def check_wired(obj, mode="MULTIPLY"):
+    """The object's materials show its lightmap: multiplied into the Principled BSDF's base
+    colour, or (EMISSION) as the surface itself."""
     image = bpy.data.images.get(f"shadowbake {obj.name.replace(' ', '_')}")
     for slot in obj.material_slots:
-        group = slot.material.node_tree.nodes.get("shadowbake_lightmap")
+        nodes = slot.material.node_tree.nodes
+        group = nodes.get("shadowbake_lightmap")
         if group is None or group.node_tree.nodes["shadowbake_image"].image != image:
             fail(f'material "{slot.material.name}" of "{obj.name}" does not show its lightmap')
+        base = nodes["Principled BSDF"].inputs["Base Color"]
+        surface = nodes["Material Output"].inputs["Surface"]
+        wanted = {"MULTIPLY": (base, "Multiplied"), "EMISSION": (surface, "Emission")}[mode]
+        socket, output = wanted
+        if not socket.is_linked or socket.links[0].from_node != group or \
+                socket.links[0].from_socket.name != output:
+            fail(f'material "{slot.material.name}" of "{obj.name}" is not wired for {mode}')
+        if mode == "EMISSION" and base.is_linked:
+            fail(f'material "{slot.material.name}": Emission left the base colour multiplied')
 
 
 # The light of build_scene written by hand in glTF's Y-up frame, where Blender's (x, y, z) is
@@ -471,6 +486,25 @@ def main():
             if not r["bake"]["reused"]))
     check_equal_to_cli(manifest, os.path.join(WORK, "cli1"))
     step("bake again, nothing changed: every receiver reused, the chair's generated UVs too")
+
+    # The Emission display, which shadowbake would read as emissive meshes (lights) were the
+    # export to see it: a bake in that state must find the same one light and reuse everything.
+    bpy.context.scene.shadowbake.preview = "EMISSION"
+    if bpy.ops.shadowbake.load() != {"FINISHED"}:
+        fail("bpy.ops.shadowbake.load() failed")
+    for obj in (floor, chair, crate):
+        check_wired(obj, "EMISSION")
+    manifest = bake()
+    lights = [light["name"] for light in manifest["lights"]]
+    if lights != ["Panel"] or not all(r["bake"]["reused"] for r in manifest["receivers"]):
+        fail(f"with the Emission display the bake saw the lights {lights} and rebaked " +
+             ", ".join(r["name"] for r in manifest["receivers"] if not r["bake"]["reused"]))
+    bpy.context.scene.shadowbake.preview = "MULTIPLY"
+    if bpy.ops.shadowbake.load() != {"FINISHED"}:
+        fail("bpy.ops.shadowbake.load() failed")
+    for obj in (floor, chair, crate):
+        check_wired(obj, "MULTIPLY")
+    step("Emission display and back: the export sees no emitters, the bake reuses everything")
 
     chair.location.x += 0.3
     manifest = bake()
