@@ -14,6 +14,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <optional>
@@ -497,13 +498,19 @@ RectanglePacking pack(const std::vector<Chart>& charts, double scale, int margin
 }
 
 // The largest density (texels per metre) at which the charts fit side², to a part in 10⁴;
-// nothing when they do not fit even as points with their margins.
+// nothing when they do not fit even as points with their margins. A chart at any density above
+// 0 takes at least its texel and the one it is placed half a texel into (texel_rectangle), one
+// more per side than at 0, so the points are tested at the least density above 0: tested at 0,
+// charts that fit only there sent the search below every density, halving towards 0 for ever.
 std::optional<double> fill_side(const std::vector<Chart>& charts, int margin, int side) {
-  if (!pack(charts, 0.0, margin, side).all_packed()) return std::nullopt;
+  const double least = std::numeric_limits<double>::min();
+  if (!pack(charts, least, margin, side).all_packed()) return std::nullopt;
   double area = 0;
   for (const Chart& c : charts) area += c.size.x() * c.size.y();
-  double lo = 0, hi = double(side) / std::sqrt(std::max(area, 1e-300));
-  while (hi - lo > 1e-4 * hi) {
+  double lo = least, hi = double(side) / std::sqrt(std::max(area, 1e-300));
+  // From a fit at `least` the search narrows to 10⁻⁴ in at most about 1,100 halvings (the
+  // exponent range of a double); the bound keeps a bad chart size from looping.
+  for (int step = 0; step < 2048 && hi - lo > 1e-4 * hi; ++step) {
     const double mid = 0.5 * (lo + hi);
     (pack(charts, mid, margin, side).all_packed() ? lo : hi) = mid;
   }

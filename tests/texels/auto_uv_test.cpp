@@ -332,6 +332,43 @@ TEST(AutoUv, ChartsThatCannotFitTheSideAreAnError) {
       << made.error().message;
 }
 
+// Charts that fit the side only as texel-less points (at density 0 each takes 1 + margin texels a
+// side, at any density above 0 one more): an error, found at once, where the density's search
+// used to halve towards 0 for ever (a chair of six boxes at 32², found by the Blender add-on).
+TEST(AutoUv, ChartsThatFitOnlyAsTexellessPointsAreAnError) {
+  Mesh m;
+  m.name = "tiles";
+  std::vector<Vec2> unused;
+  // Six squares 1 m apart, each facing its own way, so that no two join into one chart: at
+  // margin 4 a 16² side holds nine 5 × 5 points but only four 6 × 6 ones.
+  const std::array<Vec3, 6> normals = {Vec3(0, 0, 1),  Vec3(0, 0, -1), Vec3(0, 1, 0),
+                                       Vec3(0, -1, 0), Vec3(1, 0, 0),  Vec3(-1, 0, 0)};
+  for (std::size_t k = 0; k < normals.size(); ++k) {
+    const Vec3 n = normals[k];
+    const Vec3 u = (std::abs(n.x()) < 0.5 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
+    const Vec3 v = n.cross(u);
+    const Vec3 c(3.0 * double(k), 0, 0);
+    std::array<TriMesh::VertexHandle, 4> corner;
+    for (int j = 0; j < 4; ++j) {
+      const Vec3 p = c + 0.1 * ((j & 1 ? 1.0 : -1.0) * u + (j & 2 ? 1.0 : -1.0) * v);
+      corner[std::size_t(j)] = m.mesh.add_vertex(TriMesh::Point(p.x(), p.y(), p.z()));
+      m.mesh.set_normal(corner[std::size_t(j)], TriMesh::Normal(n.x(), n.y(), n.z()));
+    }
+    add_triangle(m.mesh, corner[0], corner[1], corner[3], unused);
+    add_triangle(m.mesh, corner[0], corner[3], corner[2], unused);
+  }
+  m.mesh.update_face_normals();
+  Mesh larger = m;
+  auto made = generate_lightmap_uvs(m, side_target(16));
+  ASSERT_FALSE(made);
+  EXPECT_NE(made.error().message.find("do not fit a 16² lightmap"), std::string::npos)
+      << made.error().message;
+  // A 32² side holds them at a density above 0.
+  auto fits = generate_lightmap_uvs(larger, side_target(32));
+  ASSERT_TRUE(fits) << fits.error().message;
+  EXPECT_GT(fits->texels_per_metre, 0);
+}
+
 // A bake of scenes/seams with uv = "auto" on every receiver: generated, reported so, no UV
 // warning, and stitching still finds and closes the seams between its charts.
 TEST(AutoUv, BakeOfTheSeamsSceneWithGeneratedUvs) {
