@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -91,27 +92,27 @@ void append_u32(std::vector<std::uint8_t>& out, std::uint32_t value) {
   for (int i = 0; i < 4; ++i) out.push_back(std::uint8_t(value >> (8 * i)));
 }
 
-// glTF's frame from the scene's: Y up instead of Z up, a rotation about X by −90°.
-void push_y_up(std::vector<float>& out, double x, double y, double z) {
-  out.push_back(float(x));
-  out.push_back(float(z));
-  out.push_back(float(-y));
+// glTF's frame from the scene's: from Z up, a rotation about X by −90°; a Y-up world as it is.
+std::array<double, 3> to_gltf_frame(double x, double y, double z, bool world_y_up) {
+  return world_y_up ? std::array<double, 3>{x, y, z} : std::array<double, 3>{x, z, -y};
 }
 
 }  // namespace
 
-GltfMesh gltf_mesh(const Mesh& mesh, bool with_uvs) {
+GltfMesh gltf_mesh(const Mesh& mesh, bool with_uvs, bool world_y_up) {
   GltfMesh out;
   const TriMesh& m = mesh.mesh;
   const bool own_texture_uv = mesh.texture_uv.size() == m.n_vertices();
   for (auto v : m.vertices()) {
     const auto& p = m.point(v);
-    push_y_up(out.positions, p[0], p[1], p[2]);
+    const std::array<double, 3> position = to_gltf_frame(p[0], p[1], p[2], world_y_up);
+    for (const double c : position) out.positions.push_back(float(c));
     TriMesh::Normal n = m.normal(v);
     const double length = n.norm();
     n = length > 0 ? n / length : TriMesh::Normal(0, 0, 1);
+    const std::array<double, 3> normal = to_gltf_frame(n[0], n[1], n[2], world_y_up);
     // Unit in single precision, as the validator checks it.
-    const float nx = float(n[0]), ny = float(n[2]), nz = float(-n[1]);
+    const float nx = float(normal[0]), ny = float(normal[1]), nz = float(normal[2]);
     const float norm = std::sqrt(nx * nx + ny * ny + nz * nz);
     out.normals.insert(out.normals.end(), {nx / norm, ny / norm, nz / norm});
     if (!mesh.has_uv || !with_uvs) continue;

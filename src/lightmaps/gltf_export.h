@@ -19,8 +19,9 @@
 
 namespace sb {
 
-// A receiver's mesh as glTF stores it: world space in glTF's frame (Y up: scene (x, y, z) is glTF
-// (x, z, −y)), UVs with v down (glTF's convention: 1 − v of the OBJ/Blender one).
+// A receiver's mesh as glTF stores it: world space in glTF's frame (Y up: a scene file's Z-up
+// (x, y, z) is glTF (x, z, −y); a level's world is Y up already), UVs with v down (glTF's
+// convention: 1 − v of the OBJ/Blender one).
 struct GltfMesh {
   std::vector<float> positions;  // x, y, z per vertex
   std::vector<float> normals;    // unit, per vertex
@@ -28,8 +29,10 @@ struct GltfMesh {
   std::vector<float> texcoord1;  // the lightmap UVs; both empty for a mesh without UVs
   std::vector<std::uint32_t> indices;
 };
-// `with_uvs` false (a blocker's mesh): positions, normals and triangles only.
-GltfMesh gltf_mesh(const Mesh& mesh, bool with_uvs = true);
+// `with_uvs` false (a blocker's mesh): positions, normals and triangles only. `world_y_up`: the
+// scene's world is glTF's own frame (a level's, world_is_y_up in pipeline/receiver_stages.h),
+// taken as it is; else it is a scene file's Z up, turned to Y up.
+GltfMesh gltf_mesh(const Mesh& mesh, bool with_uvs = true, bool world_y_up = false);
 
 // One lightmap texture: PNG bytes (8-bit, linear values over its intensity).
 struct GltfTexture {

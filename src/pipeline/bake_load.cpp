@@ -62,7 +62,8 @@ Status load_scene_for(const Scene& scene, const MethodEntry& method, const BakeO
     for (std::size_t i = 0; i < all.size(); ++i)
       if (!scene.objects[i].receiver)
         result->gltf_blockers.emplace_back(
-            scene.objects[i].name, std::make_shared<const GltfMesh>(gltf_mesh(all[i], false)));
+            scene.objects[i].name,
+            std::make_shared<const GltfMesh>(gltf_mesh(all[i], false, world_is_y_up(scene))));
   }
 
   // What the method asks for, built once and shared by every receiver.

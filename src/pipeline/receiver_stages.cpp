@@ -117,6 +117,11 @@ Expected<std::vector<Mesh>> load_meshes(const Scene& scene, std::vector<std::str
   return meshes;
 }
 
+bool world_is_y_up(const Scene& scene) {
+  return std::any_of(scene.objects.begin(), scene.objects.end(),
+                     [](const ObjectDesc& o) { return o.node >= 0; });
+}
+
 std::vector<const Mesh*> blocker_meshes(const Scene& scene, const std::vector<Mesh>& meshes) {
   std::vector<const Mesh*> blockers;
   for (std::size_t i = 0; i < meshes.size(); ++i)
@@ -200,7 +205,8 @@ void finish_receiver(const Scene& scene, const Mesh& mesh, const TexelSpace& spa
   out.seconds_seams = seconds_since(seams_start);
   out.covered_texels = std::int64_t(space.texels.size());
   out.covered = space.covered;
-  if (scene.output.gltf) out.gltf_mesh = std::make_shared<const GltfMesh>(gltf_mesh(mesh));
+  if (scene.output.gltf)
+    out.gltf_mesh = std::make_shared<const GltfMesh>(gltf_mesh(mesh, true, world_is_y_up(scene)));
 }
 
 }  // namespace sb

@@ -22,6 +22,11 @@ namespace sb {
 // `warnings` is given). A receiver with uv = "auto" gets its lightmap UVs here.
 Expected<std::vector<Mesh>> load_meshes(const Scene& scene, std::vector<std::string>* warnings);
 
+// Whether the scene's world is Y up, glTF's frame: a level's world is its file's
+// (docs/scene-format.md), so a scene with an object of a level (ObjectDesc::node ≥ 0) is; a scene
+// file's own world is Z up.
+bool world_is_y_up(const Scene& scene);
+
 // The blockers' meshes, in scene order.
 std::vector<const Mesh*> blocker_meshes(const Scene& scene, const std::vector<Mesh>& meshes);
 

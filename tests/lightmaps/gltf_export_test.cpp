@@ -1,8 +1,9 @@
 // Tests of the glTF binary writer (src/lightmaps/gltf_export.h), read back byte by byte: the
-// header and chunks, positions turned Y up, lightmap UVs as TEXCOORD_1 with v flipped (which a
-// render cannot tell from the expected values, since both read the same UVs), texture UVs as
-// TEXCOORD_0, MOZ_lightmap with its atlas transform, and a blocker without UVs or lightmap.
-// tests/web/ checks the same files with the Khronos validator and in three.js.
+// header and chunks, positions turned Y up from a Z-up world and kept in a Y-up one, lightmap UVs
+// as TEXCOORD_1 with v flipped (which a render cannot tell from the expected values, since both
+// read the same UVs), texture UVs as TEXCOORD_0, MOZ_lightmap with its atlas transform, and a
+// blocker without UVs or lightmap. tests/web/ checks the same files with the Khronos validator and
+// in three.js.
 #include "lightmaps/gltf_export.h"
 
 #include <gtest/gtest.h>
@@ -118,6 +119,16 @@ TEST(GltfExport, ReceiverWithAtlasAndBlocker) {
   EXPECT_FALSE(torus["attributes"].contains("TEXCOORD_1"));
   EXPECT_FALSE(g["materials"][torus["material"].get<std::size_t>()].contains("extensions"));
   EXPECT_EQ(g["nodes"][1]["name"], "torus");
+}
+
+// A scene file's world is Z up and turned; a level's is glTF's own Y up and kept as it is.
+TEST(GltfExport, AZUpWorldIsTurnedAndAYUpWorldKept) {
+  const GltfMesh turned = gltf_mesh(triangle_mesh());
+  const GltfMesh kept = gltf_mesh(triangle_mesh(), true, true);
+  EXPECT_EQ(turned.positions, (std::vector<float>{0, 1, 0, 2, 1, 0, 0, 1, -3}));
+  EXPECT_EQ(turned.normals, (std::vector<float>{0, 1, 0, 0, 1, 0, 0, 1, 0}));
+  EXPECT_EQ(kept.positions, (std::vector<float>{0, 0, 1, 2, 0, 1, 0, 3, 1}));
+  EXPECT_EQ(kept.normals, (std::vector<float>{0, 0, 1, 0, 0, 1, 0, 0, 1}));
 }
 
 TEST(GltfExport, RefusesAReceiverWithoutLightmapUvs) {

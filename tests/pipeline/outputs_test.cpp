@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -17,6 +18,7 @@
 #include "pipeline/bake.h"
 #include "pipeline/manifest.h"
 #include "pipeline/outputs.h"
+#include "pipeline/receiver_stages.h"
 #include "scene/mesh.h"
 
 namespace sb {
@@ -229,6 +231,31 @@ TEST_F(Outputs, TwentySixReceiversPackIntoAtlasesNoFilterReadsAnother) {
                            double(std::abs(atlas.at(p.x + x, p.y + y)[c] - own_image.at(x, y)[c])));
     EXPECT_EQ(worst, 0.0) << obj.name;
     ++receiver;
+  }
+}
+
+// A level's world is Y up, glTF's frame (docs/scene-format.md), so its receivers go into the
+// glTF output where the level has them; a scene file's Z-up world is turned to Y up.
+TEST_F(Outputs, TheGltfOutputKeepsALevelsYUpWorld) {
+  for (const char* file : {"/scenes/level/scene.toml", "/scenes/showcase/scene.toml"}) {
+    Scene scene = load_scene(std::string(SB_SOURCE_DIR) + file).value();
+    const bool level = std::string(file).find("level") != std::string::npos;
+    scene.bake.resolution = 32;
+    scene.bake.samples = 1;
+    scene.output.gltf = true;
+    const auto meshes = load_meshes(scene, nullptr);
+    ASSERT_TRUE(meshes) << meshes.error().message;
+    const auto result = bake(scene, {});
+    ASSERT_TRUE(result) << result.error().message;
+    const ReceiverBake& r = result->receivers.at(0);
+    ASSERT_TRUE(r.gltf_mesh);
+    const Mesh& mesh = meshes->at(r.object);
+    const auto p = mesh.mesh.point(*mesh.mesh.vertices_begin());
+    const std::vector<float>& out = r.gltf_mesh->positions;
+    const std::array<double, 3> expected =
+        level ? std::array<double, 3>{p[0], p[1], p[2]} : std::array<double, 3>{p[0], p[2], -p[1]};
+    for (int k = 0; k < 3; ++k)
+      EXPECT_FLOAT_EQ(out[std::size_t(k)], float(expected[std::size_t(k)])) << file << " " << k;
   }
 }
 
