@@ -1,5 +1,6 @@
 """The add-on's interactive path, which background mode cannot run: the Bake button's modal
-operator (timer, status bar progress) to completion, then a second bake cancelled by Esc.
+operator (timer, status bar progress) to completion, Edit > Undo and Redo of a Load, then a second
+bake cancelled by Esc.
 Needs a display; with Xvfb and Mesa's software OpenGL:
 
     BLENDER_USER_SCRIPTS=/tmp/ui/scripts xvfb-run -a -s "-screen 0 1280x800x24" \
@@ -74,6 +75,45 @@ def setup():
     settings.use_world = False
 
 
+def floor_shows(mode):
+    """Whether the floor's material shows its lightmap as `mode` says (MULTIPLY: into the base
+    colour; EMISSION: as the surface)."""
+    nodes = bpy.data.objects["Floor"].material_slots[0].material.node_tree.nodes
+    socket = (nodes["Principled BSDF"].inputs["Base Color"] if mode == "MULTIPLY"
+              else nodes["Material Output"].inputs["Surface"])
+    return socket.is_linked and socket.links[0].from_node.name == "shadowbake_lightmap"
+
+
+def check_load_undo():
+    """Load is one step of Blender's undo: after a Load that switches the display to Emission,
+    Edit > Undo gives back the Multiply wiring, and Redo the Emission one."""
+    if not floor_shows("MULTIPLY"):
+        fail("after the modal bake the floor does not show its lightmap multiplied")
+    bpy.context.scene.shadowbake.preview = "EMISSION"
+    _, override = viewport_override()
+    with bpy.context.temp_override(**override):
+        # The step a user's last edit (here: the setting) leaves before the Load; then the Load
+        # as the button runs it, pushing its own step (a script's call pushes none by default).
+        bpy.ops.ed.undo_push(message="Emission display")
+        if bpy.ops.shadowbake.load("EXEC_DEFAULT", True) != {"FINISHED"}:
+            fail("bpy.ops.shadowbake.load() failed")
+        if not floor_shows("EMISSION"):
+            fail("Load with the Emission display left the floor multiplied")
+        if bpy.ops.ed.undo() != {"FINISHED"}:
+            fail("Edit > Undo after Load failed")
+        if not floor_shows("MULTIPLY") or floor_shows("EMISSION"):
+            fail("Edit > Undo after Load did not give back the Multiply wiring")
+        if bpy.ops.ed.redo() != {"FINISHED"}:
+            fail("Edit > Redo of Load failed")
+        if not floor_shows("EMISSION"):
+            fail("Edit > Redo did not bring back the Load's Emission wiring")
+        # Back to Multiply, as a later Load would.
+        bpy.context.scene.shadowbake.preview = "MULTIPLY"
+        if bpy.ops.shadowbake.load() != {"FINISHED"}:
+            fail("bpy.ops.shadowbake.load() failed")
+    print("modal_test: Load undone by Edit > Undo and redone by Redo", flush=True)
+
+
 def viewport_override():
     window = bpy.context.window_manager.windows[0]
     area = next(a for a in window.screen.areas if a.type == "VIEW_3D")
@@ -117,6 +157,7 @@ def advance():
             state["manifest"] = f.read()
         print(f"modal_test: the modal bake finished in {elapsed:.1f} s and loaded {images}",
               flush=True)
+        check_load_undo()
         # A slow bake (reference rays, many samples) to cancel with Esc.
         bpy.context.scene.shadowbake.method = "reference"
         bpy.context.scene.shadowbake.samples = 200000
