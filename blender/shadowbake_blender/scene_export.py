@@ -287,6 +287,13 @@ def write_scene(context, settings, folder):
     Raises ExportError for a scene shadowbake could not read back as its objects."""
     os.makedirs(folder, exist_ok=True)
     export = Export(folder)
+    # shadowbake reads lengths as metres; the glTF exporter and the lights here write Blender
+    # units as they are, so a Unit Scale other than 1 changes only the irradiance's scale (power
+    # over area), which the user should know.
+    unit_scale = context.scene.unit_settings.scale_length
+    if context.scene.unit_settings.system != "NONE" and abs(unit_scale - 1.0) > 1e-6:
+        export.warnings.append(f'Scene "{context.scene.name}": its Unit Scale is {unit_scale:g}; '
+                               "shadowbake bakes one Blender unit as one metre")
     meshes = exported_meshes(context)
     receivers = []
     try:
