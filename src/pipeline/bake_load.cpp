@@ -59,11 +59,12 @@ Status load_scene_for(const Scene& scene, const MethodEntry& method, const BakeO
   if (scene.output.atlas && !options.shard)
     result->atlas = pack_atlases(sides, *scene.output.atlas);
   if (scene.output.gltf && (!options.shard || options.shard->index == 0)) {
+    const bool y_up = world_is_y_up(scene);
     for (std::size_t i = 0; i < all.size(); ++i)
       if (!scene.objects[i].receiver)
         result->gltf_blockers.emplace_back(
             scene.objects[i].name,
-            std::make_shared<const GltfMesh>(gltf_mesh(all[i], false, world_is_y_up(scene))));
+            std::make_shared<const GltfMesh>(gltf_mesh(all[i], false, y_up)));
   }
 
   // What the method asks for, built once and shared by every receiver.

@@ -311,39 +311,32 @@ def exported_light_difference(by_hand):
     return worst
 
 
-def check_area_lights(manifest, light):
-    # The light as shadowbake reads it, number by number: within 1e-6 of the one written by hand
-    # (Blender's 32-bit floats are about 1e-8 from the decimals).
-    numbers = exported_light_difference(TURNED_BY_HAND)
-    step(f"the turned rectangle's numbers as exported against the same light by hand: max abs "
-         f"difference {numbers:.3g}")
+def check_against_hand(manifest, by_hand, what, bake_bound):
+    """The exported `what` against the same lights written by hand (`by_hand`): every number
+    within 1e-6 (Blender's 32-bit floats are about 1e-8 from the decimals), and its bake within
+    `bake_bound` at every texel."""
+    numbers = exported_light_difference(by_hand)
+    baked = hand_written_difference(manifest, by_hand, "hand_" + what.replace(" ", "_"))
+    step(f"the {what} as exported against the same by hand: numbers {numbers:.3g}, bake "
+         f"{baked:.3g} apart at most")
     if numbers > 1e-6:
-        fail(f"the exported area light's numbers are {numbers:.3g} from the hand-written ones "
-             "(> 1e-6)")
+        fail(f"the exported {what}'s numbers are {numbers:.3g} from the hand-written (> 1e-6)")
+    if baked > bake_bound:
+        fail(f"the exported {what} bakes {baked:.3g} away from the hand-written (> {bake_bound:g}):"
+             " its position, normal, up or size is exported wrong")
+
+
+def check_area_lights(manifest, light):
     # The turned light: its normal and up come from Blender's 32-bit sines and cosines of 32-bit
     # angles, 1e-8 from the decimals written by hand. Measured: one chair texel moves by 1.9e-5
     # at the default 32 light rows and by 3.6e-6 at 64, the same with 4096 samples and max_cell
     # = 1 (chair RMSE 6e-7; floor 6e-8 at most, crate 0): as a blocker edge that crosses a
     # row's line would, the backprojection's midpoint rule across rows (scene-format.md,
-    # `light_rows`). So this light is held to 1e-4, which a wrong axis, size or sign exceeds by
+    # `light_rows`). So its bake is held to 1e-4, which a wrong axis, size or sign exceeds by
     # far, and the lights below, whose every number Blender holds exactly, to 1e-6.
-    turned = hand_written_difference(manifest, TURNED_BY_HAND, "hand_turned")
-    step(f"the turned rectangle exported by the add-on against the same light by hand: max abs "
-         f"difference {turned:.3g}")
-    if turned > 1e-4:
-        fail(f"the turned area light bakes {turned:.3g} away from the hand-written one (> 1e-4): "
-             "its position, normal, up or size is exported wrong")
+    check_against_hand(manifest, TURNED_BY_HAND, "turned rectangle", 1e-4)
     make_lights_exact(light)
-    manifest = bake()
-    exact_numbers = exported_light_difference(EXACT_BY_HAND)
-    if exact_numbers > 1e-6:
-        fail(f"the exported area lights' numbers are {exact_numbers:.3g} from the hand-written "
-             "ones (> 1e-6)")
-    exact = hand_written_difference(manifest, EXACT_BY_HAND, "hand_exact")
-    step(f"a rectangle and a disk exported by the add-on against the same lights by hand: max abs "
-         f"difference {exact:.3g}")
-    if exact > 1e-6:
-        fail(f"the exported area lights bake {exact:.3g} away from the hand-written ones (> 1e-6)")
+    check_against_hand(bake(), EXACT_BY_HAND, "exact rectangle and disk", 1e-6)
 
 
 def render_picture(path, light):
