@@ -36,7 +36,11 @@ struct Mesh {
   // UVs, which a glTF of the bake carries beside the lightmap UVs); empty otherwise.
   std::vector<Vec2> texture_uv;
   int skipped_degenerate = 0;  // zero-area triangles dropped on import
-  bool uv_generated = false;   // the lightmap UVs were made by the bake (texels/auto_uv.h)
+  // Triangles OpenMesh would not link to their neighbours (a vertex or edge a 2-manifold cannot
+  // have: three faces on an edge, a vertex whose fan cannot be re-linked), kept on copies of
+  // their corners (add_triangle).
+  int split_nonmanifold = 0;
+  bool uv_generated = false;  // the lightmap UVs were made by the bake (texels/auto_uv.h)
 };
 
 // Loads every mesh of every node of obj.mesh (one object = the whole file), applies node
@@ -67,8 +71,10 @@ Expected<Mesh> build_object_mesh(const ObjectDesc& obj, const RawMeshFile& file,
 
 // Adds triangle (a, b, c) to mesh; a face OpenMesh refuses (it would make a vertex or an edge
 // non-manifold) is added on three fresh copies of its vertices, and of their texture UVs when
-// `texture_uv` holds them (mesh_import.cpp).
-void add_triangle(TriMesh& mesh, TriMesh::VertexHandle a, TriMesh::VertexHandle b,
+// `texture_uv` holds them (mesh_import.cpp). Returns false for such a face. OpenMesh's own
+// messages about it (its `omerr` stream, on standard error) are silenced: the count is the
+// caller's to report, naming the object.
+bool add_triangle(TriMesh& mesh, TriMesh::VertexHandle a, TriMesh::VertexHandle b,
                   TriMesh::VertexHandle c, std::vector<Vec2>& texture_uv);
 
 // A point's coordinates bit for bit, to match points that are the same exactly (the two sides of

@@ -30,6 +30,7 @@
 //   kilometres of the origin, only degenerate triangles, a receiver without its UV channel) is
 //   an Error, never a crash or an exception.
 #include <fmt/core.h>
+#include <OpenMesh/Core/System/omstream.hh>
 
 #include <algorithm>
 #include <cmath>
@@ -37,6 +38,7 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <iostream>
 #include <sstream>
 #include <string>
 #include <system_error>
@@ -123,10 +125,25 @@ std::string format_vec(const Vec3& v) {
 
 }  // namespace
 
-// OpenMesh's add_face refuses a face that would make a vertex or an edge non-manifold (and prints
-// why); the checks below are its own, done first to keep it quiet.
-void add_triangle(TriMesh& mesh, TriMesh::VertexHandle a, TriMesh::VertexHandle b,
+namespace {
+
+// OpenMesh prints why add_face refuses a face on its `omerr` stream, which goes to standard error
+// ("PolyMeshT::add_face: patch re-linking failed", once per face of a level's non-manifold
+// vertices): disconnected once, the first time a mesh is built, so that nothing but the bake's own
+// warnings reaches the terminal.
+void quiet_openmesh() {
+  static const bool quiet = [] { return omerr().disconnect(std::cerr); }();
+  (void)quiet;
+}
+
+}  // namespace
+
+// OpenMesh's add_face refuses a face that would make a vertex or an edge non-manifold; the checks
+// below are its own, done first, and a face that passes them may still be refused (a vertex whose
+// fan of faces cannot be re-linked).
+bool add_triangle(TriMesh& mesh, TriMesh::VertexHandle a, TriMesh::VertexHandle b,
                   TriMesh::VertexHandle c, std::vector<Vec2>& texture_uv) {
+  quiet_openmesh();
   const TriMesh::VertexHandle corners[3] = {a, b, c};
   bool manifold = true;
   for (int i = 0; i < 3 && manifold; ++i) {
@@ -136,7 +153,7 @@ void add_triangle(TriMesh& mesh, TriMesh::VertexHandle a, TriMesh::VertexHandle 
     const auto he = mesh.find_halfedge(from, to);
     if (he.is_valid() && !mesh.is_boundary(he)) manifold = false;
   }
-  if (manifold && mesh.add_face(a, b, c).is_valid()) return;
+  if (manifold && mesh.add_face(a, b, c).is_valid()) return true;
 
   TriMesh::VertexHandle copies[3];
   for (int i = 0; i < 3; ++i) {
@@ -151,6 +168,7 @@ void add_triangle(TriMesh& mesh, TriMesh::VertexHandle a, TriMesh::VertexHandle 
     if (!texture_uv.empty()) texture_uv.push_back(texture_uv[std::size_t(corners[i].idx())]);
   }
   mesh.add_face(copies[0], copies[1], copies[2]);
+  return false;
 }
 
 namespace {
@@ -348,7 +366,9 @@ Expected<Mesh> build_mesh(const RawMeshFile& file, const std::vector<PartInstanc
         ++result.skipped_degenerate;
         continue;
       }
-      add_triangle(mesh, vertex(index[0]), vertex(index[1]), vertex(index[2]), result.texture_uv);
+      if (!add_triangle(mesh, vertex(index[0]), vertex(index[1]), vertex(index[2]),
+                        result.texture_uv))
+        ++result.split_nonmanifold;
     }
   }
   if (mesh.n_faces() == 0) {

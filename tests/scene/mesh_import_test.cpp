@@ -2,6 +2,8 @@
 // node transforms, normals, UV channels, and reading while other threads allocate.
 #include <gtest/gtest.h>
 
+#include <OpenMesh/Core/System/omstream.hh>
+
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
@@ -267,3 +269,28 @@ TEST_F(MeshImport, MirroringNodeTransformKeepsFaceAndVertexNormalsAgreeing) {
 
 }  // namespace
 }  // namespace sb::mesh_import_test
+
+namespace sb {
+namespace {
+
+// A triangle OpenMesh refuses (a third face on an edge) is kept on copies of its corners and
+// counted; OpenMesh's own stream, which would print why on standard error, prints nothing.
+TEST(AddTriangle, ARefusedFaceIsKeptCountedAndUnprinted) {
+  TriMesh mesh;
+  std::vector<TriMesh::VertexHandle> v;
+  for (const auto& p : {TriMesh::Point(0, 0, 0), TriMesh::Point(1, 0, 0), TriMesh::Point(0, 1, 0),
+                        TriMesh::Point(0, -1, 0), TriMesh::Point(0, 0, 1)})
+    v.push_back(mesh.add_vertex(p));
+  std::vector<Vec2> no_uv;
+  EXPECT_TRUE(add_triangle(mesh, v[0], v[1], v[2], no_uv));
+  EXPECT_TRUE(add_triangle(mesh, v[1], v[0], v[3], no_uv));
+  EXPECT_FALSE(add_triangle(mesh, v[0], v[1], v[4], no_uv));  // the edge's third face
+  EXPECT_EQ(mesh.n_faces(), 3u);
+  EXPECT_EQ(mesh.n_vertices(), 8u);
+  testing::internal::CaptureStderr();
+  omerr() << "PolyMeshT::add_face: patch re-linking failed" << std::endl;
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
+}
+
+}  // namespace
+}  // namespace sb
