@@ -84,6 +84,7 @@ struct BakeArgs {
   std::optional<int> resolution, samples;
   std::optional<double> texels_per_metre;
   std::optional<double> ao_distance;
+  std::optional<double> irradiance_floor;
   std::optional<std::string> encoding;
   std::optional<int> atlas_size, atlas_padding;
   bool per_light = false, shadowmask = false, gltf = false, no_atlas = false;
@@ -166,6 +167,7 @@ int bake_scene(const BakeArgs& args, const std::string& scene_file, const std::s
       return fail(paired.error());
   }
   if (args.ao_distance) settings.ao_distance = *args.ao_distance;
+  if (args.irradiance_floor) settings.irradiance_floor = *args.irradiance_floor;
   if (args.resolution) {
     settings.resolution = *args.resolution;
     settings.texels_per_metre = 0;
@@ -389,6 +391,7 @@ Runner add_bake_command(CLI::App& app) {
     std::int64_t seed = 0;
     double error_texels = 1;
     double ao_distance = 10;
+    double irradiance_floor = 0;
     std::string max_memory;
     double texels_per_metre = 0;
     std::string encoding, shard, balance, preset, shard_tiles;
@@ -424,6 +427,11 @@ Runner add_bake_command(CLI::App& app) {
                        "ambient occlusion: metres within which a blocker occludes (overrides "
                        "[bake] ao_distance)")
           ->check(CLI::Range(1e-6, 1e6));
+  auto* floor_opt =
+      bake->add_option("--irradiance-floor", o->irradiance_floor,
+                       "W/m²: a light without a range reaches as far as its irradiance stays "
+                       "above this (overrides [bake] irradiance_floor; 0: everywhere)")
+          ->check(CLI::Range(0.0, 1e9));
   auto* resolution_opt = bake->add_option("--resolution", o->resolution, "texels per side")
                              ->check(CLI::Range(1, 16384));
   auto* density_opt =
@@ -517,6 +525,7 @@ Runner add_bake_command(CLI::App& app) {
     if (*method_opt) o->args.method = o->method;
     if (*quantity_opt) o->args.quantity = o->quantity;
     if (*ao_distance_opt) o->args.ao_distance = o->ao_distance;
+    if (*floor_opt) o->args.irradiance_floor = o->irradiance_floor;
     if (*resolution_opt) o->args.resolution = o->resolution;
     if (*density_opt) o->args.texels_per_metre = o->texels_per_metre;
     if (!o->shard.empty()) o->args.shard = o->shard;

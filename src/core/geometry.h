@@ -33,6 +33,9 @@ struct Bounds3 {
     return Vec3((k & 1 ? hi : lo).x(), (k & 2 ? hi : lo).y(), (k & 4 ? hi : lo).z());
   }
   double diagonal() const { return empty() ? 0.0 : (hi - lo).norm(); }
+  bool contains(const Vec3& p) const {
+    return (p.array() >= lo.array()).all() && (p.array() <= hi.array()).all();
+  }
 };
 
 }  // namespace sb

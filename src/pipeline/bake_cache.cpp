@@ -94,24 +94,6 @@ Expected<std::string> file_hash(const fs::path& path) {
   return h.hex();
 }
 
-// Whether light may reach a point of box: a one-sided planar light cannot reach what lies
-// wholly behind its plane; any other light may.
-bool may_reach(const Light& light, const Bounds3& box) {
-  switch (light.shape()) {
-    case LightShape::rectangle:
-    case LightShape::disk:
-    case LightShape::polygon:
-      break;
-    default:
-      return true;
-  }
-  for (int c = 0; c < 8; ++c) {
-    const Vec3 p = box.corner(c);
-    if (light.normal().dot(p - light.centre()) > 0) return true;
-  }
-  return false;
-}
-
 Bounds3 mesh_bounds(const Mesh& m) {
   Bounds3 box;
   for (const auto v : m.mesh.vertices()) {
@@ -178,6 +160,7 @@ Expected<std::vector<ReceiverKey>> receiver_keys(const KeyInputs& in,
     h.number(d.width), h.number(d.height), h.number(d.radius);
     h.vec(d.color), h.number(d.power);
     h.number(d.shadowmask_range);
+    h.number(d.range);
     h.vec(d.spot_axis), h.number(d.spot_inner), h.number(d.spot_outer);
     h.number(d.sun_angle_deg);
     h.number(double(d.corners.size()));
@@ -248,7 +231,7 @@ Expected<std::vector<ReceiverKey>> receiver_keys(const KeyInputs& in,
     if (!ambient_occlusion) {
       std::vector<std::uint32_t> candidates;
       for (std::size_t l = 0; l < lights.size(); ++l) {
-        if (!may_reach(lights[l], box)) continue;
+        if (!lights[l].may_reach(box)) continue;
         lights_hash.text(light_hashes[l]);
         if (reaching) (*reaching)[r].push_back(lights[l].output());
         if (!local) continue;

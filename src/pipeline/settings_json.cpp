@@ -63,6 +63,7 @@ json settings_to_json(const BakeSettings& b, const OutputSettings& o) {
                {"quantity", to_string(b.quantity)},
                {"samples", b.samples},
                {"ao_distance", b.ao_distance},
+               {"irradiance_floor", b.irradiance_floor},
                {"margin", b.margin},
                {"seams", b.seams},
                {"seed", b.seed}};
@@ -94,6 +95,7 @@ Status settings_from_json(const json& j, const std::string& where, BakeSettings&
   r.read_enum("quantity", b.quantity,
               {Quantity::visibility, Quantity::irradiance, Quantity::ambient_occlusion});
   r.read("ao_distance", b.ao_distance);
+  r.read("irradiance_floor", b.irradiance_floor);
   r.read("samples", b.samples);
   r.read("margin", b.margin);
   r.read("seams", b.seams);

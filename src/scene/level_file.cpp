@@ -76,6 +76,39 @@ std::vector<double> emissive_strengths(const nlohmann::json& gltf, std::size_t c
   return strength;
 }
 
+// Per node name, the `range` of the KHR_lights_punctual light the node holds, where it gives one
+// (metres in the file's frame). Assimp 5.2 keeps it only as a node's metadata, so it is read
+// here from the document, as the emissive strengths are. A range that is not a number is kept as
+// NaN, for the light's reader to refuse.
+std::map<std::string, double> gltf_light_ranges(const nlohmann::json& gltf) {
+  std::map<std::string, double> ranges;
+  if (!gltf.is_object() || !gltf.contains("nodes") || !gltf["nodes"].is_array()) return ranges;
+  const nlohmann::json* lights = nullptr;
+  if (gltf.contains("extensions") && gltf["extensions"].is_object()) {
+    const auto& ext = gltf["extensions"];
+    if (ext.contains("KHR_lights_punctual") && ext["KHR_lights_punctual"].is_object() &&
+        ext["KHR_lights_punctual"].contains("lights") &&
+        ext["KHR_lights_punctual"]["lights"].is_array())
+      lights = &ext["KHR_lights_punctual"]["lights"];
+  }
+  if (!lights) return ranges;
+  for (const auto& node : gltf["nodes"]) {
+    if (!node.is_object() || !node.contains("name") || !node["name"].is_string() ||
+        !node.contains("extensions") || !node["extensions"].is_object())
+      continue;
+    const auto& ext = node["extensions"];
+    if (!ext.contains("KHR_lights_punctual") || !ext["KHR_lights_punctual"].is_object()) continue;
+    const auto& index = ext["KHR_lights_punctual"]["light"];
+    if (!index.is_number_unsigned() || index.get<std::size_t>() >= lights->size()) continue;
+    const auto& light = (*lights)[index.get<std::size_t>()];
+    if (!light.is_object() || !light.contains("range")) continue;
+    ranges[node["name"].get<std::string>()] = light["range"].is_number()
+                                                  ? light["range"].get<double>()
+                                                  : std::numeric_limits<double>::quiet_NaN();
+  }
+  return ranges;
+}
+
 // A node's name as an object or light name: characters a file name cannot hold become '_'.
 std::string safe_name(const std::string& name) {
   std::string out;
@@ -232,6 +265,7 @@ Expected<LevelContents> import_level(const fs::path& file, const Affine3& placem
   const std::vector<Affine3> world = node_world_transforms(*raw);
   const nlohmann::json gltf = gltf_document(file);
   const std::vector<double> strength = emissive_strengths(gltf, raw->materials.size());
+  const std::map<std::string, double> ranges = gltf_light_ranges(gltf);
   const auto fail = [&](const std::string& node, const std::string& problem) {
     return scene_error(fmt::format("{}: node '{}': {}", where, node, problem));
   };
@@ -408,6 +442,18 @@ Expected<LevelContents> import_level(const fs::path& file, const Affine3& placem
     light.power = gltf.is_object() ? 4 * std::numbers::pi * color.maxCoeff() / kLumensPerWatt
                                    : color.maxCoeff();
     light.line = line;
+    if (const auto range = ranges.find(raw_light.name); range != ranges.end()) {
+      // glTF's "range": metres in the file's frame, scaled as the placement scales the level
+      // (its largest axis scale, so that a light reaches at least as far as the file says).
+      const double scale = transform.linear().colwise().norm().maxCoeff();
+      if (!std::isfinite(range->second) || !(range->second > 0))
+        return fail(raw_light.name,
+                    fmt::format("the light's KHR_lights_punctual range is {}; it must be a "
+                                "finite number > 0 (metres), or left out to reach everywhere",
+                                range->second));
+      light.range = range->second * scale;
+      light.shadowmask_range = light.range;
+    }
     level.lights.push_back(std::move(light));
   }
   return level;

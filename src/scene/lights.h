@@ -112,7 +112,7 @@ class Light {
   // uses its mean exitance: exact for a uniform texture, the far-field value otherwise.
   Vec3 unoccluded_irradiance(const Vec3& y, const Vec3& n) const;
   // Whether any of the light lies above the horizon of (y, n) and faces y, i.e. F > 0, and y is
-  // inside a spot's cone; much cheaper than F itself.
+  // inside a spot's cone and the light's range; much cheaper than F itself.
   bool reaches(const Vec3& y, const Vec3& n) const;
   // True only where reaches(y, n) holds at every point y of the box: a rectangle's, disk's or
   // polygon's conditions are linear in y, so they hold inside if they hold at its corners (with
@@ -126,6 +126,18 @@ class Light {
   // to y. 1 everywhere for a light that is not a spot. It scales the light's irradiance, not
   // its visibility: every method reads it through unoccluded_irradiance and reaches.
   double spot_factor(const Vec3& y) const;
+  // The light's reach at y (LightDesc::range): KHR_lights_punctual's recommended window,
+  // clamp(1 − (d/range)⁴, 0, 1) with d the distance from the centre (its 1/d² is the form
+  // factor's own), 0 at and beyond the range, 1 everywhere for a light without one. Like the
+  // spot's cone it scales the light's irradiance, not its visibility (every method reads it
+  // through unoccluded_irradiance and reaches).
+  double range_factor(const Vec3& y) const;
+  // Whether the light may reach some point of the box `ys` (some normal): inside its range, in
+  // front of a flat light, within a spot's cone. Conservative: false only where no point of the
+  // box is reached; what methods and the light lists (methods/light_lists.h) cull by.
+  bool may_reach(const Bounds3& ys) const;
+  // The same for a box of points that all have the unit normal n.
+  bool may_reach(const Bounds3& ys, const Vec3& n) const;
 
   // Maps a stratified point u ∈ [0,1)² to a light sample as seen from y with normal n.
   // Rectangle and disk: uniform in area, weight cosθ_light · cosθ_receiver / r².
@@ -170,6 +182,13 @@ std::size_t output_count(const std::vector<Light>& lights);
 // named "<name>#<k>", each with its share of the power by area. Degenerate triangles are left
 // out.
 std::vector<LightDesc> mesh_light_parts(const LightDesc& mesh);
+
+// The distance from a light's centre at which its irradiance on a surface facing it falls to
+// `floor` W/m² (BakeSettings::irradiance_floor), in its brightest channel: a sphere's (a point's,
+// a spot's) P/(4π d²), a rectangle's or disk's P/(π d²) along its axis (its far field, never
+// below its near one). Infinite for a sun, a sky or a mesh light, which reach everywhere, and
+// for a floor of 0.
+double range_for_floor(const LightDesc& light, double floor);
 
 // Lambert's formula for the form factor of a planar polygon (vertices relative to the point,
 // either winding) seen from a point with unit normal n, after clipping the polygon to the

@@ -69,6 +69,11 @@ struct BakeSettings {
   int samples = 256;  // light samples per texel, for sampling methods (rays, for ambient occlusion)
   // ambient occlusion: metres along a ray within which a blocker occludes it (Blender's default)
   double ao_distance = 10.0;
+  // W/m²; > 0: each point, spot, sphere, rectangle and disk light without a `range` is given
+  // the range at which its irradiance on a surface facing it falls to this floor (a file whose
+  // lights carry none, such as Blender's exports; receiver_stages.h, placed_lights). 0: such
+  // lights reach everywhere.
+  double irradiance_floor = 0;
   int margin = 4;  // texels of dilation around UV charts
   // After dilation, adjust the texels along UV seams so that bilinear lookups on the two sides
   // agree (texels/seams.h); false leaves them as baked, and only measures the seams.
@@ -147,9 +152,14 @@ struct LightDesc {
   Vec3 color = Vec3(1, 1, 1);     // per-channel scale of the emitted power
   double power = 0;               // watts (for colour (1,1,1) and a white texture)
   std::filesystem::path texture;  // emission image over a rectangle or disk, a sky's map; resolved
-  // The shadow mask's reach (metres from the light's surface): beyond it the light's channel may
-  // be given to another light (lightmaps/shadowmask.h). Infinite: wherever the light reaches.
-  // The bake itself does not cut the light off.
+  // The light's reach, metres from its centre (KHR_lights_punctual's `range`): inside it the
+  // light's irradiance is windowed by clamp(1 − (d/range)⁴, 0, 1), glTF's recommended falloff
+  // (Light::range_factor); at and beyond it the light adds nothing, and no method spends work on
+  // it there. Infinite: it reaches everywhere (suns, skies and mesh lights always do).
+  double range = std::numeric_limits<double>::infinity();
+  // The shadow mask's reach (metres from the light's centre): beyond it the light's channel may
+  // be given to another light (lightmaps/shadowmask.h). The scene reader sets it to `range`
+  // where it is not given; infinite: wherever the light reaches.
   double shadowmask_range = std::numeric_limits<double>::infinity();
   // A spot (a sphere light imported from a level's spot light): the unit axis it shines along and
   // its cone's inner and outer half-angles, radians; spot_outer 0: no cone. Its unoccluded

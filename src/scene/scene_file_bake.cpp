@@ -10,9 +10,10 @@ namespace sb {
 Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::table& table) {
   TableReader r(file, table, "[bake]");
   // Every bake's keys, then each method's own (SettingSpec, from the registry).
-  std::vector<std::string_view> known = {"resolution", "texels_per_metre", "method", "quantity",
-                                         "samples",    "ao_distance",      "margin", "seams",
-                                         "seed",       "max_memory"};
+  std::vector<std::string_view> known = {
+      "resolution", "texels_per_metre", "method",          "quantity",
+      "samples",    "ao_distance",      "margin",          "seams",
+      "seed",       "max_memory",       "irradiance_floor"};
   for (const SettingSpec& spec : method_setting_specs()) known.push_back(spec.key);
   r.check_known_keys(known);
   BakeSettings bake;
@@ -50,6 +51,9 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
                         [](double x) { return std::isfinite(x) && x > 0 && x <= 1e6; })) {
     bake.ao_distance = *v;
   }
+  if (auto v = r.number("irradiance_floor", "a number >= 0 (W/m²; 0: lights reach everywhere)",
+                        [](double x) { return std::isfinite(x) && x >= 0 && x <= 1e9; }))
+    bake.irradiance_floor = *v;
   if (auto v = r.integer("samples", 1, int_max)) bake.samples = static_cast<int>(*v);
   if (auto v = r.integer("margin", 0, int_max)) bake.margin = static_cast<int>(*v);
   if (auto v = r.boolean("seams")) bake.seams = *v;

@@ -78,7 +78,7 @@ Status override_lights(const std::filesystem::path& file, const toml::table& tab
                        const std::filesystem::path& level, std::vector<LightDesc>& lights) {
   TableReader r(file, table, "[[import.light]]");
   r.check_known_keys(
-      {"name", "enabled", "radius", "angle_deg", "power", "color", "shadowmask_range"});
+      {"name", "enabled", "radius", "angle_deg", "power", "color", "shadowmask_range", "range"});
   const std::vector<LightDesc*> targets = matching(r, lights, "light", level);
   const auto enabled = r.boolean("enabled");
   const auto radius = r.number("radius", "a number >= 0 (metres; 0: a point light, for spheres)",
@@ -87,7 +87,8 @@ Status override_lights(const std::filesystem::path& file, const toml::table& tab
   const auto color = r.vec3("color", "3 finite numbers >= 0, not all zero",
                             [](double x) { return std::isfinite(x) && x >= 0; });
   if (color && color->isZero(0)) r.fail_got("color", "3 finite numbers >= 0, not all zero");
-  const auto range = r.number("shadowmask_range", "a number > 0 (metres)", is_positive);
+  const auto mask_range = r.number("shadowmask_range", "a number > 0 (metres)", is_positive);
+  const auto range = r.number("range", "a finite number > 0 (metres from its centre)", is_positive);
   const auto angle = r.number("angle_deg", "a number of degrees in (0, 10]",
                               [](double x) { return std::isfinite(x) && x > 0 && x <= 10; });
   for (const LightDesc* light : targets) {
@@ -99,6 +100,10 @@ Status override_lights(const std::filesystem::path& file, const toml::table& tab
              fmt::format("'angle_deg' applies to suns, and '{}' is not one", light->name));
     if (radius && *radius == 0 && light->shape == LightShape::disk)
       r.fail("radius", fmt::format("'{}' is a disk: its radius must be > 0", light->name));
+    if (range && (sun || light->shape == LightShape::mesh || light->shape == LightShape::sky))
+      r.fail("range", fmt::format("'{}' is a {}, which reaches everywhere: 'range' applies to "
+                                  "point, spot, sphere, rectangle and disk lights",
+                                  light->name, sun ? "sun" : to_string(light->shape)));
     if (radius && light->shape != LightShape::sphere && light->shape != LightShape::disk)
       r.fail("radius", fmt::format("'radius' applies to sphere and disk lights, and '{}' is a "
                                    "{}",
@@ -114,7 +119,12 @@ Status override_lights(const std::filesystem::path& file, const toml::table& tab
     if (angle) set_sun_angle(*light, *angle);
     if (power) light->power = *power;
     if (color) light->color = *color;
-    if (range) light->shadowmask_range = *range;
+    if (range) {
+      // The mask's reach follows the light's where the file gave it none of its own.
+      if (light->shadowmask_range == light->range) light->shadowmask_range = *range;
+      light->range = *range;
+    }
+    if (mask_range) light->shadowmask_range = *mask_range;
     light->line = int(r.line());
     if (enabled && !*enabled) light->name.clear();  // removed below
   }

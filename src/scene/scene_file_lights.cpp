@@ -47,12 +47,12 @@ void read_cone(TableReader& r, LightDesc& light) {
 // A sun: `direction` (where its light goes), `angle_deg` and `irradiance` on a surface facing
 // it, made a distant disk by sun_light (sun_light.h), placed for the scene by the bake.
 Expected<LightDesc> read_sun(TableReader& r, LightDesc light) {
-  for (const char* key :
-       {"position", "normal", "up", "size", "radius", "power", "texture", "cone_deg", "blend",
-        "strength", "map", "rotation_deg", "parts", "model", "turbidity", "sun", "sun_direction"})
+  for (const char* key : {"position", "normal", "up", "size", "radius", "power", "texture",
+                          "cone_deg", "blend", "strength", "map", "rotation_deg", "parts", "model",
+                          "turbidity", "sun", "sun_direction", "range"})
     r.forbid(key,
              "does not apply to a sun, which is given by 'direction', 'angle_deg' and "
-             "'irradiance'");
+             "'irradiance' (and reaches everywhere)");
   Vec3 direction = Vec3(0, 0, -1);
   if (r.require("direction")) {
     if (auto v = r.vec3("direction", "3 finite numbers, not all zero", is_finite)) {
@@ -127,10 +127,10 @@ void read_sky_model(TableReader& r, LightDesc& light) {
 // (scene/sky.h); placed around the scene by the bake.
 Expected<LightDesc> read_sky(TableReader& r, const std::filesystem::path& file, LightDesc light) {
   for (const char* key : {"position", "normal", "size", "radius", "power", "texture", "direction",
-                          "angle_deg", "irradiance", "cone_deg", "blend"})
+                          "angle_deg", "irradiance", "cone_deg", "blend", "range"})
     r.forbid(key,
              "does not apply to a sky, which is given by 'color', 'strength', 'map' or "
-             "'model', 'rotation_deg', 'up' and 'parts'");
+             "'model', 'rotation_deg', 'up' and 'parts' (and reaches everywhere)");
   light.shape = LightShape::sky;
   light.up = Vec3::UnitZ();  // a scene file's zenith; a glTF level's is +Y
   if (auto v = r.vec3("up", "3 finite numbers, not all zero", is_finite)) {
@@ -222,6 +222,7 @@ Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::ta
                       "power",
                       "texture",
                       "shadowmask_range",
+                      "range",
                       "direction",
                       "angle_deg",
                       "irradiance",
@@ -368,6 +369,10 @@ Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::ta
     r.forbid("texture", "applies only to rectangle and disk lights, not sphere");
   } else if (r.find("texture")) {
     if (auto texture = existing_file(r, file, "texture", "texture image")) light.texture = *texture;
+  }
+  if (auto v = r.number("range", "a finite number > 0 (metres from its centre)", is_positive)) {
+    light.range = *v;
+    light.shadowmask_range = *v;
   }
   if (auto v = r.number("shadowmask_range", "a number > 0 (metres)", is_positive))
     light.shadowmask_range = *v;

@@ -303,9 +303,10 @@ class HandWrittenLevel : public ::testing::Test {
 
   // A glTF of `nodes`, the quad as mesh 0 with material 0 of the given emissive factor (and
   // strength, when not 1), and the scene's root nodes.
+  // `lights`, when given, is KHR_lights_punctual's array of lights, which nodes name by index.
   fs::path write(const nlohmann::json& nodes, const std::vector<int>& roots,
                  const std::vector<double>& emissive = {0, 0, 0}, double strength = 1,
-                 double quad_size = 1) {
+                 double quad_size = 1, const nlohmann::json& lights = nullptr) {
     const float h = float(quad_size / 2);
     const float positions[] = {-h, -h, 0, h, -h, 0, h, h, 0, -h, h, 0};
     const float normals[] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
@@ -355,6 +356,10 @@ class HandWrittenLevel : public ::testing::Test {
         nlohmann::json::array({position, accessor(1, 5126, 4, "VEC3"), accessor(2, 5126, 4, "VEC2"),
                                accessor(3, 5123, 6, "SCALAR")});
     if (strength != 1) gltf["extensionsUsed"] = {"KHR_materials_emissive_strength"};
+    if (!lights.is_null()) {
+      gltf["extensions"]["KHR_lights_punctual"]["lights"] = lights;
+      gltf["extensionsUsed"] = {"KHR_lights_punctual"};
+    }
     const fs::path file = dir_ / "level.gltf";
     std::ofstream(file) << gltf.dump(1);
     return file;
@@ -700,6 +705,47 @@ TEST(SunLight, LevelBakesAsTheReferenceDoes) {
     ASSERT_GT(count, 0) << a.name;
     EXPECT_LT(std::sqrt(sum / double(count)), 0.01) << a.name;
   }
+}
+
+}  // namespace
+}  // namespace sb
+
+namespace sb {
+namespace {
+
+// KHR_lights_punctual's `range` (which Assimp 5.2 does not carry) is each light's reach, scaled
+// with the level; a light without one reaches everywhere; a range that is not a number > 0 is an
+// error naming the light's node.
+TEST_F(HandWrittenLevel, PunctualLightsKeepTheirRange) {
+  const nlohmann::json lights = {{{"type", "point"}, {"intensity", 20}, {"range", 4.5}},
+                                 {{"type", "point"}, {"intensity", 20}},
+                                 {{"type", "point"}, {"intensity", 20}, {"range", -1}}};
+  const auto node = [](const char* name, int light, double z) {
+    return nlohmann::json{{"name", name},
+                          {"translation", {0, 0, z}},
+                          {"extensions", {{"KHR_lights_punctual", {{"light", light}}}}}};
+  };
+  const nlohmann::json nodes = {
+      {{"name", "floor"}, {"mesh", 0}}, node("near", 0, 1), node("far", 1, 2)};
+  auto level = import_level(write(nodes, {0, 1, 2}, {0, 0, 0}, 1, 1, lights),
+                            object_transform(Vec3::Zero(), Vec3::Zero(), Vec3::Constant(2)), 0);
+  ASSERT_TRUE(level) << level.error().message;
+  ASSERT_EQ(level->lights.size(), 2u);
+  for (const LightDesc& light : level->lights) {
+    if (light.name == "near") {
+      EXPECT_DOUBLE_EQ(light.range, 9.0);  // 4.5 m of the file, the level scaled by 2
+      EXPECT_DOUBLE_EQ(light.shadowmask_range, 9.0);
+    } else {
+      EXPECT_TRUE(std::isinf(light.range)) << light.name;
+    }
+  }
+  const nlohmann::json bad = {{{"name", "floor"}, {"mesh", 0}}, node("broken", 2, 1)};
+  auto refused = import_level(write(bad, {0, 1}, {0, 0, 0}, 1, 1, lights), Affine3::Identity(), 0);
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().message.find("node 'broken': the light's KHR_lights_punctual range"),
+            std::string::npos)
+      << refused.error().message;
+  EXPECT_EQ(refused.error().message.find('\n'), std::string::npos);
 }
 
 }  // namespace

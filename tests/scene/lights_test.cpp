@@ -388,3 +388,107 @@ TEST(SpotLight, ConeScalesTheIrradianceAsKhrLightsPunctualSays) {
 }
 
 }  // namespace sb
+
+namespace sb {
+namespace {
+
+// A light's `range` as glTF viewers apply it (KHR_lights_punctual's recommended falloff, as
+// Khronos's sample viewer computes it): the irradiance inside times clamp(1 − (d/range)⁴, 0, 1),
+// none at and beyond the range; the visibility and the form factor are not scaled.
+TEST(LightRange, WindowsTheIrradianceAsGltfViewersDo) {
+  LightDesc bulb = sphere(0.05);
+  bulb.position = Vec3(0, 0, 2);
+  LightDesc ranged = bulb;
+  ranged.range = 6;
+  const Light a(ranged), b(bulb);
+  const Vec3 up(0, 0, 1);
+  for (double x : {0.0, 1.0, 3.0, 5.0, 5.6, 5.65, 5.66, 7.0}) {
+    const Vec3 y(x, 0, 0);
+    const double d = (y - bulb.position).norm();
+    const double window = std::clamp(1 - std::pow(d / 6, 4), 0.0, 1.0);
+    EXPECT_NEAR(a.range_factor(y), window, 1e-12) << x;
+    EXPECT_NEAR(a.unoccluded_irradiance(y, up).x(), window * b.unoccluded_irradiance(y, up).x(),
+                1e-15)
+        << x;
+    EXPECT_EQ(a.reaches(y, up), window > 0 && b.reaches(y, up)) << x;
+    EXPECT_EQ(a.form_factor(y, up), b.form_factor(y, up)) << x;
+  }
+  EXPECT_EQ(b.range_factor(Vec3(1e6, 0, 0)), 1.0);  // no range: everywhere
+}
+
+// may_reach, which the light lists cull by, is false only where no point of the box is reached:
+// checked against reaches at a grid of points and normals in random boxes, for each shape, with
+// and without a range and a spot's cone.
+TEST(LightRange, MayReachHoldsWhereverSomePointIsReached) {
+  std::vector<LightDesc> lights = {rectangle(0.6, 0.4), tilted_disk(0.3), sphere(0.2), triangle()};
+  LightDesc spot = sphere(0.05);
+  spot.spot_axis = Vec3(0.3, 0, -1).normalized();
+  spot.spot_inner = 0.2, spot.spot_outer = 0.4;
+  lights.push_back(spot);
+  const std::size_t shapes = lights.size();
+  for (std::size_t k = 0; k < shapes; ++k) {
+    LightDesc ranged = lights[k];
+    ranged.range = 1.5;
+    lights.push_back(ranged);
+  }
+  Rng rng(11);
+  int culled = 0;
+  for (const LightDesc& desc : lights) {
+    const Light light(desc);
+    for (int box_index = 0; box_index < 300; ++box_index) {
+      const Vec3 centre(4 * rng.next_double() - 2, 4 * rng.next_double() - 2,
+                        3 * rng.next_double() - 1);
+      const Vec3 half(0.3 * rng.next_double(), 0.3 * rng.next_double(), 0.3 * rng.next_double());
+      Bounds3 box;
+      box.extend(centre - half);
+      box.extend(centre + half);
+      const Vec3 n =
+          Vec3(2 * rng.next_double() - 1, 2 * rng.next_double() - 1, 2 * rng.next_double() - 1)
+              .normalized();
+      bool reached = false, reached_n = false;
+      for (int i = 0; i <= 4; ++i)
+        for (int j = 0; j <= 4; ++j)
+          for (int l = 0; l <= 4; ++l) {
+            const Vec3 y = box.lo + Vec3(i, j, l).cwiseProduct(box.hi - box.lo) / 4;
+            reached_n = reached_n || light.reaches(y, n);
+            for (const Vec3& m : {Vec3(0, 0, 1), Vec3(0, 0, -1), Vec3(1, 0, 0), Vec3(0, -1, 0)})
+              reached = reached || light.reaches(y, m);
+          }
+      if (reached) {
+        EXPECT_TRUE(light.may_reach(box)) << desc.name << " box " << box_index;
+      }
+      if (reached_n) {
+        EXPECT_TRUE(light.may_reach(box, n)) << desc.name << " box " << box_index;
+      }
+      culled += !light.may_reach(box, n);
+    }
+  }
+  EXPECT_GT(culled, 300) << "the test must see boxes culled";
+}
+
+// Under an irradiance floor a light without a range reaches where its irradiance on a surface
+// facing it falls to the floor: a point's P/(4π d²), a panel's P/(π d²) along its axis.
+TEST(LightRange, FloorGivesTheDistanceOfThatIrradiance) {
+  LightDesc bulb = sphere(0.05);
+  bulb.power = 100;
+  bulb.color = Vec3(0.5, 1, 0.25);
+  const double d = range_for_floor(bulb, 0.01);
+  EXPECT_NEAR(100 / (4 * kPi * d * d), 0.01, 1e-12);
+  bulb.range = d;
+  const Light light(bulb);
+  // Just inside, the closed form's irradiance facing it (the window's aside) is the floor's.
+  const Vec3 y = bulb.position + Vec3(0, 0, -d * (1 - 1e-6));
+  EXPECT_NEAR(light.unoccluded_irradiance(y, Vec3(0, 0, 1)).y() / light.range_factor(y), 0.01,
+              1e-6);
+  LightDesc panel = rectangle(0.5, 0.5);
+  panel.power = 40;
+  const double dp = range_for_floor(panel, 0.5);
+  EXPECT_NEAR(40 / (kPi * dp * dp), 0.5, 1e-12);
+  LightDesc sun = tilted_disk(1);
+  sun.sun_angle_deg = 0.5;
+  EXPECT_FALSE(std::isfinite(range_for_floor(sun, 0.5)));
+  EXPECT_FALSE(std::isfinite(range_for_floor(bulb, 0)));
+}
+
+}  // namespace
+}  // namespace sb

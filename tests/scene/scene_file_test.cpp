@@ -700,3 +700,34 @@ TEST_F(SceneFile, RejectsBadOutputKeys) {
 
 }  // namespace
 }  // namespace sb
+
+namespace sb {
+namespace {
+
+// A light's reach: `range` on a [[light]] (its shadow mask's reach follows it unless given), and
+// [bake] irradiance_floor; a range that is not a finite number > 0, or one on a sun or a sky, is an
+// error naming the light.
+TEST_F(SceneFile, ReadsARangeAndTheIrradianceFloor) {
+  const Scene scene = load_ok("[bake]\nirradiance_floor = 0.02\n" + object_floor + light_bulb +
+                              "range = 7.5\n" + light_panel + "range = 3\nshadowmask_range = 2\n");
+  EXPECT_EQ(scene.bake.irradiance_floor, 0.02);
+  EXPECT_EQ(scene.lights[0].range, 7.5);
+  EXPECT_EQ(scene.lights[0].shadowmask_range, 7.5);
+  EXPECT_EQ(scene.lights[1].range, 3);
+  EXPECT_EQ(scene.lights[1].shadowmask_range, 2);
+  const Scene plain = load_ok(object_floor + light_bulb);
+  EXPECT_TRUE(std::isinf(plain.lights[0].range));
+  EXPECT_EQ(plain.bake.irradiance_floor, 0);
+  for (const char* bad : {"0", "-2", "nan", "inf", "\"far\""})
+    expect_error(object_floor + light_bulb + "range = " + bad + "\n", "range", "light 'bulb'",
+                 "'range' must be a finite number > 0");
+  const std::string sun =
+      "[[light]]\nname = \"sun\"\nshape = \"sun\"\ndirection = [0, 0, -1]\nirradiance = 1\n";
+  expect_error(object_floor + sun + "range = 5\n", "range", "light 'sun'",
+               "'range' does not apply to a sun");
+  expect_error("[bake]\nirradiance_floor = -1\n" + object_floor + light_bulb, "irradiance_floor",
+               "[bake]", "'irradiance_floor' must be a number >= 0");
+}
+
+}  // namespace
+}  // namespace sb
