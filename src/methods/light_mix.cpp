@@ -11,8 +11,8 @@
 namespace sb {
 
 LightMix::LightMix(const TexelSpace& space, const std::vector<Light>& lights, Quantity quantity,
-                   Order order, KeepPerLight keep)
-    : space_(space), lights_(lights), quantity_(quantity), keep_(keep) {
+                   Order order, KeepPerLight keep, const LightLists* lists)
+    : space_(space), lights_(lights), lists_(lists), quantity_(quantity), keep_(keep) {
   // Visibility: texels where no light counts hold kNoLightCounts until finish() fills the
   // terminators' (terminator_fill.h).
   const float unset = quantity == Quantity::visibility ? kNoLightCounts : 0.0f;
@@ -23,8 +23,12 @@ LightMix::LightMix(const TexelSpace& space, const std::vector<Light>& lights, Qu
   direct_ = order == Order::light_major && lights.size() == 1 && quantity == Quantity::visibility &&
             !keep.any();
   if (order == Order::light_major && !direct_) {
-    set_values_.assign(lights.size(), std::vector<Vec3f>(space.texels.size(), Vec3f::Zero()));
-    set_flags_.assign(lights.size(), std::vector<std::uint8_t>(space.texels.size(), 0));
+    set_sums_.resize(space.texels.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, set_sums_.size(), 1 << 14),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        std::fill(set_sums_.begin() + std::ptrdiff_t(range.begin()),
+                                  set_sums_.begin() + std::ptrdiff_t(range.end()), Sum{});
+                      });
   }
   const std::size_t outputs = output_count(lights);
   if (keep_.values) out_.per_light.assign(outputs, Image(space.width, space.height, 3, unset));
@@ -81,10 +85,14 @@ void LightMix::keep_output(std::size_t output, std::size_t texel, const Vec3& h0
 void LightMix::add(Sum& sum, std::size_t light, std::size_t texel, const Vec3& h0, const Vec3& v) {
   sum.h += h0.cwiseProduct(v);
   sum.h0 += h0;
+  sum.lights += h0.maxCoeff() > 0;
   keep(light, texel, h0, v);
 }
 
 void LightMix::write(std::size_t texel, const Sum& sum) {
+  for (std::uint32_t most = most_lights_.load(std::memory_order_relaxed);
+       sum.lights > most && !most_lights_.compare_exchange_weak(most, sum.lights);) {
+  }
   const Texel& t = space_.texels[texel];
   float* px = out_.image.at(t.x, t.y);
   if (quantity_ == Quantity::visibility && !(sum.h0.maxCoeff() > 0)) return;  // kNoLightCounts
@@ -108,26 +116,21 @@ void LightMix::set(std::size_t light, std::size_t texel, int x, int y, const Vec
   if (direct_) {
     float* px = out_.image.at(x, y);
     for (int c = 0; c < 3; ++c) px[c] = lights_[0].exitance()[c] > 0 ? float(v[c]) : 0.0f;
+    most_lights_.store(1, std::memory_order_relaxed);
     return;
   }
-  set_values_[light][texel] = v.cast<float>();
-  set_flags_[light][texel] = 1;
+  // V as a light-by-light method hands it on, in single precision (its field's).
+  add(set_sums_[texel], light, texel, unoccluded(light, texel), v.cast<float>().cast<double>());
 }
 
 MixedImages LightMix::finish() {
-  if (!direct_ && !set_values_.empty()) {
-    // Texels are independent: the closed forms of every light at every texel, on all threads.
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, space_.texels.size(), 1024),
+  if (!set_sums_.empty()) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, set_sums_.size(), 1024),
                       [&](const tbb::blocked_range<std::size_t>& range) {
-                        for (std::size_t t = range.begin(); t != range.end(); ++t) {
-                          Sum sum;
-                          for (std::size_t l = 0; l < lights_.size(); ++l) {
-                            if (!set_flags_[l][t]) continue;
-                            add(sum, l, t, unoccluded(l, t), set_values_[l][t].cast<double>());
-                          }
-                          write(t, sum);
-                        }
+                        for (std::size_t t = range.begin(); t != range.end(); ++t)
+                          write(t, set_sums_[t]);
                       });
+    set_sums_ = FreshVector<Sum>();
   }
   // A mesh light's images from its parts' sums: V = Σ H0·V / Σ H0 per channel.
   for (std::size_t o = 0; o < sums_.size(); ++o) {
@@ -139,21 +142,22 @@ MixedImages LightMix::finish() {
       keep_output(o, t, sum.h0, v);
     }
   }
+  out_.most_lights = most_lights_.load();
   // Visibility across curved receivers' terminators, in every image of V.
   std::vector<std::size_t> every(lights_.size());
   for (std::size_t l = 0; l < every.size(); ++l) every[l] = l;
   if (quantity_ == Quantity::visibility)
-    fill_terminators(space_, lights_, every, UncountedMark::value, out_.image);
+    fill_terminators(space_, lights_, every, UncountedMark::value, out_.image, lists_);
   const std::size_t outputs = std::max(out_.per_light.size(), out_.per_light_visibility.size());
   for (std::size_t o = 0; o < outputs; ++o) {
     std::vector<std::size_t> parts;
     for (std::size_t l = 0; l < lights_.size(); ++l)
       if (std::size_t(lights_[l].output()) == o) parts.push_back(l);
     if (quantity_ == Quantity::visibility && o < out_.per_light.size())
-      fill_terminators(space_, lights_, parts, UncountedMark::value, out_.per_light[o]);
+      fill_terminators(space_, lights_, parts, UncountedMark::value, out_.per_light[o], lists_);
     if (o < out_.per_light_visibility.size())
       fill_terminators(space_, lights_, parts, UncountedMark::flag_off,
-                       out_.per_light_visibility[o]);
+                       out_.per_light_visibility[o], lists_);
   }
   return std::move(out_);
 }

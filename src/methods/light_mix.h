@@ -9,10 +9,12 @@
 // summed in double over lights in scene order and written as float.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
 #include "core/image.h"
+#include "methods/light_lists.h"
 #include "scene/lights.h"
 #include "texels/texel_space.h"
 
@@ -34,6 +36,8 @@ struct KeepPerLight {
 //    uncovered texels included (what a shadow mask holds, lightmaps/shadowmask.h).
 struct MixedImages {
   Image image;
+  // The most lights that reach any one texel (H0 > 0 there): how many a texel sums at most.
+  std::uint32_t most_lights = 0;
   std::vector<Image> per_light;             // empty unless kept
   std::vector<Image> per_light_visibility;  // empty unless kept
 };
@@ -41,10 +45,12 @@ struct MixedImages {
 class LightMix {
  public:
   // How the method visits (light, texel) pairs: all of a texel's lights at once (add, write), or
-  // light by light (set, then finish combines; it holds every light's V until then).
+  // light by light (set, then finish writes; each texel's sums are kept until then, not each
+  // light's values). `lists`, where given, says which lights may reach each block of texels
+  // (the terminators' fill weighs those alone; the others add exactly 0).
   enum class Order { texel_major, light_major };
   LightMix(const TexelSpace& space, const std::vector<Light>& lights, Quantity quantity,
-           Order order, KeepPerLight keep);
+           Order order, KeepPerLight keep, const LightLists* lists = nullptr);
 
   // H0_l at texel t (per channel, W/m²): a light whose H0 is 0 everywhere need not be estimated.
   Vec3 unoccluded(std::size_t light, std::size_t texel) const;
@@ -53,12 +59,15 @@ class LightMix {
   // H0 and V to the texel's Sum, then write() it. Many threads may do this for distinct texels.
   struct Sum {
     Vec3 h = Vec3::Zero(), h0 = Vec3::Zero();
+    std::uint32_t lights = 0;  // those added with H0 > 0
   };
   void add(Sum& sum, std::size_t light, std::size_t texel, const Vec3& h0, const Vec3& v);
   void write(std::size_t texel, const Sum& sum);
 
   // Methods that run light by light: light l's visibility at texel t (per channel, [0, 1]); a
-  // pair never set is left out. Combined in finish(). Many threads may set distinct pairs.
+  // pair never set is left out. Its H0 and H0·V are added to the texel's sums at once, so the
+  // lights are set one after another, in scene order, each pair at most once (as a texel-major
+  // method adds them); many threads may set distinct texels of one light.
   void set(std::size_t light, std::size_t texel, const Vec3& v);
   // The same for a caller that knows the texel's pixel (x, y), which then need not be read from
   // its record (a 4096² receiver's records are half a gigabyte).
@@ -72,14 +81,15 @@ class LightMix {
 
   const TexelSpace& space_;
   const std::vector<Light>& lights_;
+  const LightLists* lists_;
   Quantity quantity_;
   KeepPerLight keep_;
   MixedImages out_;
   bool direct_ = false;  // one light's visibility, light-major: set() writes the image itself
-  // Light-major methods' values until finish(): per light, V per texel and whether it was set;
-  // empty for texel-major ones.
-  std::vector<std::vector<Vec3f>> set_values_;
-  std::vector<std::vector<std::uint8_t>> set_flags_;
+  std::atomic<std::uint32_t> most_lights_{0};  // MixedImages::most_lights, as texels are written
+  // Light-major methods' sums per texel until finish() (48 bytes a texel, whatever the number
+  // of lights); empty for texel-major ones.
+  FreshVector<Sum> set_sums_;
   // Per scene light (Light::output): its parts' sums per texel, for a mesh light whose
   // images are kept; empty for the others.
   std::vector<std::vector<Sum>> sums_;

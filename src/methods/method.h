@@ -70,6 +70,9 @@ struct ReceiverInput {
   const Mesh* mesh = nullptr;
   const ObjectDesc* object = nullptr;
   std::uint64_t stream = 0;  // the receiver's name's key (name_stream): its own random streams
+  // Which lights may reach each block of its texels (light_lists.h): a method visits only those
+  // pairs, so its cost follows the lights' reach. Null: the method makes its own.
+  const LightLists* lists = nullptr;
 };
 
 // What a method says about one receiver beyond its values, as data the pipeline passes on.

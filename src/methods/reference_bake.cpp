@@ -12,6 +12,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <optional>
+
 #include "occluders/shadow_rays.h"
 #include "occluders/sky_rays.h"
 
@@ -21,7 +23,9 @@ MixedImages bake_reference(const TexelSpace& space, const ReferenceInputs& in,
                            std::int64_t* rays_traced) {
   const auto& lights = *in.lights;
   const RayScene& rays = *in.rays;
-  LightMix mix(space, lights, in.quantity, LightMix::Order::texel_major, in.keep_per_light);
+  std::optional<LightLists> own;
+  const LightLists& lists = in.lists ? *in.lists : own.emplace(space, lights);
+  LightMix mix(space, lights, in.quantity, LightMix::Order::texel_major, in.keep_per_light, &lists);
   std::atomic<std::int64_t> traced{0};
   // Counted: the kept rows' rays (a tile's halo, traced for the terminators' neighbours, is not).
   const auto [kept0, kept1] = kept_texels(space);
@@ -37,7 +41,9 @@ MixedImages bake_reference(const TexelSpace& space, const ReferenceInputs& in,
           const Texel& texel = space.texels[t];
           const std::int64_t before = local_rays;
           LightMix::Sum sum;
-          for (std::size_t l = 0; l < lights.size(); ++l) {
+          // The lights that may reach it (its block's list): the others add nothing.
+          for (const std::uint32_t light : lists.lights_of(lists.block_of(texel.x, texel.y))) {
+            const std::size_t l = light;
             if (const Sky* sky = lights[l].sky()) {
               // The whole sky at its first part; its other parts add nothing.
               if (l > 0 && lights[l - 1].sky() == sky) continue;
@@ -89,6 +95,7 @@ class ReferenceMethod final : public Method {
     in.texels_done = context_.texels_done;
     in.progress = context_.progress;
     in.keep_per_light = context_.keep_per_light;
+    in.lists = receiver.lists;
     MethodResult result;
     result.images = bake_reference(*receiver.space, in, &result.rays);
     return result;

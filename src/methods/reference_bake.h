@@ -22,6 +22,8 @@ struct ReferenceInputs {
   std::atomic<std::int64_t>* texels_done = nullptr;  // progress counter, may be null
   ProgressFn progress;          // called with texels_done after each chunk, may be empty
   KeepPerLight keep_per_light;  // per-light images wanted (MixedImages)
+  // Which lights may reach each block of texels (light_lists.h); null: the bake makes them.
+  const LightLists* lists = nullptr;
 };
 
 // Returns width × height RGB images (LightMix's rule: per covered texel V = Σ_l H_l / Σ_l H0_l or

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <utility>
 
 namespace sb {
@@ -87,7 +88,8 @@ bool square_reaches(const TexelSpace& space, const Texel& texel, const H0& h0) {
 }  // namespace
 
 void fill_terminators(const TexelSpace& space, const std::vector<Light>& all,
-                      const std::vector<std::size_t>& lights, UncountedMark mark, Image& image) {
+                      const std::vector<std::size_t>& lights, UncountedMark mark, Image& image,
+                      const LightLists* lists) {
   const int values = mark == UncountedMark::value ? 3 : 1;
   if (space.face_shading.empty()) {
     if (mark == UncountedMark::value) clear_uncounted(image);
@@ -104,13 +106,22 @@ void fill_terminators(const TexelSpace& space, const std::vector<Light>& all,
       tbb::blocked_range<std::size_t>(0, space.texels.size(), 1024),
       [&](const tbb::blocked_range<std::size_t>& range) {
         std::vector<Fill>& mine = fills.local();
+        std::vector<std::size_t> listed;  // the texel's block's among `lights`
         for (std::size_t t = range.begin(); t != range.end(); ++t) {
           const Texel& texel = space.texels[t];
           if (counted(image.at(texel.x, texel.y), mark)) continue;
           const Vec3 p = texel.position.cast<double>(), n = texel.normal.cast<double>();
+          const std::vector<std::size_t>* weighed = &lights;
+          if (lists) {
+            const auto block = lists->lights_of(lists->block_of(texel.x, texel.y));
+            listed.clear();
+            std::set_intersection(lights.begin(), lights.end(), block.begin(), block.end(),
+                                  std::back_inserter(listed));
+            weighed = &listed;
+          }
           const auto h0 = [&](const Vec3& normal) {
             double sum = 0;
-            for (const std::size_t l : lights)
+            for (const std::size_t l : *weighed)
               sum += all[l].unoccluded_irradiance(p, normal.normalized()).sum();
             return sum;
           };

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/image.h"
+#include "methods/light_lists.h"
 #include "scene/lights.h"
 #include "texels/texel_space.h"
 
@@ -36,8 +37,11 @@ enum class UncountedMark {
 };
 
 // Fills `image`'s uncounted covered texels as above from the lights `lights` (indices into
-// `all`) and then, for UncountedMark::value, sets every texel still kNoLightCounts to 0.
+// `all`, ascending) and then, for UncountedMark::value, sets every texel still kNoLightCounts to
+// 0. With `lists`, a texel weighs only those of `lights` its block lists (the rest give H0 = 0
+// there under every normal of its square).
 void fill_terminators(const TexelSpace& space, const std::vector<Light>& all,
-                      const std::vector<std::size_t>& lights, UncountedMark mark, Image& image);
+                      const std::vector<std::size_t>& lights, UncountedMark mark, Image& image,
+                      const LightLists* lists = nullptr);
 
 }  // namespace sb

@@ -258,6 +258,34 @@ bool enclosed(RTCScene scene, const Vec3& p, const Vec3& side, double skip, bool
 
 }  // namespace
 
+bool RayScene::inside_solid(const Vec3& p) const {
+  // The 26 directions to a cube's face centres, edge midpoints and corners, turned a little off
+  // the axes a level's walls and floors lie along (a ray along a wall meets nothing of it).
+  const Eigen::Matrix3d turn =
+      (Eigen::AngleAxisd(0.1, Vec3(0, 0, 1)) * Eigen::AngleAxisd(0.07, Vec3(1, 0, 0)))
+          .toRotationMatrix();
+  int hits = 0, behind = 0;
+  for (int x = -1; x <= 1; ++x)
+    for (int y = -1; y <= 1; ++y)
+      for (int z = -1; z <= 1; ++z) {
+        if (x == 0 && y == 0 && z == 0) continue;
+        const Vec3 d = turn * Vec3(x, y, z).normalized();
+        RTCIntersectContext context;
+        rtcInitIntersectContext(&context);
+        RTCRayHit query;
+        query.ray = single_ray(p, d, 0.0, std::numeric_limits<float>::infinity());
+        query.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        query.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(impl_->scene, &context, &query);
+        if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+        ++hits;
+        // (Embree's geometric normal points to the counter-clockwise front, as enclosed() reads
+        // it.)
+        behind += Vec3(query.hit.Ng_x, query.hit.Ng_y, query.hit.Ng_z).dot(d) > 0;
+      }
+  return hits >= 13 && behind == hits;
+}
+
 int RayScene::blocker_index(const Mesh* mesh) const {
   const auto it = std::find(impl_->meshes.begin(), impl_->meshes.end(), mesh);
   return it == impl_->meshes.end() ? -1 : int(it - impl_->meshes.begin());

@@ -65,6 +65,12 @@ class RayScene {
   // sheet (open on both sides).
   bool buried(const Vec3& p, const Vec3& n, int own, const Vec3& own_winding) const;
 
+  // Whether the point lies inside solid geometry: of 26 rays from it spread over the sphere, at
+  // least half meet a blocker triangle, and every one that does meets it from behind (its
+  // winding's normal turned away from the point). A light there (a level's light inside a wall's
+  // brush) sees no surface's front: it reaches nothing.
+  bool inside_solid(const Vec3& p) const;
+
   // A mesh's place among the blockers given to build that have faces (as buried() counts
   // them), or -1 for one that is not among them.
   int blocker_index(const Mesh* mesh) const;

@@ -20,6 +20,7 @@
 // over a small hierarchy.
 #include "occluders/shaft_culling.h"
 
+#include "core/nearest_point.h"
 #include "occluders/blocker_solids.h"
 #include "occluders/ray_scene.h"
 
@@ -646,6 +647,60 @@ std::span<const std::uint32_t> ShaftCuller::solids_with_balls(std::uint32_t key)
 }
 
 std::size_t ShaftCuller::triangle_count() const { return impl_->tris.size(); }
+
+void ShaftCuller::triangles_in_box(const Bounds3& box, std::vector<std::uint32_t>& out) const {
+  out.clear();
+  const std::vector<Node>& nodes = impl_->nodes;
+  if (nodes.empty() || box.empty()) return;
+  const auto meets = [&](const Vec3& lo, const Vec3& hi) {
+    return (lo.array() <= box.hi.array()).all() && (box.lo.array() <= hi.array()).all();
+  };
+  thread_local std::vector<int> stack;
+  stack.assign(1, 0);
+  while (!stack.empty()) {
+    const Node& node = nodes[std::size_t(stack.back())];
+    stack.pop_back();
+    if (!meets(node.box.lo, node.box.hi)) continue;
+    if (node.count > 0) {
+      for (int i = node.first; i < node.first + node.count; ++i)
+        if (meets(impl_->tris[std::size_t(i)].lo, impl_->tris[std::size_t(i)].hi))
+          out.push_back(std::uint32_t(i));
+      continue;
+    }
+    stack.push_back(node.left);
+    stack.push_back(node.right);
+  }
+  std::sort(out.begin(), out.end());
+}
+
+std::vector<std::uint32_t> ShaftCuller::triangles_within(const Vec3& centre, double radius) const {
+  std::vector<std::uint32_t> found;
+  const std::vector<Node>& nodes = impl_->nodes;
+  if (nodes.empty()) return found;
+  const auto near = [&](const Vec3& lo, const Vec3& hi) {
+    return (centre.cwiseMax(lo).cwiseMin(hi) - centre).norm() < radius;
+  };
+  std::vector<int> stack = {0};
+  while (!stack.empty()) {
+    const Node& node = nodes[std::size_t(stack.back())];
+    stack.pop_back();
+    if (!near(node.box.lo, node.box.hi)) continue;
+    if (node.count > 0) {
+      for (int i = node.first; i < node.first + node.count; ++i) {
+        const Tri& t = impl_->tris[std::size_t(i)];
+        double bary[3];
+        if (near(t.lo, t.hi) &&
+            nearest_point(t.v[0], t.v[1], t.v[2], centre, bary) < radius * radius)
+          found.push_back(std::uint32_t(i));
+      }
+      continue;
+    }
+    stack.push_back(node.left);
+    stack.push_back(node.right);
+  }
+  std::sort(found.begin(), found.end());
+  return found;
+}
 
 std::uint32_t ShaftCuller::triangle_of_face(std::int64_t face) const {
   return impl_->of_face[std::size_t(face)];

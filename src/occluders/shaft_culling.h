@@ -78,6 +78,11 @@ class ShaftCuller {
                      const Light& light, const std::vector<std::uint32_t>* among = nullptr,
                      const std::vector<std::uint32_t>* except = nullptr) const;
 
+  // The triangles that pass within `radius` of `centre` (a sphere light's ball), ascending.
+  std::vector<std::uint32_t> triangles_within(const Vec3& centre, double radius) const;
+  // The triangles whose bounding boxes meet `box`, into `out` (cleared), ascending.
+  void triangles_in_box(const Bounds3& box, std::vector<std::uint32_t>& out) const;
+
   // A triangle's bounding box, its three corners and its unit normal (by its index in the
   // hierarchy, as ShaftPolygon::triangle and tile_candidates give it).
   Bounds3 triangle_bounds(std::uint32_t triangle) const;

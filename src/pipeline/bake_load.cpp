@@ -27,7 +27,21 @@ Status load_scene_for(const Scene& scene, const MethodEntry& method, const BakeO
   loaded->meshes = std::move(*meshes);
   const std::vector<Mesh>& all = loaded->meshes;
   const std::vector<int> sides = lightmap_sides(scene, all, &result->setup_warnings);
-  auto lights = make_lights(placed_lights(scene, all), scene.file);
+  // The ray scene first where the method traces (the lights' check below reads it).
+  loaded->blockers = blocker_meshes(scene, all);
+  const MethodNeeds needs = method.needs(scene.bake);
+  if (needs.rays) {
+    auto built = RayScene::build(loaded->blockers);
+    if (!built) return built.error();
+    loaded->rays.emplace(std::move(*built));
+  }
+  std::vector<LightDesc> descs = placed_lights(scene, all);
+  if (Status checked =
+          cut_enclosed_lights(scene, loaded->blockers, loaded->rays ? &*loaded->rays : nullptr,
+                              descs, result->setup_warnings);
+      !checked)
+    return checked.error();
+  auto lights = make_lights(descs, scene.file);
   if (!lights) return lights.error();
   loaded->lights = std::move(*lights);
 
@@ -67,14 +81,7 @@ Status load_scene_for(const Scene& scene, const MethodEntry& method, const BakeO
             std::make_shared<const GltfMesh>(gltf_mesh(all[i], false, y_up)));
   }
 
-  // What the method asks for, built once and shared by every receiver.
-  loaded->blockers = blocker_meshes(scene, all);
-  const MethodNeeds needs = method.needs(scene.bake);
-  if (needs.rays) {
-    auto built = RayScene::build(loaded->blockers);
-    if (!built) return built.error();
-    loaded->rays.emplace(std::move(*built));
-  }
+  // What else the method asks for, built once and shared by every receiver.
   if (needs.clusters) loaded->clusters.emplace(build_clusters(loaded->blockers));
   if (needs.shafts) loaded->shafts.emplace(loaded->blockers);
   return Ok{};

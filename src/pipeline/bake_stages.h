@@ -81,7 +81,10 @@ struct Texels {
   std::vector<UvLayoutReport> layouts;
   std::vector<std::vector<std::string>> warnings;  // its UV layout's
   std::vector<std::vector<std::uint8_t>> reached;  // per light: 1 where it reaches a texel
-  std::int64_t total = 0;                          // covered texels, reused ones too
+  // Per receiver baked here, which lights may reach each block of its texels (empty where
+  // reused).
+  std::vector<std::optional<LightLists>> lists;
+  std::int64_t total = 0;  // covered texels, reused ones too
 };
 
 Expected<Texels> build_texels(const Scene& scene, const MethodEntry& method,

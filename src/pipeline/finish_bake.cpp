@@ -4,6 +4,7 @@
 
 #include "lightmaps/shadowmask.h"
 #include "pipeline/bake_stages.h"
+#include "pipeline/receiver_stages.h"
 
 namespace sb {
 
@@ -16,17 +17,26 @@ void finish_bake(const Scene& scene, BakeResult& result, bool whole) {
   std::int64_t texels = 0;
   for (const ReceiverBake& r : result.receivers) texels += r.covered_texels;
   const bool lit = scene.bake.quantity != Quantity::ambient_occlusion;
+  std::vector<const LightDesc*> unreached;
   for (std::size_t l = 0; whole && lit && texels > 0 && l < scene.lights.size(); ++l) {
     bool reached = false;
     for (const ReceiverBake& r : result.receivers)
       reached = reached || (l < r.lights_reached.size() && r.lights_reached[l]);
-    if (reached) continue;
-    const LightDesc& d = scene.lights[l];
-    warnings.push_back(fmt::format(
-        "{}:{}: light '{}': reaches no texel of any receiver (is its 'normal' the right way, or "
-        "its 'position' behind the receivers?); it adds nothing",
-        scene.file.string(), d.line, d.name));
+    if (!reached) unreached.push_back(&scene.lights[l]);
   }
+  // One warning each for a few; for many (a level's lights beyond their range of every
+  // receiver), one for all, naming the first few; and where none reaches, that the lightmaps
+  // are black.
+  warn_lights(scene, unreached,
+              "reaches no texel of any receiver (is its 'normal' the right way, its 'position' "
+              "behind the receivers, or its 'range' short of them?); it adds nothing",
+              "lights reach no texel of any receiver (facing away, below every texel's horizon, "
+              "or out of range)",
+              "they add nothing", warnings);
+  if (!unreached.empty() && unreached.size() == scene.lights.size())
+    warnings.push_back(fmt::format(
+        "{}: none of the scene's {} light(s) reaches any receiver; every lightmap is black",
+        scene.file.string(), scene.lights.size()));
   for (const ReceiverBake& r : result.receivers)
     warnings.insert(warnings.end(), r.report.warnings.begin(), r.report.warnings.end());
   result.shadowmask_channels.clear();

@@ -21,9 +21,9 @@ using json = nlohmann::ordered_json;
 // The receiver keys the schema names; any other key is one of the method's own entries.
 const std::set<std::string, std::less<>>& receiver_schema_keys() {
   static const std::set<std::string, std::less<>> keys = {
-      "name",         "files",   "atlas",          "uv_channel", "resolution", "method",
-      "quantity",     "samples", "covered_texels", "uv_layout",  "seams",      "seconds",
-      "method_stats", "bake"};
+      "name",      "files",    "atlas",   "uv_channel",     "resolution",
+      "method",    "quantity", "samples", "covered_texels", "most_lights_per_texel",
+      "uv_layout", "seams",    "seconds", "method_stats",   "bake"};
   return keys;
 }
 
@@ -250,6 +250,7 @@ json manifest_to_json(const Manifest& m) {
   out["lights"] = json::array();
   for (const auto& l : m.lights) {
     json light = {{"name", l.name}, {"shape", to_string(l.shape)}};
+    if (l.range) light["range"] = *l.range;
     if (l.shadowmask_channel) {
       light["shadowmask_channel"] = *l.shadowmask_channel >= 0
                                         ? json(shadowmask_channel_name(*l.shadowmask_channel))
@@ -304,6 +305,7 @@ Expected<Manifest> manifest_from_json(const json& json_manifest, const std::stri
       FieldReader light_fields(entry, where, path, status);
       light_fields.read("name", light.name);
       light_fields.read("shape", light.shape);
+      light_fields.read_optional("range", light.range);
       if (!status || !entry.contains("shadowmask_channel")) return;
       const json& channel = entry["shadowmask_channel"];
       int c = -1;

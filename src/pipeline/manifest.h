@@ -28,6 +28,9 @@ struct ManifestLight {
   LightShape shape = LightShape::rectangle;
   // With [output] shadowmask: its channel (0–3: R, G, B, A) or −1 (left out: "none").
   std::optional<int> shadowmask_channel;
+  // Its reach, metres (LightDesc::range: the file's, or [bake] irradiance_floor's); none where
+  // it reaches everywhere.
+  std::optional<double> range;
 };
 
 // One file and how to decode it (docs/cli.md, "Encodings"): the quantity a texel stands for is

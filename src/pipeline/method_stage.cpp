@@ -65,6 +65,7 @@ Status bake_receivers(const Scene& scene, const MethodEntry& method, const Loade
     input.object = &obj;
     // Keyed by its name: adding or removing other objects leaves its samples as they were.
     input.stream = name_stream(obj.name);
+    input.lists = &*texels.lists[r];
     const std::int64_t done_before = texels_done.load();
     auto baked = (*baker)->bake(input);
     if (!baked) return baked.error();
@@ -72,6 +73,7 @@ Status bake_receivers(const Scene& scene, const MethodEntry& method, const Loade
     texels_done = done_before + std::int64_t(texels.spaces[r].texels.size());
     if (context.progress) context.progress(double(texels_done.load()));
     out.image = std::move(baked->images.image);
+    out.most_lights_per_texel = baked->images.most_lights;
     out.per_light = std::move(baked->images.per_light);
     out.per_light_visibility = std::move(baked->images.per_light_visibility);
     out.report = std::move(baked->report);
@@ -82,9 +84,11 @@ Status bake_receivers(const Scene& scene, const MethodEntry& method, const Loade
       crop_to_tile(out, texels.spaces[r], *loaded.tiles[r]);  // the rest at the join
     } else {
       out.uv_layout = texels.layouts[r];
-      finish_receiver(scene, loaded.meshes[object], texels.spaces[r], loaded.lights, out);
+      finish_receiver(scene, loaded.meshes[object], texels.spaces[r], loaded.lights,
+                      *texels.lists[r], out);
     }
     texels.spaces[r] = TexelSpace();  // its memory back before the next receiver's
+    texels.lists[r].reset();
     out.seconds = texels.seconds[r] + seconds_since(start);
     result->receivers.push_back(std::move(out));
   }

@@ -374,6 +374,10 @@ Status write_outputs(OutputFolder& folder, const Scene& scene, const BakeSetting
     ManifestLight& light = manifest.lights.emplace_back();
     light.name = scene.lights[l].name;
     light.shape = scene.lights[l].shape;
+    const double range = std::isfinite(scene.lights[l].range)
+                             ? scene.lights[l].range
+                             : range_for_floor(scene.lights[l], scene.bake.irradiance_floor);
+    if (std::isfinite(range)) light.range = range;
     if (out.shadowmask && l < result.shadowmask_channels.size())
       light.shadowmask_channel = result.shadowmask_channels[l];
   }

@@ -9,6 +9,7 @@ void write_record(const ReceiverRecord& record, json& into) {
   const UvLayoutReport& layout = record.uv_layout;
   const SeamReport& seams = record.seams;
   into["covered_texels"] = record.covered_texels;
+  into["most_lights_per_texel"] = record.most_lights_per_texel;
   into["uv_layout"] = {{"charts", layout.charts},
                        {"uv_area", layout.uv_area},
                        {"uv_area_outside", layout.uv_area_outside},
@@ -29,6 +30,8 @@ void write_record(const ReceiverRecord& record, json& into) {
 
 void read_record(FieldReader& fields, const json& object, ReceiverRecord& record) {
   fields.read("covered_texels", record.covered_texels);
+  if (object.contains("most_lights_per_texel"))
+    fields.read("most_lights_per_texel", record.most_lights_per_texel);
   if (const json* layout = fields.object("uv_layout")) {
     FieldReader in = fields.nested(*layout, "uv_layout");
     UvLayoutReport& out = record.uv_layout;

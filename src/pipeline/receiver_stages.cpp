@@ -5,8 +5,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <map>
 #include <memory>
+#include <optional>
 
 #include "core/stopwatch.h"
 #include "lightmaps/shadowmask.h"
@@ -23,17 +25,22 @@ namespace sb {
 namespace {
 
 // The covered texels whose value means nothing, for the seams' stitching (texels/seams.h): in a
-// visibility, those none of `lights` reaches (V = H / H0 with H0 = 0, written 0). None for an
-// irradiance, which is 0 there in truth.
+// visibility, those none of the lights reaches (V = H / H0 with H0 = 0, written 0): every light,
+// or those that make up scene light `output`. None for an irradiance, which is 0 there in truth.
 std::vector<std::uint8_t> arbitrary_texels(bool visibility, const TexelSpace& space,
-                                           const std::vector<const Light*>& lights) {
+                                           const std::vector<Light>& lights,
+                                           const LightLists& lists,
+                                           std::optional<std::size_t> output = std::nullopt) {
   std::vector<std::uint8_t> arbitrary;
   if (!visibility) return arbitrary;
   arbitrary.assign(space.covered.size(), 0);
   for (const Texel& t : space.texels) {
     const Vec3 y = t.position.cast<double>(), n = t.normal.cast<double>();
-    const bool reached =
-        std::any_of(lights.begin(), lights.end(), [&](const Light* l) { return l->reaches(y, n); });
+    // Its block's lights: the others reach none of its texels.
+    const auto listed = lists.lights_of(lists.block_of(t.x, t.y));
+    const bool reached = std::any_of(listed.begin(), listed.end(), [&](std::uint32_t l) {
+      return (!output || std::size_t(lights[l].output()) == *output) && lights[l].reaches(y, n);
+    });
     arbitrary[std::size_t(t.y) * std::size_t(space.width) + std::size_t(t.x)] = !reached;
   }
   return arbitrary;
@@ -43,22 +50,15 @@ std::vector<std::uint8_t> arbitrary_texels(bool visibility, const TexelSpace& sp
 // light), then each light's value and visibility images (that light alone), so that a light's
 // image is stitched as a bake of that light alone would stitch it.
 std::vector<SeamImage> seam_images(const Scene& scene, ReceiverBake& out, const TexelSpace& space,
-                                   const std::vector<Light>& lights) {
+                                   const std::vector<Light>& lights, const LightLists& lists) {
   const bool visibility = scene.bake.quantity == Quantity::visibility;
-  std::vector<const Light*> all;
-  for (const Light& l : lights) all.push_back(&l);
-  std::vector<SeamImage> images = {{&out.image, arbitrary_texels(visibility, space, all)}};
-  // The lights a scene light is made of: itself, or a mesh light's triangles.
-  const auto parts = [&](std::size_t output) {
-    std::vector<const Light*> of;
-    for (const Light& l : lights)
-      if (std::size_t(l.output()) == output) of.push_back(&l);
-    return of;
-  };
+  std::vector<SeamImage> images = {
+      {&out.image, arbitrary_texels(visibility, space, lights, lists)}};
   for (std::size_t l = 0; l < out.per_light.size(); ++l)
-    images.push_back({&out.per_light[l], arbitrary_texels(visibility, space, parts(l))});
+    images.push_back({&out.per_light[l], arbitrary_texels(visibility, space, lights, lists, l)});
   for (std::size_t l = 0; l < out.per_light_visibility.size(); ++l)
-    images.push_back({&out.per_light_visibility[l], arbitrary_texels(true, space, parts(l))});
+    images.push_back(
+        {&out.per_light_visibility[l], arbitrary_texels(true, space, lights, lists, l)});
   return images;
 }
 
@@ -101,6 +101,13 @@ Expected<std::vector<Mesh>> load_meshes(const Scene& scene, std::vector<std::str
                           std::to_string(mesh->skipped_degenerate) +
                           " degenerate (zero-area) triangles");
     }
+    if (mesh->split_nonmanifold > 0 && warnings) {
+      warnings->push_back(fmt::format(
+          "{}: {} triangle(s) meet others at an edge or vertex no 2-manifold has (three or more "
+          "faces on an edge, or a vertex whose faces do not form one fan); each was kept on "
+          "copies of its corners, which bakes it as it is but leaves its edges unshared",
+          object_location(scene.file, obj), mesh->split_nonmanifold));
+    }
     if (obj.auto_uv && obj.receiver) {
       AutoUvTarget target;
       target.margin = scene.bake.margin;
@@ -129,9 +136,15 @@ std::vector<const Mesh*> blocker_meshes(const Scene& scene, const std::vector<Me
   return blockers;
 }
 
-// The scene's lights with every sun and sky placed for the meshes' bounds (sun_light.h, sky.h).
+// The scene's lights with every sun and sky placed for the meshes' bounds (sun_light.h, sky.h),
+// and, under an irradiance floor, a range for each light that has none.
 std::vector<LightDesc> placed_lights(const Scene& scene, const std::vector<Mesh>& meshes) {
   std::vector<LightDesc> lights = scene.lights;
+  for (LightDesc& l : lights) {
+    if (std::isfinite(l.range)) continue;
+    l.range = range_for_floor(l, scene.bake.irradiance_floor);
+    if (!std::isfinite(l.shadowmask_range)) l.shadowmask_range = l.range;
+  }
   const auto at_infinity = [](const LightDesc& l) {
     return l.sun_angle_deg > 0 || l.shape == LightShape::sky;
   };
@@ -150,15 +163,64 @@ std::vector<LightDesc> placed_lights(const Scene& scene, const std::vector<Mesh>
   return lights;
 }
 
+Status cut_enclosed_lights(const Scene& scene, const std::vector<const Mesh*>& blockers,
+                           const RayScene* rays, std::vector<LightDesc>& lights,
+                           std::vector<std::string>& warnings) {
+  const auto tested = [](const LightDesc& l) {
+    return l.sun_angle_deg == 0 &&
+           (l.shape == LightShape::sphere || l.shape == LightShape::rectangle ||
+            l.shape == LightShape::disk);
+  };
+  if (blockers.empty() || std::none_of(lights.begin(), lights.end(), tested)) return Ok{};
+  std::optional<RayScene> own;
+  if (!rays) {
+    auto built = RayScene::build(blockers);
+    if (!built) return built.error();
+    rays = &own.emplace(std::move(*built));
+  }
+  std::vector<const LightDesc*> enclosed;
+  for (LightDesc& l : lights) {
+    if (!tested(l) || !rays->inside_solid(l.position)) continue;
+    l.range = 0;
+    l.shadowmask_range = 0;
+    enclosed.push_back(&l);
+  }
+  warn_lights(scene, enclosed,
+              "its centre lies inside solid geometry (every ray from it meets a surface from "
+              "behind); it reaches nothing",
+              "lights' centres lie inside solid geometry (every ray from each meets a surface "
+              "from behind)",
+              "they reach nothing", warnings);
+  return Ok{};
+}
+
+void warn_lights(const Scene& scene, const std::vector<const LightDesc*>& lights,
+                 std::string_view each, std::string_view many, std::string_view then,
+                 std::vector<std::string>& warnings) {
+  constexpr std::size_t kNamed = 5;
+  if (lights.size() <= kNamed) {
+    for (const LightDesc* l : lights)
+      warnings.push_back(
+          fmt::format("{}:{}: light '{}': {}", scene.file.string(), l->line, l->name, each));
+    return;
+  }
+  std::string names;
+  for (std::size_t k = 0; k < kNamed; ++k) names += (k ? ", '" : "'") + lights[k]->name + "'";
+  warnings.push_back(fmt::format("{}: {} {}, {} and {} more; {}", scene.file.string(),
+                                 lights.size(), many, names, lights.size() - kNamed, then));
+}
+
 std::vector<std::uint8_t> lights_reaching(const Scene& scene, const TexelSpace& space,
-                                          const std::vector<Light>& lights) {
+                                          const std::vector<Light>& lights,
+                                          const LightLists& lists) {
   std::vector<std::uint8_t> reached(scene.lights.size(), 0);
   if (scene.bake.quantity == Quantity::ambient_occlusion) return reached;
-  for (const Light& light : lights) {
-    std::uint8_t& reaches = reached[std::size_t(light.output())];
-    for (const Texel& t : space.texels) {
-      if (reaches) break;  // this light, or another part of its mesh light
-      reaches = light.reaches(t.position.cast<double>(), t.normal.cast<double>());
+  // Texel by texel, the lights of its block not yet found to reach (this light, or another part
+  // of its mesh light): a light the lists leave out everywhere costs nothing.
+  for (const Texel& t : space.texels) {
+    for (const std::uint32_t l : lists.lights_of(lists.block_of(t.x, t.y))) {
+      std::uint8_t& reaches = reached[std::size_t(lights[l].output())];
+      if (!reaches) reaches = lights[l].reaches(t.position.cast<double>(), t.normal.cast<double>());
     }
   }
   return reached;
@@ -187,7 +249,7 @@ Expected<std::vector<std::string>> layout_warnings(const Scene& scene, const Obj
 }
 
 void finish_receiver(const Scene& scene, const Mesh& mesh, const TexelSpace& space,
-                     const std::vector<Light>& lights, ReceiverBake& out) {
+                     const std::vector<Light>& lights, const LightLists& lists, ReceiverBake& out) {
   for (std::size_t l = 0; l < out.per_light_visibility.size(); ++l)
     apply_shadowmask_range(out.per_light_visibility[l], scene.lights[l], space);
   const auto dilate_start = std::chrono::steady_clock::now();
@@ -198,7 +260,7 @@ void finish_receiver(const Scene& scene, const Mesh& mesh, const TexelSpace& spa
   const auto seams_start = std::chrono::steady_clock::now();
   // The arbitrary-texel masks cost a reach test per texel and light: only for a mesh with seams.
   if (const std::vector<SeamEdge> seams = find_seams(mesh); !seams.empty()) {
-    out.seams = stitch_seams(seams, space.covered, seam_images(scene, out, space, lights),
+    out.seams = stitch_seams(seams, space.covered, seam_images(scene, out, space, lights, lists),
                              seam_scale(scene, out.image), scene.bake.seams);
   }
   out.seams.stitched = scene.bake.seams;

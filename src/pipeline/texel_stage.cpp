@@ -14,6 +14,7 @@ Expected<Texels> build_texels(const Scene& scene, const MethodEntry& method,
   Texels out;
   out.warnings.resize(n);
   out.reached.resize(n);
+  out.lists.resize(n);
   for (std::size_t r = 0; r < n; ++r) {
     const std::size_t i = loaded.receivers[r];
     const Mesh& mesh = loaded.meshes[i];
@@ -30,17 +31,19 @@ Expected<Texels> build_texels(const Scene& scene, const MethodEntry& method,
       out.spaces.push_back(rasterise_texels(mesh, side, side,
                                             tile_window(*loaded.tiles[r], method.tile_halo, side)));
       out.spaces.back().kept = *loaded.tiles[r];
+      out.lists[r].emplace(out.spaces.back(), loaded.lights);
       out.seconds.push_back(seconds_since(start));
       out.layouts.emplace_back();
       out.total += std::int64_t(out.spaces.back().texels.size());
       continue;
     } else {
       out.spaces.push_back(rasterise_texels(mesh, side, side));
+      out.lists[r].emplace(out.spaces.back(), loaded.lights);
       out.seconds.push_back(seconds_since(start));
       covered = std::int64_t(out.spaces.back().texels.size());
       out.layouts.push_back(check_uv_layout(mesh, out.spaces.back(), scene.bake.margin));
       // Which lights reach any of its texels (for the warning about lights that reach nothing).
-      out.reached[r] = lights_reaching(scene, out.spaces.back(), loaded.lights);
+      out.reached[r] = lights_reaching(scene, out.spaces.back(), loaded.lights, *out.lists[r]);
     }
     out.total += covered;
     auto warnings = layout_warnings(scene, scene.objects[i], out.layouts.back(), covered, side);

@@ -185,6 +185,7 @@ Expected<std::vector<ReceiverBake>> join_tiles(const Scene& scene,
         copy_rows(t.per_light[l], 0, rows, out.per_light[l], t.tile->begin);
       for (std::size_t l = 0; l < t.per_light_visibility.size(); ++l)
         copy_rows(t.per_light_visibility[l], 0, rows, out.per_light_visibility[l], t.tile->begin);
+      out.most_lights_per_texel = std::max(out.most_lights_per_texel, t.most_lights_per_texel);
       std::copy(t.covered.begin(), t.covered.end(),
                 covered.begin() + std::ptrdiff_t(std::size_t(t.tile->begin) * std::size_t(side)));
       // The method's counts and rays add up; its warnings once each.
@@ -222,8 +223,9 @@ Expected<std::vector<ReceiverBake>> join_tiles(const Scene& scene,
         layout_warnings(scene, obj, out.uv_layout, std::int64_t(space.texels.size()), side);
     if (!warnings) return warnings.error();
     out.uv_warnings = std::move(*warnings);
-    out.lights_reached = lights_reaching(scene, space, *lights);
-    finish_receiver(scene, mesh, space, *lights, out);
+    const LightLists lists(space, *lights);
+    out.lights_reached = lights_reaching(scene, space, *lights, lists);
+    finish_receiver(scene, mesh, space, *lights, lists, out);
     out.seconds += seconds_since(start);
     joined.push_back(std::move(out));
   }

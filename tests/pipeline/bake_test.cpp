@@ -3,13 +3,20 @@
 // so a flipped or transposed lightmap cannot pass.
 #include <gtest/gtest.h>
 
-#include <chrono>
+#include <unistd.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
 
 #include "pipeline/bake.h"
 #include "support/closed_forms.h"
 #include "support/image_errors.h"
+#include "support/test_scenes.h"
 
 namespace sb {
 namespace {
@@ -133,6 +140,82 @@ TEST(Bake, ReportsSettingsTheMethodIgnores) {
   EXPECT_NE(ignored[0].find("[bake] shadow_map: method 'reference' does not use it"),
             std::string::npos)
       << ignored[0];
+}
+
+}  // namespace
+}  // namespace sb
+
+namespace sb {
+namespace {
+
+// The parallel scene with `lights` added, each a small sphere at the given place.
+Scene with_bulbs(const std::vector<Vec3>& places) {
+  Scene scene = parallel_scene(16, 16);
+  for (std::size_t k = 0; k < places.size(); ++k) {
+    LightDesc bulb;
+    bulb.name = "bulb" + std::to_string(k);
+    bulb.shape = LightShape::sphere;
+    bulb.position = places[k];
+    bulb.radius = 0.01;
+    bulb.power = 10;
+    bulb.line = int(100 + k);
+    scene.lights.push_back(bulb);
+  }
+  return scene;
+}
+
+bool has_warning(const BakeResult& r, const std::string& text) {
+  return std::any_of(r.warnings.begin(), r.warnings.end(),
+                     [&](const std::string& w) { return w.find(text) != std::string::npos; });
+}
+
+// A light inside a closed blocker (a cube over the parallel scene's floor) reaches nothing, in
+// every method: a warning names it, and the bake is that of the scene without it.
+TEST(Bake, ALightInsideSolidGeometryReachesNothing) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("sb_enclosed_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  // A 0.4 m cube centred at (0.3, 0.2, 0.9), above the scene's blocker, its faces
+  // counter-clockwise seen from outside.
+  std::ofstream(dir / "cube.obj") << "v 0.1 0 0.7\nv 0.5 0 0.7\nv 0.5 0.4 0.7\nv 0.1 0.4 0.7\n"
+                                     "v 0.1 0 1.1\nv 0.5 0 1.1\nv 0.5 0.4 1.1\nv 0.1 0.4 1.1\n"
+                                     "f 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\n"
+                                     "f 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n";
+  for (const std::string method : {"backprojection", "reference"}) {
+    Scene without = parallel_scene(16, 16);
+    without.bake.method = method;
+    ObjectDesc cube;
+    cube.name = "cube";
+    cube.mesh = dir / "cube.obj";
+    cube.receiver = false;
+    without.objects.push_back(cube);
+    Scene with = without;
+    with.lights.push_back(test_scenes::sphere_light("bulb", Vec3(0.3, 0.2, 0.9), 0.05, 10));
+    auto a = bake(without), b = bake(with);
+    ASSERT_TRUE(a && b) << (a ? b.error().message : a.error().message);
+    EXPECT_TRUE(has_warning(*b, "light 'bulb': its centre lies inside solid geometry")) << method;
+    EXPECT_FALSE(has_warning(*a, "inside solid geometry")) << method;
+    EXPECT_EQ(a->receivers[0].image.pixels, b->receivers[0].image.pixels) << method;
+  }
+  std::filesystem::remove_all(dir);
+}
+
+// Many lights that reach nothing are one warning naming the first five; where no light reaches
+// any receiver, a warning says the lightmaps are black.
+TEST(Bake, ManyLightsThatReachNothingAreOneWarning) {
+  std::vector<Vec3> below;
+  for (int k = 0; k < 8; ++k) below.push_back(Vec3(0.1 * k, 0, -5));  // under the floor
+  auto some = bake(with_bulbs(below));
+  ASSERT_TRUE(some) << some.error().message;
+  EXPECT_TRUE(has_warning(*some, "8 lights reach no texel of any receiver"));
+  EXPECT_TRUE(has_warning(*some, "'bulb0', 'bulb1', 'bulb2', 'bulb3', 'bulb4' and 3 more"));
+  EXPECT_FALSE(has_warning(*some, "every lightmap is black"));
+  Scene none = with_bulbs({Vec3(0, 0, -5)});
+  none.lights.erase(none.lights.begin());  // the panel: only the bulb under the floor is left
+  auto dark = bake(none);
+  ASSERT_TRUE(dark) << dark.error().message;
+  EXPECT_TRUE(has_warning(*dark, "light 'bulb0': reaches no texel of any receiver"));
+  EXPECT_TRUE(has_warning(*dark, "none of the scene's 1 light(s) reaches any receiver"));
 }
 
 }  // namespace

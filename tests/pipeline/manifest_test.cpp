@@ -29,7 +29,8 @@ Manifest full_manifest() {
   m.seed = 18446744073709551615ull;
   m.margin = 4;
   m.method_settings = {{"trace", true}, {"convolve", false}};
-  m.lights = {{"panel", LightShape::rectangle, 0}, {"bulb", LightShape::sphere, -1}};
+  m.lights = {{"panel", LightShape::rectangle, 0, std::nullopt},
+              {"bulb", LightShape::sphere, -1, 14.75}};
   m.png_white_point = 12.5;
   ManifestReceiver& r = m.receivers.emplace_back();
   r.name = "floor";
@@ -44,6 +45,7 @@ Manifest full_manifest() {
   r.quantity = Quantity::irradiance;
   r.samples = 256;
   r.covered_texels = 2000;
+  r.most_lights_per_texel = 37;
   r.uv_layout.charts = 3;
   r.uv_layout.uv_area = 0.75;
   r.uv_layout.uv_area_outside = 0.125;
@@ -86,6 +88,9 @@ TEST(Manifest, RoundTripsEveryKey) {
   EXPECT_EQ(read->seed, written.seed);
   EXPECT_EQ(read->quantity, Quantity::irradiance);
   EXPECT_EQ(read->lights[1].shape, LightShape::sphere);
+  EXPECT_EQ(read->lights[1].range, 14.75);
+  EXPECT_FALSE(read->lights[0].range);
+  EXPECT_EQ(read->receivers[0].most_lights_per_texel, 37);
   EXPECT_EQ(read->png_white_point, 12.5);
   EXPECT_EQ(read->method_settings, written.method_settings);  // trace true, convolve false
   ASSERT_EQ(read->receivers.size(), 1u);
@@ -114,10 +119,11 @@ TEST(Manifest, KeepsTheFilesKeyOrder) {
                                       "lights", "png_white_point", "receivers", "warnings",
                                       "load_seconds", "bake_seconds", "shadow_rays"}));
   // The method's own entries follow method_stats.
-  EXPECT_EQ(keys(j["receivers"][0]),
-            (std::vector<std::string>{"name", "files", "uv_channel", "resolution", "method",
-                                      "quantity", "samples", "covered_texels", "uv_layout", "seams",
-                                      "seconds", "method_stats", "penumbra_error", "lights"}));
+  EXPECT_EQ(
+      keys(j["receivers"][0]),
+      (std::vector<std::string>{"name", "files", "uv_channel", "resolution", "method", "quantity",
+                                "samples", "covered_texels", "most_lights_per_texel", "uv_layout",
+                                "seams", "seconds", "method_stats", "penumbra_error", "lights"}));
   EXPECT_EQ(keys(j["receivers"][0]["uv_layout"]),
             (std::vector<std::string>{"charts", "uv_area", "uv_area_outside", "overlapping_texels",
                                       "texels_near_other_charts", "margin", "stretch",

@@ -26,6 +26,7 @@ ReceiverBake sample_receiver() {
   r.image = Image(4, 4, 3);
   r.covered.assign(16, 1);
   r.covered_texels = 16;
+  r.most_lights_per_texel = 9;
   r.uv_layout.uv_area = 0.75;
   r.uv_layout.uv_area_outside = 0.125;
   r.uv_layout.overlapping_texels = 7;
@@ -46,7 +47,8 @@ ReceiverBake sample_receiver() {
 // The record's keys of a receiver's JSON, in their order.
 json record_of(const json& receiver) {
   json out = json::object();
-  for (const char* key : {"covered_texels", "uv_layout", "seams"}) out[key] = receiver.at(key);
+  for (const char* key : {"covered_texels", "most_lights_per_texel", "uv_layout", "seams"})
+    out[key] = receiver.at(key);
   return out;
 }
 

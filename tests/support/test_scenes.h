@@ -25,6 +25,18 @@ inline Scene load(const std::string& name, int resolution, const std::string& me
   return *scene;
 }
 
+// A sphere light as the tests add one by hand.
+inline LightDesc sphere_light(const std::string& name, const Vec3& position, double radius,
+                              double power) {
+  LightDesc light;
+  light.name = name;
+  light.shape = LightShape::sphere;
+  light.position = position;
+  light.radius = radius;
+  light.power = power;
+  return light;
+}
+
 inline ObjectDesc& object(Scene& scene, const std::string& name) {
   for (auto& o : scene.objects)
     if (o.name == name) return o;

@@ -4,11 +4,14 @@
 // hierarchy and the estimator's value over them, and the whole method's value for the texel.
 //
 // Run: build/shadowbake_texel_probe [--resolution N] SCENE RECEIVER LIGHT X Y [X Y ...] (SCENE: a
-// scene file or a level; --resolution as the bake's, overriding the scene's sizes)
+// scene file or a level; --resolution as the bake's, overriding the scene's sizes; LIGHT "*":
+// every light that reaches the texel, the worst first)
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +21,71 @@
 #include "scene/level_file.h"
 #include "support/built_scene.h"
 #include "texels/lightmap_sizes.h"
+
+namespace {
+
+// Calls f(x, y, texel) for each X Y pair of `points` (count of them) that a texel covers; says
+// so for the others.
+template <class F>
+void each_point(const sb::TexelGrid& grid, int count, char** points, F&& f) {
+  for (int a = 0; a + 1 < count; a += 2) {
+    const int x = std::atoi(points[a]), y = std::atoi(points[a + 1]);
+    const std::int32_t t = grid.texel(x, y);
+    if (t < 0)
+      fmt::print("({}, {}): not covered\n", x, y);
+    else
+      f(x, y, std::size_t(t));
+  }
+}
+
+// LIGHT "*": every light that reaches each texel, with its H0 (summed over channels), the
+// method's V and the reference's at 4096 samples, the largest H0-weighted difference first.
+int every_light(const sb::test_scenes::Built& built, const sb::TexelSpace& space, int count,
+                char** points) {
+  using namespace sb;
+  BackprojectionInputs in;
+  in.lights = &built.lights;
+  in.culler = &*built.culler;
+  in.rays = &*built.rays;
+  const TexelGrid grid(space);
+  std::vector<std::optional<LightField>> fields(built.lights.size());
+  each_point(grid, count, points, [&](int x, int y, std::size_t t) {
+    const Texel& tx = space.texels[t];
+    const Vec3 p = tx.position.cast<double>(), n = tx.normal.cast<double>();
+    struct Row {
+      std::string name;
+      double h0, method, reference;
+    };
+    std::vector<Row> rows;
+    double h = 0, h_ref = 0, h0 = 0;
+    for (std::size_t l = 0; l < built.lights.size(); ++l) {
+      const Light& light = built.lights[l];
+      if (!light.reaches(p, n)) continue;
+      const double weight = light.unoccluded_irradiance(p, n).sum();
+      if (!(weight > 0)) continue;
+      if (!fields[l]) fields[l] = backprojection_light(space, in, l);
+      ShadowRays batch(4096);
+      std::vector<Vec2> strata;
+      Vec3 v = Vec3::Zero();
+      estimate_visibility(space, t, light, *built.rays, 4096, 3, 0, batch, strata, &v);
+      rows.push_back({light.desc().name, weight, fields[l]->visibility_at(x, y), v.x()});
+      h += weight * rows.back().method, h_ref += weight * v.x(), h0 += weight;
+    }
+    std::sort(rows.begin(), rows.end(), [](const Row& a, const Row& b) {
+      return a.h0 * std::abs(a.method - a.reference) > b.h0 * std::abs(b.method - b.reference);
+    });
+    fmt::print(
+        "({}, {}) p ({:.4f} {:.4f} {:.4f}) n ({:.3f} {:.3f} {:.3f}): {} lights, V {:.4f}, "
+        "reference 4096 {:.4f}\n",
+        x, y, p.x(), p.y(), p.z(), n.x(), n.y(), n.z(), rows.size(), h / h0, h_ref / h0);
+    for (std::size_t k = 0; k < std::min<std::size_t>(rows.size(), 8); ++k)
+      fmt::print("  {}: H0 {:.4g}  V {:.4f}  reference {:.4f}\n", rows[k].name, rows[k].h0,
+                 rows[k].method, rows[k].reference);
+  });
+  return 0;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace sb;
@@ -49,11 +117,12 @@ int main(int argc, char** argv) {
     if (scene->objects[i].name == argv[2]) object = i, receiver = r;
     ++r;
   }
+  const int side = sides[receiver];
+  const TexelSpace space = rasterise_texels(built.meshes[object], side, side);
+  if (std::string(argv[3]) == "*") return every_light(built, space, argc - 4, argv + 4);
   std::size_t light = 0;
   for (std::size_t l = 0; l < built.lights.size(); ++l)
     if (built.lights[l].desc().name == argv[3]) light = l;
-  const int side = sides[receiver];
-  const TexelSpace space = rasterise_texels(built.meshes[object], side, side);
   const Light& L = built.lights[light];
   const double offset = built.rays->surface_offset();
   BackprojectionInputs in;
@@ -62,14 +131,8 @@ int main(int argc, char** argv) {
   in.rays = &*built.rays;
   const LightField field = backprojection_light(space, in, light);
   const TexelGrid grid(space);
-  for (int a = 4; a + 1 < argc; a += 2) {
-    const int x = std::atoi(argv[a]), y = std::atoi(argv[a + 1]);
-    const std::int32_t t = grid.texel(x, y);
-    if (t < 0) {
-      fmt::print("({}, {}): not covered\n", x, y);
-      continue;
-    }
-    const Texel& tx = space.texels[std::size_t(t)];
+  each_point(grid, argc - 4, argv + 4, [&](int x, int y, std::size_t t) {
+    const Texel& tx = space.texels[t];
     const Vec3 p = tx.position.cast<double>(), n = tx.normal.cast<double>();
     const Vec3 o = space.ray_origin(std::size_t(t), offset);
     fmt::print(
@@ -83,8 +146,7 @@ int main(int argc, char** argv) {
       ShadowRays batch(samples);
       std::vector<Vec2> strata;
       Vec3 v;
-      if (estimate_visibility(space, std::size_t(t), L, *built.rays, samples, 3, 0, batch, strata,
-                              &v))
+      if (estimate_visibility(space, t, L, *built.rays, samples, 3, 0, batch, strata, &v))
         fmt::print("  reference {}: V {:.4f}\n", samples, v.x());
     }
     const Vec3 dir = L.centre() - o;
@@ -126,6 +188,6 @@ int main(int argc, char** argv) {
       fmt::print("  estimator over its own shaft, {} rows: V {:.4f} (contributes {})\n", rows,
                  s.visibility, s.contributes);
     }
-  }
+  });
   return 0;
 }

@@ -19,8 +19,11 @@
 #include <array>
 #include <atomic>
 #include <limits>
+#include <optional>
+#include <span>
 
 #include "methods/backprojection/penumbra_estimator.h"
+#include "methods/backprojection/piercing_blockers.h"
 #include "methods/backprojection/tile_shafts.h"
 #include "occluders/blocker_solids.h"
 #include "occluders/shadow_rays.h"
@@ -94,9 +97,20 @@ std::vector<int> faces_across_slab(const Light& light, const BlockerSolid& solid
   return cuts;
 }
 
+// The parts of a triangle that pierces the light's ball (piercing_blockers.h) as polygons, each
+// its own umbra (a part alone is convex; the triangle's parts together are not), reported as
+// `key`.
+void add_parts(const PiercingBlockers& piercing, std::uint32_t triangle, std::uint32_t key,
+               const Vec3& normal, std::vector<BlockerPolygon>& out) {
+  const auto parts = piercing.parts_of(triangle);
+  for (const std::array<Vec3, 3>& part : parts)
+    out.push_back({part.data(), 3, normal, key,
+                   PiercingBlockers::kPartUmbra | std::uint32_t(&part - piercing.parts.data())});
+}
+
 TileBlockers tile_blockers(const ShaftCuller& culler, const Light& light,
                            const std::vector<std::uint32_t>& candidates, const Bounds3& origins,
-                           double offset) {
+                           double offset, const PiercingBlockers& piercing) {
   TileBlockers out;
   const Vec3 centre = origins.centre(), half = 0.5 * (origins.hi - origins.lo);
   // Each convex solid among the candidates once, with how far the whole tile lies in front of
@@ -124,10 +138,21 @@ TileBlockers tile_blockers(const ShaftCuller& culler, const Light& light,
   // enough of them for that to pay.
   std::vector<std::uint8_t> whole(keys.size());
   for (std::size_t k = 0; k < keys.size(); ++k) whole[k] = distances[k] > offset;
+  // A triangle through the light's ball goes as its parts outside it, and its solid, if any, as
+  // triangles.
+  for (std::uint32_t i : candidates) {
+    if (!piercing.pierces(i)) continue;
+    const auto at = std::find(keys.begin(), keys.end(), culler.blocker_key(i));
+    if (at != keys.end()) whole[std::size_t(at - keys.begin())] = 0;
+  }
   std::vector<std::uint32_t> dense;  // dense meshes' keys, in order of first candidate
   std::vector<std::vector<std::uint32_t>> dense_triangles;
   for (std::uint32_t i : candidates) {
     const std::uint32_t key = culler.blocker_key(i);
+    if (piercing.pierces(i)) {
+      add_parts(piercing, i, key, culler.triangle_normal(i), out.polygons);
+      continue;
+    }
     if (key & ShaftCuller::kMeshKey) {
       auto at = std::find(dense.begin(), dense.end(), key);
       if (at == dense.end()) {
@@ -144,7 +169,14 @@ TileBlockers tile_blockers(const ShaftCuller& culler, const Light& light,
   }
   for (std::size_t k = 0; k < dense.size(); ++k) {
     std::vector<std::uint32_t>& list = dense_triangles[k];
-    if (list.size() < kOutlineTriangles) {
+    // A sphere light's outline is made anew per texel (penumbra_estimator.h): it pays where the
+    // mesh's triangles are small beside the tile (a knot's), not where they are as large as a
+    // level's walls and floors (OpenArena's oacmpctf3: the evaluations took 11 % longer so).
+    double sizes = 0;
+    if (light.shape() == LightShape::sphere)
+      for (std::uint32_t i : list) sizes += culler.triangle_bounds(i).diagonal();
+    const bool large = sizes > double(list.size()) * origins.diagonal();
+    if (list.size() < kOutlineTriangles || large) {
       for (std::uint32_t i : list)
         out.polygons.push_back(
             {culler.triangle_corners(i), 3, culler.triangle_normal(i), dense[k], i});
@@ -189,6 +221,7 @@ TileBlockers tile_blockers(const ShaftCuller& culler, const Light& light,
     for (std::uint32_t i : candidates)
       if (culler.blocker_key(i) == keys[k])
         faces.push_back({culler.triangle_corners(i), 3, culler.triangle_normal(i), i});
+    // (A whole solid has no triangle through the ball: see above.)
     out.faces.push_back(std::move(faces));
     out.solids.push_back({&solid, keys[k], nullptr, 0, distances[k]});
   }
@@ -222,6 +255,7 @@ class LightPairs final : public PairSource {
         tiles_(tiles),
         offset_(in.rays->surface_offset()),
         estimator_(light, in.light_rows, offset_),
+        piercing_(piercing_blockers(*in.culler, light)),
         prepared_of_(tiles.patches.size(), -1) {
     // The listed patches' blockers, and those of the umbrae whose texels the refinement may
     // evaluate as its cells' corners: the umbra patches of a tile that holds cells, or of a tile
@@ -238,10 +272,7 @@ class LightPairs final : public PairSource {
                            searched(tx - 1, ty - 1);
       for (std::uint32_t p = tiles.first_patch[i]; p < tiles.first_patch[i + 1]; ++p) {
         const TileShafts::Kind k = tiles.patches[p].kind;
-        // (An umbra proven by the ray from its centre has no list: its texels search the
-        // hierarchy.)
-        if (k == TileShafts::Kind::listed ||
-            (k == TileShafts::Kind::umbra && corners && !tiles.patches[p].candidates.empty())) {
+        if (k == TileShafts::Kind::listed || (k == TileShafts::Kind::umbra && corners)) {
           prepared_of_[p] = std::int32_t(prepare.size());
           prepare.push_back(p);
         }
@@ -249,9 +280,24 @@ class LightPairs final : public PairSource {
     }
     prepared_.resize(prepare.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, prepare.size(), 8), [&](const auto& r) {
+      std::vector<std::uint32_t> listed;
       for (std::size_t k = r.begin(); k != r.end(); ++k) {
         const TileShafts::Patch& patch = tiles.patches[prepare[k]];
-        prepared_[k] = tile_blockers(*in.culler, light, patch.candidates, patch.origins, offset_);
+        const std::vector<std::uint32_t>* candidates = &patch.candidates;
+        // An umbra the shaft test proved without listing its candidates (tile_shafts.cpp):
+        // listed here, where its texels are cells' corners; where they are too many, its
+        // texels search the hierarchy.
+        if (candidates->empty()) {
+          if (!in.culler->tile_candidates(patch.origins, light, kTileCandidates, listed) ||
+              listed.empty()) {
+            prepared_of_[prepare[k]] = -1;
+            continue;
+          }
+          std::sort(listed.begin(), listed.end());
+          candidates = &listed;
+        }
+        prepared_[k] =
+            tile_blockers(*in.culler, light, *candidates, patch.origins, offset_, piercing_);
       }
     });
   }
@@ -341,12 +387,14 @@ class LightPairs final : public PairSource {
       const ShaftCuller::Polygons listed = in_.culler->shaft_polygons(
           origin, p, n, light_, nullptr, std::size_t(in_.max_polygons), polygons);
       if (listed == ShaftCuller::Polygons::too_many) return traced();
-      for (const ShaftPolygon& poly : polygons)
-        blockers.push_back({poly.v.data(), poly.count, poly.normal, poly.triangle});
-      // The union of what samples see is kept by key (a solid's triangles as the solid).
-      for (BlockerPolygon& b : blockers) {
-        b.source = b.triangle;
-        b.triangle = in_.culler->blocker_key(b.triangle);
+      // The union of what samples see is kept by key (a solid's triangles as the solid); a
+      // triangle through the light's ball goes as its parts outside it.
+      for (const ShaftPolygon& poly : polygons) {
+        const std::uint32_t key = in_.culler->blocker_key(poly.triangle);
+        if (piercing_.pierces(poly.triangle))
+          add_parts(piercing_, poly.triangle, key, poly.normal, blockers);
+        else
+          blockers.push_back({poly.v.data(), poly.count, poly.normal, key, poly.triangle});
       }
       sample = estimator_.visibility(p, n, origin, Blockers{&blockers, nullptr, nullptr},
                                      form_factor, &out.triangles);
@@ -416,6 +464,12 @@ class LightPairs final : public PairSource {
       for (std::size_t j = k; j < end; ++j) {
         origins.push_back(space_.ray_origin(texels[j], offset_));
         box.extend(origins.back());
+      }
+      // A clear or umbra patch's texels hold their exact values already: the cell interpolates
+      // none of them.
+      if (patch.kind == TileShafts::Kind::clear || patch.kind == TileShafts::Kind::umbra) {
+        k = end;
+        continue;
       }
       if (patch.kind != TileShafts::Kind::listed) {
         for (std::size_t j = k; j < end; ++j) {
@@ -528,6 +582,7 @@ class LightPairs final : public PairSource {
   const TileShafts& tiles_;
   double offset_;
   PenumbraEstimator estimator_;
+  PiercingBlockers piercing_;  // the triangles through a sphere light's ball
   // The listed patches' blockers, and some umbrae's (above); per patch, its place among them or
   // -1.
   std::vector<TileBlockers> prepared_;
@@ -538,47 +593,54 @@ class LightPairs final : public PairSource {
 // estimate at `samples` rays: a textured light's (the estimator weighs a uniform light only), or a
 // point's at one ray, which is exact (its shadows are hard: nothing to estimate or interpolate).
 void bake_light_by_rays(const TexelSpace& space, const TexelGrid& grid,
-                        const BackprojectionInputs& in, std::size_t l, int samples, LightMix& mix,
-                        RouteCounts& counts) {
+                        const BackprojectionInputs& in, std::span<const std::uint32_t> in_reach,
+                        std::size_t l, int samples, LightMix& mix, RouteCounts& counts) {
   const Light& light = (*in.lights)[l];
   const double offset = in.rays->surface_offset();
-  const TileShafts tiles =
-      tile_shafts(space, grid, *in.culler, *in.rays, light, kTileCandidates, /*umbrae=*/false);
+  const TileShafts tiles = tile_shafts(space, grid, *in.culler, *in.rays, light, kTileCandidates,
+                                       /*umbrae=*/false, in_reach);
   // Counted: the kept rows' texels (a tile's halo is not).
   const auto kept = kept_texels(space);
   const std::size_t kept0 = kept.first, kept1 = kept.second;
   std::atomic<std::int64_t> clear{0}, traced{0}, rays{0};
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, space.texels.size(), 64), [&](const auto& r) {
-        ShadowRays batch(samples);
-        std::vector<Vec2> strata;
-        std::int64_t local_clear = 0, local_traced = 0, local_rays = 0;
-        for (std::size_t t = r.begin(); t != r.end(); ++t) {
-          const Texel& tx = space.texels[t];
-          const Vec3 p = tx.position.cast<double>(), n = tx.normal.cast<double>();
-          if (!light.reaches(p, n)) continue;
-          const TileShafts::Patch& patch = tiles.patch(tx.x, tx.y);
-          if (patch.kind == TileShafts::Kind::clear ||
-              !in.culler->maybe_blocked(
-                  space.ray_origin(t, offset), p, n, light,
-                  patch.kind == TileShafts::Kind::listed ? &patch.candidates : nullptr)) {
-            mix.set(l, t, Vec3::Ones());
-            local_clear += t >= kept0 && t < kept1;
-            continue;
-          }
-          Vec3 v;
-          if (!estimate_visibility(space, t, light, *in.rays, samples, in.seed, in.stream, batch,
-                                   strata, &v))
-            continue;
-          mix.set(l, t, v);
-          if (t < kept0 || t >= kept1) continue;
-          ++local_traced;
-          local_rays += batch.size();
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, in_reach.size(), 1), [&](const auto& r) {
+    ShadowRays batch(samples);
+    std::vector<Vec2> strata;
+    std::int64_t local_clear = 0, local_traced = 0, local_rays = 0;
+    for (std::size_t k = r.begin(); k != r.end(); ++k) {
+      const std::size_t tile = in_reach[k];
+      const int x0 = int(tile % std::size_t(tiles.tiles_x)) * TileShafts::kTile;
+      const int y0 = int(tile / std::size_t(tiles.tiles_x)) * TileShafts::kTile;
+      for (int j = 0; j < TileShafts::kTile * TileShafts::kTile; ++j) {
+        const int x = x0 + j % TileShafts::kTile, y = y0 + j / TileShafts::kTile;
+        const std::int32_t texel = grid.texel(x, y);
+        if (texel < 0 || !tiles.reached_at(x, y)) continue;
+        const std::size_t t = std::size_t(texel);
+        const Texel& tx = space.texels[t];
+        const Vec3 p = tx.position.cast<double>(), n = tx.normal.cast<double>();
+        const TileShafts::Patch& patch = tiles.patch(x, y);
+        if (patch.kind == TileShafts::Kind::clear ||
+            !in.culler->maybe_blocked(
+                space.ray_origin(t, offset), p, n, light,
+                patch.kind == TileShafts::Kind::listed ? &patch.candidates : nullptr)) {
+          mix.set(l, t, x, y, Vec3::Ones());
+          local_clear += t >= kept0 && t < kept1;
+          continue;
         }
-        clear += local_clear;
-        traced += local_traced;
-        rays += local_rays;
-      });
+        Vec3 v;
+        if (!estimate_visibility(space, t, light, *in.rays, samples, in.seed, in.stream, batch,
+                                 strata, &v))
+          continue;
+        mix.set(l, t, x, y, v);
+        if (t < kept0 || t >= kept1) continue;
+        ++local_traced;
+        local_rays += batch.size();
+      }
+    }
+    clear += local_clear;
+    traced += local_traced;
+    rays += local_rays;
+  });
   counts[TexelRoute::clear] += clear;
   counts[TexelRoute::traced] += traced;
   counts.rays += rays;
@@ -594,12 +656,14 @@ std::int64_t RouteCounts::reached() const {
 
 namespace {
 
-// Light l's field over the receiver whose texel grid (light-independent) is `grid`.
+// Light l's field over the receiver whose texel grid (light-independent) is `grid`, over the
+// tiles `in_reach` (the rest are empty).
 LightField light_field(const TexelSpace& space, const TexelGrid& grid,
-                       const BackprojectionInputs& in, std::size_t l) {
+                       const BackprojectionInputs& in, std::span<const std::uint32_t> in_reach,
+                       std::size_t l) {
   const Light& light = (*in.lights)[l];
-  const TileShafts tiles =
-      tile_shafts(space, grid, *in.culler, *in.rays, light, kTileCandidates, /*umbrae=*/true);
+  const TileShafts tiles = tile_shafts(space, grid, *in.culler, *in.rays, light, kTileCandidates,
+                                       /*umbrae=*/true, in_reach);
   const LightPairs pairs(space, light, in, tiles);
   return refine_light(space, grid, tiles, pairs, in.refinement);
 }
@@ -608,40 +672,54 @@ LightField light_field(const TexelSpace& space, const TexelGrid& grid,
 
 LightField backprojection_light(const TexelSpace& space, const BackprojectionInputs& in,
                                 std::size_t l) {
-  return light_field(space, TexelGrid(space), in, l);
+  const LightLists lists(space, *in.lights);
+  return light_field(space, TexelGrid(space), in, lists.blocks_of(l), l);
 }
 
 MixedImages bake_backprojection(const TexelSpace& space, const BackprojectionInputs& in,
                                 RouteCounts* routes) {
   const std::vector<Light>& lights = *in.lights;
-  LightMix mix(space, lights, in.quantity, LightMix::Order::light_major, in.keep_per_light);
+  std::optional<LightLists> own;
+  const LightLists& lists = in.lists ? *in.lists : own.emplace(space, lights);
+  LightMix mix(space, lights, in.quantity, LightMix::Order::light_major, in.keep_per_light, &lists);
   RouteCounts counts;
   // Counted: the kept rows' texels (a tile's halo is not).
   const auto kept = kept_texels(space);
   const std::size_t kept0 = kept.first, kept1 = kept.second;
   const TexelGrid grid(space);  // built once: it does not depend on the light
   for (std::size_t l = 0; l < lights.size(); ++l) {
+    // The tiles the light may reach (its lists' blocks): its cost follows its reach.
+    const std::span<const std::uint32_t> in_reach = lists.blocks_of(l);
+    if (in_reach.empty()) continue;
     if (lights[l].textured() || lights[l].is_point()) {
-      bake_light_by_rays(space, grid, in, l, lights[l].is_point() ? 1 : in.samples, mix, counts);
+      bake_light_by_rays(space, grid, in, in_reach, l, lights[l].is_point() ? 1 : in.samples, mix,
+                         counts);
       continue;
     }
-    const LightField field = light_field(space, grid, in, l);
-    // Distinct texels in parallel (LightMix::set allows it), rows by rows through the grid (so
+    const LightField field = light_field(space, grid, in, in_reach, l);
+    // Distinct texels in parallel (LightMix::set allows it), tile by tile through the grid (so
     // that no texel's record is read), each range counting its routes.
     tbb::combinable<RouteCounts> local;
-    tbb::parallel_for(tbb::blocked_range<int>(0, space.height, 16),
-                      [&](const tbb::blocked_range<int>& rows) {
-                        RouteCounts& c = local.local();
-                        grid.for_each(rows.begin(), rows.end(), [&](std::size_t t, int x, int y) {
-                          const TexelRoute route = field.route_at(x, y);
-                          if (route == TexelRoute::none) return;
-                          mix.set(l, t, x, y, Vec3::Constant(double(field.visibility_at(x, y))));
-                          if (t < kept0 || t >= kept1) return;
-                          ++c[route];
-                          if (route == TexelRoute::traced)
-                            c.rays += in.light_rows * LightRows::kCells / 2;
-                        });
-                      });
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, in_reach.size(), 4), [&](const auto& range) {
+          RouteCounts& c = local.local();
+          for (std::size_t k = range.begin(); k != range.end(); ++k) {
+            const int x0 = int(in_reach[k] % std::uint32_t(lists.blocks_x())) * TileShafts::kTile;
+            const int y0 = int(in_reach[k] / std::uint32_t(lists.blocks_x())) * TileShafts::kTile;
+            for (int j = 0; j < TileShafts::kTile * TileShafts::kTile; ++j) {
+              const int x = x0 + j % TileShafts::kTile, y = y0 + j / TileShafts::kTile;
+              const std::int32_t texel = grid.texel(x, y);
+              if (texel < 0) continue;
+              const std::size_t t = std::size_t(texel);
+              const TexelRoute route = field.route_at(x, y);
+              if (route == TexelRoute::none) continue;
+              mix.set(l, t, x, y, Vec3::Constant(double(field.visibility_at(x, y))));
+              if (t < kept0 || t >= kept1) continue;
+              ++c[route];
+              if (route == TexelRoute::traced) c.rays += in.light_rows * LightRows::kCells / 2;
+            }
+          }
+        });
     local.combine_each([&](const RouteCounts& c) {
       for (std::size_t r = 0; r < c.pairs.size(); ++r) counts.pairs[r] += c.pairs[r];
       counts.rays += c.rays;

@@ -31,6 +31,8 @@ struct BackprojectionInputs {
   int samples = 256;
   std::uint64_t seed = 0, stream = 0;
   KeepPerLight keep_per_light;
+  // Which lights may reach each block of texels (light_lists.h); null: the bake makes them.
+  const LightLists* lists = nullptr;
 };
 
 // (light, texel) pairs by route (texel_routes.h), and the rays traced.

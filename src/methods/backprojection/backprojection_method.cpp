@@ -64,6 +64,7 @@ class BackprojectionMethod final : public Method {
     in.seed = settings.seed;
     in.stream = receiver.stream;
     in.keep_per_light = context_.keep_per_light;
+    in.lists = receiver.lists;
     RouteCounts routes;
     MethodResult result;
     result.images = bake_backprojection(*receiver.space, in, &routes);

@@ -102,6 +102,24 @@ struct Rasteriser {
   double gap_to(const Vec3& lo_corner, const Vec3& hi_corner) const {
     return (lo_corner - origin).cwiseMax(origin - hi_corner).cwiseMax(Vec3::Zero()).norm();
   }
+  // Whether the box lies wholly outside the cone from the origin around the light's ball (every
+  // ray the rows stand for runs inside it), by the box's bounding ball: a lower bound on its
+  // distance to the cone's side, perp·cos α − along·sin α, above the ball's radius. Cheaper than
+  // cutting and projecting a polygon that hides nothing.
+  // Whether the plane through `point` with unit normal `n` leaves the origin and the light's ball
+  // on one side: no ray from the origin to the light crosses it.
+  bool beside_plane(const Vec3& point, const Vec3& n) const {
+    const double h_from = n.dot(origin - point), h_ball = n.dot(f.ball_centre - point);
+    return f.ball_radius > 0 &&
+           ((h_from > 0 && h_ball > f.ball_radius) || (h_from < 0 && h_ball < -f.ball_radius));
+  }
+  bool outside_cone(const Vec3& lo_corner, const Vec3& hi_corner) const {
+    if (!(cone_cos > 0)) return false;
+    const Vec3 v = 0.5 * (lo_corner + hi_corner) - origin;
+    const double along = v.dot(cone_axis);
+    const double perp = (v - along * cone_axis).norm();
+    return perp * cone_cos - along * cone_sin > 0.5 * (hi_corner - lo_corner).norm();
+  }
 
   // One convex region of the light's plane, given by its outline's edges: the rows its t-range
   // holds (begin), each edge's crossing of them (edge), then each row's chord within the light
@@ -136,6 +154,10 @@ struct Rasteriser {
   const double h_top;  // above: behind the origin
   const Vec3 horizon;
   double extent_lo = kInfinity, extent_hi = -kInfinity;  // the rows' s-range
+  // The cone from the origin around the light's ball (outside_cone); cone_cos 0: none (the
+  // origin in the ball).
+  Vec3 cone_axis = Vec3::Zero();
+  double cone_sin = 1, cone_cos = 0;
   const double t_first, t_last;
   // A point (s, t) of the light's plane in world space: the frame's axes may be scaled (a
   // sphere's rows are those of the unit disk).
@@ -176,6 +198,13 @@ Rasteriser::Rasteriser(const RasterTarget& target)
   for (int r = 0; r < n; ++r) {
     extent_lo = std::min(extent_lo, rows.enter[std::size_t(r)]);
     extent_hi = std::max(extent_hi, rows.leave[std::size_t(r)]);
+  }
+  const Vec3 to = f.ball_centre - origin;
+  const double distance = to.norm();
+  if (f.ball_radius > 0 && distance > f.ball_radius * (1 + 1e-6)) {
+    cone_axis = to / distance;
+    cone_sin = f.ball_radius / distance;
+    cone_cos = std::sqrt(1 - cone_sin * cone_sin);
   }
 }
 
@@ -385,6 +414,8 @@ void Rasteriser::add_polygon(const BlockerPolygon& poly) {
   }
   const double gap = gap_to(box_lo, box_hi);
   covers = false;
+  // It hides none of the light where no ray to the light crosses its plane or comes near it.
+  if (beside_plane(poly.v[0], poly.normal) || outside_cone(box_lo, box_hi)) return;
   const bool reaches = add_blocker(poly.v, poly.count, poly.normal, gap);
   // One polygon, clear of the origin, covering the whole light: its umbra, convex as a convex
   // solid's is (a tree crown's facet over a texel in the sun's shadow), so refinement may

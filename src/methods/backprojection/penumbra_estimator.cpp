@@ -147,6 +147,7 @@ PenumbraEstimator::PenumbraEstimator(const Light& light, int rows, double light_
     double t_min = kInfinity, t_max = -kInfinity;
     for (std::size_t k = 0; k < 4; ++k) {
       const Vec3 offset = outline[k] - light.centre();
+      ball_radius_ = std::max(ball_radius_, offset.norm() * (1 + 1e-9));
       corners_[k] = Vec2(offset.dot(row_axis_s_), offset.dot(row_axis_t_));
       t_min = std::min(t_min, corners_[k].y());
       t_max = std::max(t_max, corners_[k].y());
@@ -175,6 +176,7 @@ PenumbraEstimator::PenumbraEstimator(const Light& light, int rows, double light_
   }
   // A disk of radius R (a sphere's unit disk, scaled per texel): ∫ of its chord 2·√(R² − t²).
   const double radius = light.shape() == LightShape::disk ? light.desc().radius : 1.0;
+  ball_radius_ = light.desc().radius * (1 + 1e-9);
   rows_.pitch = 2 * radius / n;
   rows_.first = -radius + 0.5 * rows_.pitch;
   const auto below = [&](double t) {
@@ -202,6 +204,8 @@ bool PenumbraEstimator::frame(const Vec3& position, LightFrame& f) const {
     f.t_axis = row_axis_t_;
     f.radius = light.shape() == LightShape::disk ? light.desc().radius : 0.0;
     f.clip_height = light_offset_;
+    f.ball_centre = light.centre();
+    f.ball_radius = ball_radius_;
     return true;
   }
   // The silhouette of the sphere seen from the texel, as the reference samples it: a disk of
@@ -220,6 +224,8 @@ bool PenumbraEstimator::frame(const Vec3& position, LightFrame& f) const {
   f.t_axis = -s * a + c * b;
   f.radius = radius * std::sqrt(std::max(0.0, dist * dist - radius * radius)) / dist;
   f.clip_height = 0;
+  f.ball_centre = light.centre();
+  f.ball_radius = ball_radius_;
   return true;
 }
 
@@ -314,9 +320,10 @@ const LightRows& PenumbraEstimator::rows_for(const LightFrame& f, const Vec3& po
 namespace {
 
 // A row's exact intervals in order of their starts (insertion sort: a handful).
-std::array<std::pair<double, double>, kExactIntervals> sorted_intervals(
-    const BlockedRows::Row& row) {
-  std::array<std::pair<double, double>, kExactIntervals> sorted = row.intervals;
+std::array<BlockedRows::Interval, kExactIntervals> sorted_intervals(const BlockedRows::Row& row) {
+  std::array<BlockedRows::Interval, kExactIntervals> sorted;
+  std::copy(row.intervals.begin(), row.intervals.begin() + std::min(row.count, kExactIntervals),
+            sorted.begin());
   for (int k = 1; k < row.count; ++k)
     for (int j = k; j > 0 && sorted[std::size_t(j)] < sorted[std::size_t(j - 1)]; --j)
       std::swap(sorted[std::size_t(j)], sorted[std::size_t(j - 1)]);
@@ -454,7 +461,7 @@ PenumbraSample PenumbraEstimator::visibility(const Vec3& position, const Vec3& n
   if (!frame(position, f)) return out;
   LightRows scratch;
   const LightRows& rows = rows_for(f, position, normal, scratch);
-  BlockedRows blocked;
+  BlockedRows blocked(rows.count);
   if (blocking) blocking->clear();
   const RasterTarget target{&f,       &rows, origin,  position, normal, light_offset_,
                             &blocked, &out,  blocking};
@@ -531,7 +538,7 @@ PenumbraSample PenumbraEstimator::visibility_traced(const Vec3& position, const 
   for (std::size_t i = 0; i < t_hit.size(); ++i)
     if (t_hit[i] >= 0)
       out.nearest_blocker = std::min(out.nearest_blocker, t_hit[i] * probe_directions[i].norm());
-  BlockedRows blocked;
+  BlockedRows blocked(n);
   for (int r = 0; r < n; ++r) {
     BlockedRows::Row& row = blocked.rows[std::size_t(r)];
     row.count = kExactIntervals + 1;

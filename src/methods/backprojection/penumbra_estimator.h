@@ -63,7 +63,7 @@ struct LightRows {
   int count = 0;
   double pitch = 0, first = 0;
   bool whole = true;  // across the whole light; false: across the part above a texel's horizon
-  std::array<double, kMaxRows> enter{}, leave{};
+  std::array<double, kMaxRows> enter, leave;  // rows [0, count) written
 };
 
 // One edge of a dense mesh's triangle that may bound the union of a tile's triangles of it.
@@ -182,6 +182,7 @@ class PenumbraEstimator {
   double light_offset_;
   Vec3 row_axis_s_, row_axis_t_;  // a rectangle's, disk's or polygon's frame (world)
   std::array<Vec2, 4> corners_;   // a rectangle's or polygon's corners in (s, t)
+  double ball_radius_ = 0;        // of a ball about the light's centre that holds it
 };
 
 // Whether the triangle `corners` hides all of `light` from `origin` (exactly: every segment from

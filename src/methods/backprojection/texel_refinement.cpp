@@ -110,12 +110,7 @@ class Refinement {
 
   Refinement(const TexelSpace& space, const TexelGrid& grid, const TileShafts& tiles,
              const PairSource& source, const RefinementSettings& settings)
-      : space_(space),
-        grid_(grid),
-        tiles_(tiles),
-        source_(source),
-        settings_(settings),
-        reached_(tiles.reached) {}
+      : space_(space), grid_(grid), tiles_(tiles), source_(source), settings_(settings) {}
 
   // The tiles' places in the field, and every texel's first value and state.
   void place_tiles();
@@ -146,7 +141,9 @@ class Refinement {
     const Kind kind = kind_at(tx, ty);
     return kind == Kind::listed || kind == Kind::all;
   }
-  bool is_reached(std::int32_t t) const { return t >= 0 && reached_[std::size_t(t)]; }
+  // Whether the light reaches the texel at pixel (x, y), `t` (-1: none is covered there).
+  bool is_reached(std::int32_t t, int x, int y) const { return t >= 0 && tiles_.reached_at(x, y); }
+  bool is_reached(int x, int y) const { return is_reached(grid_.texel(x, y), x, y); }
   // A texel's place in the arrays: every texel a cell's checks read has one (the cells' own, and
   // their corners but clear ones, which are valued and hold what `none_` holds, and the
   // uncovered or unreached ones, which no check reads past `reached`).
@@ -167,6 +164,7 @@ class Refinement {
                            const std::array<std::int64_t, 5>& places, bool all_zero,
                            const Bounds3& box, double texel_extent) const;
   bool midpoints_agree(const Cell& c) const;
+  bool settled(const Cell& c) const;
   void interpolate(const Cell& c);
 
   const TexelSpace& space_;
@@ -174,7 +172,6 @@ class Refinement {
   const TileShafts& tiles_;
   const PairSource& source_;
   const RefinementSettings& settings_;
-  const FreshVector<std::uint8_t>& reached_;
   std::vector<std::size_t> slotted_;  // the tiles with a place, in order of it
   FreshVector<std::uint8_t> state_;
   // The evaluated texels' samples, in order of evaluation (a level's at a time), and each
@@ -189,13 +186,15 @@ class Refinement {
 // umbra tiles the light reaches in part (a covered texel of theirs is not reached).
 void Refinement::place_tiles() {
   const std::size_t tile_count = tiles_.kind.size();
-  std::vector<std::uint8_t> partly(tile_count, 0);
-  tbb::parallel_for(tbb::blocked_range<int>(0, tiles_.tiles_y), [&](const auto& r) {
-    grid_.for_each(r.begin() * kTile, std::min(space_.height, r.end() * kTile),
-                   [&](std::size_t t, int x, int y) {
-                     if (!reached_[t]) partly[tiles_.tile_of(x, y)] = 1;
-                   });
-  });
+  // A tile the light reaches (its kind not empty) holding a covered texel it does not reach.
+  const auto partly = [&](std::size_t i) {
+    const int x0 = int(i % std::size_t(tiles_.tiles_x)) * kTile;
+    const int y0 = int(i / std::size_t(tiles_.tiles_x)) * kTile;
+    std::uint64_t covered = 0;
+    for (int j = 0; j < kTile * kTile; ++j)
+      if (grid_.texel(x0 + j % kTile, y0 + j / kTile) >= 0) covered |= std::uint64_t(1) << j;
+    return (covered & ~tiles_.reached[i]) != 0;
+  };
   field.tiles_x = tiles_.tiles_x;
   field.slot.assign(tile_count, -1);
   field.tile_route.assign(tile_count, TexelRoute::none);
@@ -205,7 +204,7 @@ void Refinement::place_tiles() {
       const Kind kind = tiles_.kind[i];
       const bool corners = kind == Kind::umbra && (cells_in(tx - 1, ty) || cells_in(tx, ty - 1) ||
                                                    cells_in(tx - 1, ty - 1));
-      if (cells_in(tx, ty) || corners || (kind != Kind::empty && partly[i])) {
+      if (cells_in(tx, ty) || corners || (kind != Kind::empty && partly(i))) {
         field.slot[i] = std::int32_t(slotted_.size());
         slotted_.push_back(i);
       } else {
@@ -230,7 +229,7 @@ void Refinement::first_writes() {
       const int x0 = int(tile % std::size_t(tiles_.tiles_x)) * kTile;
       const int y0 = int(tile / std::size_t(tiles_.tiles_x)) * kTile;
       for (int j = 0; j < kTile * kTile; ++j) {
-        const bool lit = is_reached(grid_.texel(x0 + j % kTile, y0 + j / kTile));
+        const bool lit = is_reached(x0 + j % kTile, y0 + j / kTile);
         // The texel's own patch's kind (a tile's patches may differ).
         const Kind kind = lit ? tiles_.kind_at(x0 + j % kTile, y0 + j / kTile) : Kind::empty;
         const bool clear = lit && kind == Kind::clear, umbra = lit && kind == Kind::umbra;
@@ -263,7 +262,7 @@ std::vector<Cell> Refinement::first_cells() const {
 // sample would.
 void Refinement::enqueue(int x, int y, bool umbra_too, std::vector<Queued>& queue) {
   const std::int32_t t = grid_.texel(x, y);
-  if (!is_reached(t)) return;
+  if (!is_reached(t, x, y)) return;
   const std::int64_t at = place(x, y);
   if (at < 0 || state_[std::size_t(at)] == kQueued) return;
   const TexelRoute route = field.route[std::size_t(at)];
@@ -299,7 +298,7 @@ Refinement::Verdict Refinement::verdict(const Cell& c) const {
   std::array<std::int64_t, 5> places;
   for (std::size_t k = 0; k < 5; ++k) {
     at[k] = grid_.texel(xs[k], ys[k]);
-    if (!is_reached(at[k])) return kFail;
+    if (!is_reached(at[k], xs[k], ys[k])) return kFail;
     places[k] = place(xs[k], ys[k]);
     if (!valued(places[k])) return kFail;
   }
@@ -327,7 +326,7 @@ Refinement::Verdict Refinement::verdict(const Cell& c) const {
   for (int y = c.y0; y < c.y0 + s; ++y)
     for (int x = c.x0; x < c.x0 + s; ++x) {
       const std::int32_t t = grid_.texel(x, y);
-      if (!is_reached(t)) continue;
+      if (!is_reached(t, x, y)) continue;
       const Texel& tx = space_.texels[std::size_t(t)];
       const double u = double(x - c.x0) / s, w = double(y - c.y0) / s;
       const Vec3 bilinear = (1 - w) * ((1 - u) * p00 + u * p10) + w * ((1 - u) * p01 + u * p11);
@@ -375,7 +374,7 @@ Refinement::Verdict Refinement::blockers_verdict(const Cell& c,
   for (int y = c.y0; y < c.y0 + s; ++y)
     for (int x = c.x0; x < c.x0 + s; ++x) {
       const std::int32_t t = grid_.texel(x, y);
-      if (is_reached(t)) inside.push_back(std::size_t(t));
+      if (is_reached(t, x, y)) inside.push_back(std::size_t(t));
     }
   // All five 0, and every texel in the umbra of a ball inside one closed blocker they saw
   // (a tree crown, lumpy, that no one of its facets hides the light behind), or all five in
@@ -413,7 +412,7 @@ std::array<std::array<int, 6>, 4> edges(const Cell& c) {
 // interpolation's value there (linear along the cell's sides).
 bool Refinement::midpoints_agree(const Cell& c) const {
   for (const auto& [mx, my, ax, ay, bx, by] : edges(c)) {
-    if (!is_reached(grid_.texel(mx, my)) || !valued(place(mx, my))) return false;
+    if (!is_reached(mx, my) || !valued(place(mx, my))) return false;
     if (std::abs(visibility(mx, my) - 0.5 * (visibility(ax, ay) + visibility(bx, by))) >
         settings_.tolerance)
       return false;
@@ -430,7 +429,7 @@ void Refinement::interpolate(const Cell& c) {
   for (int y = c.y0; y < c.y0 + s; ++y)
     for (int x = c.x0; x < c.x0 + s; ++x) {
       const std::size_t at = std::size_t(place(x, y));  // the cell's own: its tile has one
-      if (!is_reached(grid_.texel(x, y)) || state_[at] == kValued) continue;
+      if (!is_reached(x, y) || state_[at] == kValued) continue;
       const double u = double(x - c.x0) / s, w = double(y - c.y0) / s;
       // (a, b, corner_a, corner_b): the triangle's coordinates and its two corners, so that
       // V = 2b·vc + (a − b)·corner_b + (1 − a − b)·corner_a.
@@ -450,7 +449,23 @@ void Refinement::interpolate(const Cell& c) {
     }
 }
 
-std::vector<Cell> Refinement::refine_level(const std::vector<Cell>& cells) {
+// Whether every texel the light reaches that cell c owns is valued exactly already (a clear or
+// umbra patch's, tile_shafts.h): the cell has nothing to interpolate, and its samples need not
+// be evaluated (a cell beside it evaluates the corners it shares when it needs them).
+bool Refinement::settled(const Cell& c) const {
+  for (int y = c.y0; y < c.y0 + c.size; ++y)
+    for (int x = c.x0; x < c.x0 + c.size; ++x) {
+      if (!is_reached(x, y)) continue;
+      const std::size_t at = std::size_t(place(x, y));
+      if (state_[at] != kValued || field.route[at] == TexelRoute::interpolated) return false;
+    }
+  return true;
+}
+
+std::vector<Cell> Refinement::refine_level(const std::vector<Cell>& given) {
+  std::vector<Cell> cells;
+  for (const Cell& c : given)
+    if (!settled(c)) cells.push_back(c);
   // Their samples, each evaluated once.
   std::vector<Queued> queue;
   for (const Cell& c : cells) {
@@ -509,7 +524,8 @@ void Refinement::evaluate_rest() {
     for (int j = 0; j < kTile * kTile; ++j) {
       const std::int32_t t = grid_.texel(x0 + j % kTile, y0 + j / kTile);
       const std::size_t at = s * std::size_t(kTile * kTile) + std::size_t(j);
-      if (is_reached(t) && state_[at] != kValued) rest.push_back({std::size_t(t), at});
+      if (is_reached(t, x0 + j % kTile, y0 + j / kTile) && state_[at] != kValued)
+        rest.push_back({std::size_t(t), at});
     }
   }
   evaluate_all(rest);

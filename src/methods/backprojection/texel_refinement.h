@@ -85,10 +85,17 @@ struct TileShafts {
   // tile (row-major), its texel's patch within the tile.
   std::vector<std::int32_t> mixed;
   std::vector<std::array<std::uint8_t, kTile * kTile>> patch_at;
-  FreshVector<std::uint8_t> reached;  // per texel: 1 where the light reaches it (H0 > 0)
+  // Per tile, a bit per pixel (row-major within the tile): 1 where a covered texel lies that the
+  // light reaches (H0 > 0); 0 throughout a tile the light's lists leave out.
+  std::vector<std::uint64_t> reached;
   std::size_t tile_of(int x, int y) const {
     return std::size_t(y / kTile) * std::size_t(tiles_x) + std::size_t(x / kTile);
   }
+  static std::uint64_t bit_of(int x, int y) {
+    return std::uint64_t(1) << ((y % kTile) * kTile + x % kTile);
+  }
+  // Whether the light reaches the texel at pixel (x, y), which lies in the lightmap.
+  bool reached_at(int x, int y) const { return (reached[tile_of(x, y)] & bit_of(x, y)) != 0; }
   // The patch of the texel at pixel (x, y), covered and reached.
   const Patch& patch(int x, int y) const {
     const std::size_t tile = tile_of(x, y);

@@ -19,12 +19,15 @@ namespace sb {
 bool hides_from_all(const Light& light, const Vec3* corners, std::span<const Vec3> points,
                     double offset);
 
-// Every tile's shaft test for `light`, patch by patch (TileShafts; ShaftCuller::tile_candidates,
-// at most `max` candidates a patch): clear, listed, all, or, with `umbrae`, an umbra where a
-// triangle hides all of the light from the eight corners of its box of ray origins (so from
-// every one of them: a triangle's umbra is convex): the triangle the ray from the box's centre to
-// the light's centre meets, or one of its candidates. `rays`: those rays, and the surface offset.
+// The shaft test of each of the tiles `in_reach` (indices, ascending: the blocks the light's
+// lists give it, methods/light_lists.h; every other tile is empty) for `light`, patch by patch
+// (TileShafts; ShaftCuller::tile_candidates, at most `max` candidates a patch): clear, listed,
+// all, or, with `umbrae`, an umbra where a triangle hides all of the light from the eight
+// corners of its box of ray origins (so from every one of them: a triangle's umbra is convex):
+// the triangle the ray from the box's centre to the light's centre meets, or one of its
+// candidates. `rays`: those rays, and the surface offset.
 TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const ShaftCuller& culler,
-                       const RayScene& rays, const Light& light, std::size_t max, bool umbrae);
+                       const RayScene& rays, const Light& light, std::size_t max, bool umbrae,
+                       std::span<const std::uint32_t> in_reach);
 
 }  // namespace sb

@@ -44,7 +44,7 @@ TileShafts listed_tiles() {
   tiles.patches.assign(tiles.kind.size(), {TileShafts::Kind::listed, {7}, Bounds3()});
   tiles.first_patch.resize(tiles.kind.size() + 1);
   for (std::size_t i = 0; i <= tiles.kind.size(); ++i) tiles.first_patch[i] = std::uint32_t(i);
-  tiles.reached.assign(kSide * kSide, 1);
+  tiles.reached.assign(tiles.kind.size(), ~std::uint64_t(0));
   return tiles;
 }
 
@@ -281,9 +281,9 @@ TEST(TexelRefinement, TilesWithoutPlacesHoldTheirKindsValue) {
   tiles.kind[at(0, 7)] = Kind::empty;
   for (std::size_t i = 0; i < tiles.kind.size(); ++i) tiles.patches[i].kind = tiles.kind[i];
   for (int y = 0; y < k; ++y)  // the light reaches only the left half of tile (5, 0)
-    for (int x = 5 * k + k / 2; x < 6 * k; ++x) tiles.reached[std::size_t(y * kSide + x)] = 0;
-  for (int y = 7 * k; y < 8 * k; ++y)  // nor any of the empty tile
-    for (int x = 0; x < k; ++x) tiles.reached[std::size_t(y * kSide + x)] = 0;
+    for (int x = 5 * k + k / 2; x < 6 * k; ++x)
+      tiles.reached[tiles.tile_of(x, y)] &= ~TileShafts::bit_of(x, y);
+  tiles.reached[at(0, 7)] = 0;  // nor any of the empty tile
   // A field with a kink inside the cells' tile, whose corners in the umbra are evaluated.
   const auto field_at = [](int x, int) { return x < 20 ? 1.0 : 0.25; };
   FieldSource source(space, field_at);
@@ -292,7 +292,7 @@ TEST(TexelRefinement, TilesWithoutPlacesHoldTheirKindsValue) {
   int corners = 0;
   for (const Texel& t : space.texels) {
     const Kind kind = tiles.kind[at(t.x / k, t.y / k)];
-    const bool reached = tiles.reached[std::size_t(t.y * kSide + t.x)] != 0;
+    const bool reached = tiles.reached_at(t.x, t.y);
     const TexelRoute route = field.route_at(t.x, t.y);
     const float v = field.visibility_at(t.x, t.y);
     if (!reached) {

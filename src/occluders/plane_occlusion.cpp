@@ -1,0 +1,233 @@
+// plane_hides_light (plane_occlusion.h): the blocker triangles of one plane, together, between a
+// box of points and a light.
+#include "occluders/plane_occlusion.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <utility>
+#include <vector>
+
+namespace sb {
+
+namespace {
+
+// Planes tried per box: the first few the ray from its centre to the light's centre crosses (a
+// wall's two faces, and one more).
+constexpr int kPlanesTried = 3;
+// A triangle lies in the plane where each corner lies within this of it, metres, plus a
+// ten-millionth of the corner's distance from the origin (a level's float coordinates).
+constexpr double kInPlane = 1e-5;
+constexpr double kInPlaneRelative = 1e-7;
+// What is left of the crossings' polygon, as a share of its area, under which it counts as
+// covered: slivers along the triangles' shared edges, from rounding.
+constexpr double kUncovered = 1e-7;
+// The most convex pieces the subtraction may hold before it gives up (a wall of many small
+// triangles over a hole).
+constexpr std::size_t kMaxPieces = 256;
+
+using Polygon = std::vector<Vec2>;  // convex, counter-clockwise
+
+double area(const Polygon& p) {
+  double twice = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const Vec2& a = p[i];
+    const Vec2& b = p[(i + 1) % p.size()];
+    twice += a.x() * b.y() - a.y() * b.x();
+  }
+  return 0.5 * twice;
+}
+
+// 2 × the signed area of (a, b, p): > 0 where p lies left of a → b.
+double side(const Vec2& a, const Vec2& b, const Vec2& p) {
+  return (b.x() - a.x()) * (p.y() - a.y()) - (b.y() - a.y()) * (p.x() - a.x());
+}
+
+// The part of `p` on the left of a → b (`left`) or on its right.
+Polygon clip(const Polygon& p, const Vec2& a, const Vec2& b, bool left) {
+  Polygon out;
+  const auto inside = [&](double s) { return left ? s >= 0 : s <= 0; };
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const Vec2& u = p[i];
+    const Vec2& v = p[(i + 1) % p.size()];
+    const double su = side(a, b, u), sv = side(a, b, v);
+    if (inside(su)) out.push_back(u);
+    if ((su > 0 && sv < 0) || (su < 0 && sv > 0)) out.push_back(u + (v - u) * (su / (su - sv)));
+  }
+  return out;
+}
+
+// The convex hull of `points`, counter-clockwise (Andrew's monotone chain).
+Polygon convex_hull(std::vector<Vec2> points) {
+  std::sort(points.begin(), points.end(), [](const Vec2& a, const Vec2& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  if (points.size() < 3) return {};
+  Polygon hull(2 * points.size());
+  std::size_t k = 0;
+  for (const Vec2& p : points) {
+    while (k >= 2 && side(hull[k - 2], hull[k - 1], p) <= 0) --k;
+    hull[k++] = p;
+  }
+  for (std::size_t i = points.size() - 1, lower = k + 1; i-- > 0;) {
+    while (k >= lower && side(hull[k - 2], hull[k - 1], points[i]) <= 0) --k;
+    hull[k++] = points[i];
+  }
+  hull.resize(k - 1);
+  return hull;
+}
+
+// The corners of a polytope that holds every point a shadow ray may end at: a rectangle's or
+// polygon's own, the square around a disk in its plane, the cube around a sphere. None for the
+// other shapes.
+std::vector<Vec3> light_corners(const Light& light) {
+  std::vector<Vec3> corners;
+  std::array<Vec3, 4> outline;
+  switch (light.shape()) {
+    case LightShape::rectangle:
+    case LightShape::polygon: {
+      const int count = light.outline(outline);
+      corners.assign(outline.begin(), outline.begin() + count);
+      break;
+    }
+    case LightShape::disk: {
+      const double r = light.desc().radius;
+      for (const double a : {-r, r})
+        for (const double b : {-r, r})
+          corners.push_back(light.centre() + a * light.right() + b * light.up());
+      break;
+    }
+    case LightShape::sphere: {
+      Bounds3 box;
+      box.extend(light.centre() - Vec3::Constant(light.desc().radius));
+      box.extend(light.centre() + Vec3::Constant(light.desc().radius));
+      for (int k = 0; k < 8; ++k) corners.push_back(box.corner(k));
+      break;
+    }
+    case LightShape::mesh:
+    case LightShape::sky:
+      break;
+  }
+  return corners;
+}
+
+// Whether the triangles lying in the plane of triangle `seed` cover every crossing of the plane
+// by a segment from the box's corners `box` to the light's `ends`.
+bool plane_covers(const ShaftCuller& culler, std::uint32_t seed, const std::array<Vec3, 8>& box,
+                  const std::vector<Vec3>& ends, double offset) {
+  const Vec3 n = culler.triangle_normal(seed);
+  const double d = n.dot(culler.triangle_corners(seed)[0]);
+  // The box wholly on one side, the light wholly on the other, each clear of the plane by more
+  // than a shadow ray skips.
+  std::array<double, 8> h_box;
+  for (std::size_t k = 0; k < 8; ++k) h_box[k] = n.dot(box[k]) - d;
+  const double sign = h_box[0] > 0 ? 1.0 : -1.0;
+  for (const double h : h_box)
+    if (!(sign * h > offset)) return false;
+  std::vector<double> h_end(ends.size());
+  for (std::size_t k = 0; k < ends.size(); ++k) {
+    h_end[k] = n.dot(ends[k]) - d;
+    if (!(-sign * h_end[k] > offset)) return false;
+  }
+  // The plane's frame, and the crossings' polygon in it.
+  const Vec3 u = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
+  const Vec3 v = n.cross(u);
+  const auto in_plane = [&](const Vec3& p) { return Vec2(u.dot(p), v.dot(p)); };
+  std::vector<Vec2> crossings;
+  for (std::size_t a = 0; a < 8; ++a)
+    for (std::size_t b = 0; b < ends.size(); ++b)
+      crossings.push_back(
+          in_plane((-h_end[b] * box[a] + h_box[a] * ends[b]) / (h_box[a] - h_end[b])));
+  const Polygon hull = convex_hull(std::move(crossings));
+  const double hull_area = hull.empty() ? 0.0 : area(hull);
+  if (!(hull_area > 0)) return false;
+  Vec2 lo = hull[0], hi = hull[0];
+  for (const Vec2& p : hull) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  // The blocker triangles whose boxes meet the polygon's (in space, as thick as a triangle may
+  // stand off the plane and count as in it), then those in the plane over the polygon's box,
+  // counter-clockwise in its frame.
+  Bounds3 slab;
+  for (const Vec2& p : hull) slab.extend(Vec3(d * n + p.x() * u + p.y() * v));
+  const double thick = kInPlane + kInPlaneRelative * std::max(slab.lo.norm(), slab.hi.norm());
+  slab.lo -= Vec3::Constant(thick), slab.hi += Vec3::Constant(thick);
+  thread_local std::vector<std::uint32_t> near;
+  culler.triangles_in_box(slab, near);
+  std::vector<std::array<Vec2, 3>> triangles;
+  for (const std::uint32_t i : near) {
+    const Vec3* c = culler.triangle_corners(i);
+    bool in = true;
+    for (int k = 0; k < 3 && in; ++k)
+      in = std::abs(n.dot(c[k]) - d) <= kInPlane + kInPlaneRelative * c[k].norm();
+    if (!in) continue;
+    std::array<Vec2, 3> t = {in_plane(c[0]), in_plane(c[1]), in_plane(c[2])};
+    const Vec2 t_lo = t[0].cwiseMin(t[1]).cwiseMin(t[2]), t_hi = t[0].cwiseMax(t[1]).cwiseMax(t[2]);
+    if ((t_hi.array() < lo.array()).any() || (t_lo.array() > hi.array()).any()) continue;
+    const double twice = side(t[0], t[1], t[2]);
+    if (twice == 0) continue;
+    if (twice < 0) std::swap(t[1], t[2]);
+    triangles.push_back(t);
+  }
+  // The largest first: a wall's big triangles leave the fewest pieces.
+  std::sort(triangles.begin(), triangles.end(), [](const auto& a, const auto& b) {
+    return side(a[0], a[1], a[2]) > side(b[0], b[1], b[2]);
+  });
+  const double negligible = kUncovered * hull_area;
+  std::vector<Polygon> pieces = {hull}, next;
+  for (const auto& t : triangles) {
+    next.clear();
+    for (const Polygon& piece : pieces) {
+      // The piece less the triangle: its parts outside each edge, in turn, of what is left.
+      Polygon rest = piece;
+      for (int e = 0; e < 3 && !rest.empty(); ++e) {
+        const Vec2& a = t[std::size_t(e)];
+        const Vec2& b = t[std::size_t((e + 1) % 3)];
+        Polygon outside = clip(rest, a, b, false);
+        if (outside.size() >= 3 && area(outside) > negligible) next.push_back(std::move(outside));
+        rest = clip(rest, a, b, true);
+        if (rest.size() < 3 || area(rest) <= negligible) rest.clear();
+      }
+    }
+    pieces.swap(next);
+    if (pieces.empty()) return true;
+    if (pieces.size() > kMaxPieces) return false;
+  }
+  return false;
+}
+
+}  // namespace
+
+bool plane_hides_light(const ShaftCuller& culler, const RayScene& rays, const Light& light,
+                       const Bounds3& origins, const RayScene::Hit* first) {
+  if (origins.empty()) return false;
+  const std::vector<Vec3> ends = light_corners(light);
+  if (ends.empty()) return false;
+  std::array<Vec3, 8> box;
+  for (int k = 0; k < 8; ++k) box[std::size_t(k)] = origins.corner(k);
+  const double offset = rays.surface_offset();
+  // Along the ray from the box's centre to the light's centre, plane after plane.
+  Vec3 from = origins.centre();
+  const Vec3 to = light.centre();
+  std::array<std::pair<Vec3, double>, kPlanesTried> tried;  // (unit normal, offset)
+  int planes = 0;
+  for (int k = 0; k < kPlanesTried; ++k) {
+    const RayScene::Hit hit = k == 0 && first ? *first : rays.first_hit_face(from, to - from, 1.0);
+    if (hit.face < 0) return false;  // nothing more between the centres
+    const std::uint32_t triangle = culler.triangle_of_face(hit.face);
+    const Vec3& n = culler.triangle_normal(triangle);
+    const double d = n.dot(culler.triangle_corners(triangle)[0]);
+    // A plane tried already (a wall's coplanar triangle further on) is not tried again.
+    const bool again = std::any_of(tried.begin(), tried.begin() + planes, [&](const auto& p) {
+      const double cosine = p.first.dot(n);
+      return std::abs(cosine) > 1 - 1e-9 && std::abs(p.second - (cosine > 0 ? d : -d)) < kInPlane;
+    });
+    if (!again) {
+      if (plane_covers(culler, triangle, box, ends, offset)) return true;
+      tried[std::size_t(planes++)] = {n, d};
+    }
+    // On past the hit.
+    from = from + (to - from) * std::min(1.0, hit.t + 1e-6);
+  }
+  return false;
+}
+
+}  // namespace sb
