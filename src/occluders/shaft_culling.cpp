@@ -43,10 +43,16 @@ struct Plane {
   double eval(const Vec3& x) const { return n.dot(x) - d; }
 };
 
-// A shaft's planes: at most 8 sides, the light's plane and the texel's horizon.
+// A shaft's planes: at most 8 sides, the light's plane and the texel's horizon; and the box
+// around the apex and the light's base, which holds every segment from the one to the other (a
+// box's six compares reject most of a level's nodes before the planes' dot products).
 struct Planes {
   std::array<Plane, 12> p;
   int n = 0;
+  Vec3 lo, hi;  // the box
+  bool misses(const Vec3& box_lo, const Vec3& box_hi) const {
+    return (box_hi.array() < lo.array()).any() || (box_lo.array() > hi.array()).any();
+  }
   void clear() { n = 0; }
   void push_back(const Plane& plane) { p[std::size_t(n++)] = plane; }
   const Plane* begin() const { return p.data(); }
@@ -277,10 +283,18 @@ struct ShaftCuller::Impl {
           e2 = axis.cross(e1);
         }
         // The octagon circumscribing the circle.
-        const double radius_scale = 1.0 / std::cos(std::numbers::pi / 8);
+        static const std::array<Vec2, 8> octagon = [] {
+          std::array<Vec2, 8> out;
+          const double radius_scale = 1.0 / std::cos(std::numbers::pi / 8);
+          for (int k = 0; k < 8; ++k) {
+            const double a = (k + 0.5) * std::numbers::pi / 4;
+            out[std::size_t(k)] = radius_scale * Vec2(std::cos(a), std::sin(a));
+          }
+          return out;
+        }();
         for (int k = 0; k < 8; ++k) {
-          const double a = (k + 0.5) * std::numbers::pi / 4;
-          base[std::size_t(k)] = centre + r * radius_scale * (std::cos(a) * e1 + std::sin(a) * e2);
+          const Vec2& o = octagon[std::size_t(k)];
+          base[std::size_t(k)] = centre + r * (o.x() * e1 + o.y() * e2);
         }
         corners = 8;
         break;
@@ -297,6 +311,15 @@ struct ShaftCuller::Impl {
     }
 
     planes.clear();
+    planes.lo = apex.lo, planes.hi = apex.hi;
+    for (int k = 0; k < corners; ++k) {
+      planes.lo = planes.lo.cwiseMin(base[std::size_t(k)]);
+      planes.hi = planes.hi.cwiseMax(base[std::size_t(k)]);
+    }
+    if (light.shape() == LightShape::sphere) {
+      planes.lo = planes.lo.cwiseMin(c - Vec3::Constant(light.desc().radius));
+      planes.hi = planes.hi.cwiseMax(c + Vec3::Constant(light.desc().radius));
+    }
     Vec3 mid = Vec3::Zero();
     for (int k = 0; k < corners; ++k) mid += base[std::size_t(k)];
     mid /= corners;
@@ -353,6 +376,7 @@ struct ShaftCuller::Impl {
                 Clip& scratch, bool clip_it = true, bool inside = false) const {
     if (t.normal.isZero()) return false;
     // The triangle's box wholly outside one plane: nothing of it is in the shaft.
+    if (!inside && planes.misses(t.lo, t.hi)) return false;
     if (!inside)
       for (const Plane& pl : planes) {
         const Vec3 near(pl.n.x() >= 0 ? t.lo.x() : t.hi.x(), pl.n.y() >= 0 ? t.lo.y() : t.hi.y(),
@@ -418,6 +442,7 @@ struct ShaftCuller::Impl {
     stack[top++] = 0;
     while (top > 0) {
       const Node& node = nodes[std::size_t(stack[--top])];
+      if (planes.misses(node.box.lo, node.box.hi)) continue;
       bool outside = false, inside = true;
       for (const Plane& pl : planes) {
         // The box's corner least far along the plane's normal, and the farthest.
