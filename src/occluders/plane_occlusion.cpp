@@ -43,9 +43,9 @@ double side(const Vec2& a, const Vec2& b, const Vec2& p) {
   return (b.x() - a.x()) * (p.y() - a.y()) - (b.y() - a.y()) * (p.x() - a.x());
 }
 
-// The part of `p` on the left of a → b (`left`) or on its right.
-Polygon clip(const Polygon& p, const Vec2& a, const Vec2& b, bool left) {
-  Polygon out;
+// The part of `p` on the left of a → b (`left`) or on its right, into `out`.
+void clip(const Polygon& p, const Vec2& a, const Vec2& b, bool left, Polygon& out) {
+  out.clear();
   const auto inside = [&](double s) { return left ? s >= 0 : s <= 0; };
   for (std::size_t i = 0; i < p.size(); ++i) {
     const Vec2& u = p[i];
@@ -54,16 +54,16 @@ Polygon clip(const Polygon& p, const Vec2& a, const Vec2& b, bool left) {
     if (inside(su)) out.push_back(u);
     if ((su > 0 && sv < 0) || (su < 0 && sv > 0)) out.push_back(u + (v - u) * (su / (su - sv)));
   }
-  return out;
 }
 
-// The convex hull of `points`, counter-clockwise (Andrew's monotone chain).
-Polygon convex_hull(std::vector<Vec2> points) {
+// The convex hull of `points` (sorted in place), counter-clockwise (Andrew's monotone chain).
+void convex_hull(std::vector<Vec2>& points, Polygon& hull) {
   std::sort(points.begin(), points.end(), [](const Vec2& a, const Vec2& b) {
     return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
   });
-  if (points.size() < 3) return {};
-  Polygon hull(2 * points.size());
+  hull.clear();
+  if (points.size() < 3) return;
+  hull.resize(2 * points.size());
   std::size_t k = 0;
   for (const Vec2& p : points) {
     while (k >= 2 && side(hull[k - 2], hull[k - 1], p) <= 0) --k;
@@ -74,14 +74,13 @@ Polygon convex_hull(std::vector<Vec2> points) {
     hull[k++] = points[i];
   }
   hull.resize(k - 1);
-  return hull;
 }
 
 // The corners of a polytope that holds every point a shadow ray may end at: a rectangle's or
 // polygon's own, the square around a disk in its plane, the cube around a sphere. None for the
 // other shapes.
-std::vector<Vec3> light_corners(const Light& light) {
-  std::vector<Vec3> corners;
+void light_corners(const Light& light, std::vector<Vec3>& corners) {
+  corners.clear();
   std::array<Vec3, 4> outline;
   switch (light.shape()) {
     case LightShape::rectangle:
@@ -108,7 +107,6 @@ std::vector<Vec3> light_corners(const Light& light) {
     case LightShape::sky:
       break;
   }
-  return corners;
 }
 
 // Whether the triangles lying in the plane of triangle `seed` cover every crossing of the plane
@@ -124,7 +122,8 @@ bool plane_covers(const ShaftCuller& culler, std::uint32_t seed, const std::arra
   const double sign = h_box[0] > 0 ? 1.0 : -1.0;
   for (const double h : h_box)
     if (!(sign * h > offset)) return false;
-  std::vector<double> h_end(ends.size());
+  thread_local std::vector<double> h_end;
+  h_end.resize(ends.size());
   for (std::size_t k = 0; k < ends.size(); ++k) {
     h_end[k] = n.dot(ends[k]) - d;
     if (!(-sign * h_end[k] > offset)) return false;
@@ -133,12 +132,14 @@ bool plane_covers(const ShaftCuller& culler, std::uint32_t seed, const std::arra
   const Vec3 u = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
   const Vec3 v = n.cross(u);
   const auto in_plane = [&](const Vec3& p) { return Vec2(u.dot(p), v.dot(p)); };
-  std::vector<Vec2> crossings;
+  thread_local std::vector<Vec2> crossings;
+  crossings.clear();
   for (std::size_t a = 0; a < 8; ++a)
     for (std::size_t b = 0; b < ends.size(); ++b)
       crossings.push_back(
           in_plane((-h_end[b] * box[a] + h_box[a] * ends[b]) / (h_box[a] - h_end[b])));
-  const Polygon hull = convex_hull(std::move(crossings));
+  thread_local Polygon hull;
+  convex_hull(crossings, hull);
   const double hull_area = hull.empty() ? 0.0 : area(hull);
   if (!(hull_area > 0)) return false;
   Vec2 lo = hull[0], hi = hull[0];
@@ -152,7 +153,8 @@ bool plane_covers(const ShaftCuller& culler, std::uint32_t seed, const std::arra
   slab.lo -= Vec3::Constant(thick), slab.hi += Vec3::Constant(thick);
   thread_local std::vector<std::uint32_t> near;
   culler.triangles_in_box(slab, near);
-  std::vector<std::array<Vec2, 3>> triangles;
+  thread_local std::vector<std::array<Vec2, 3>> triangles;
+  triangles.clear();
   for (const std::uint32_t i : near) {
     const Vec3* c = culler.triangle_corners(i);
     bool in = true;
@@ -172,18 +174,37 @@ bool plane_covers(const ShaftCuller& culler, std::uint32_t seed, const std::arra
     return side(a[0], a[1], a[2]) > side(b[0], b[1], b[2]);
   });
   const double negligible = kUncovered * hull_area;
-  std::vector<Polygon> pieces = {hull}, next;
+  // The pieces left, each with its box; a piece the triangle's box misses passes on whole.
+  struct Piece {
+    Polygon polygon;
+    Vec2 lo, hi;
+  };
+  const auto boxed = [](const Polygon& p) {
+    Piece piece{p, p[0], p[0]};
+    for (const Vec2& q : p) piece.lo = piece.lo.cwiseMin(q), piece.hi = piece.hi.cwiseMax(q);
+    return piece;
+  };
+  thread_local std::vector<Piece> pieces, next;
+  thread_local Polygon rest, outside, inside;
+  pieces.clear();
+  pieces.push_back(boxed(hull));
   for (const auto& t : triangles) {
+    const Vec2 t_lo = t[0].cwiseMin(t[1]).cwiseMin(t[2]), t_hi = t[0].cwiseMax(t[1]).cwiseMax(t[2]);
     next.clear();
-    for (const Polygon& piece : pieces) {
+    for (Piece& piece : pieces) {
+      if ((t_hi.array() < piece.lo.array()).any() || (t_lo.array() > piece.hi.array()).any()) {
+        next.push_back(std::move(piece));
+        continue;
+      }
       // The piece less the triangle: its parts outside each edge, in turn, of what is left.
-      Polygon rest = piece;
+      rest = piece.polygon;
       for (int e = 0; e < 3 && !rest.empty(); ++e) {
         const Vec2& a = t[std::size_t(e)];
         const Vec2& b = t[std::size_t((e + 1) % 3)];
-        Polygon outside = clip(rest, a, b, false);
-        if (outside.size() >= 3 && area(outside) > negligible) next.push_back(std::move(outside));
-        rest = clip(rest, a, b, true);
+        clip(rest, a, b, false, outside);
+        if (outside.size() >= 3 && area(outside) > negligible) next.push_back(boxed(outside));
+        clip(rest, a, b, true, inside);
+        rest.swap(inside);
         if (rest.size() < 3 || area(rest) <= negligible) rest.clear();
       }
     }
@@ -199,7 +220,8 @@ bool plane_covers(const ShaftCuller& culler, std::uint32_t seed, const std::arra
 bool plane_hides_light(const ShaftCuller& culler, const RayScene& rays, const Light& light,
                        const Bounds3& origins, const RayScene::Hit* first) {
   if (origins.empty()) return false;
-  const std::vector<Vec3> ends = light_corners(light);
+  thread_local std::vector<Vec3> ends;
+  light_corners(light, ends);
   if (ends.empty()) return false;
   std::array<Vec3, 8> box;
   for (int k = 0; k < 8; ++k) box[std::size_t(k)] = origins.corner(k);
