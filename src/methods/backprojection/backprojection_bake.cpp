@@ -344,9 +344,18 @@ class LightPairs final : public PairSource {
     // texel sees it, which the origin sees shifted by parallax, where the rows see the
     // silhouette's disk. Where the shift is a noticeable part of the sphere's radius, the rows'
     // fixed points are traced to where the reference aims.
+    // Every ray traced there runs from the origin to the light, inside the origin's shaft: where
+    // no blocker may lie in it (most such texels of a level's smooth-shaded curves), V is
+    // exactly 1 without them.
     if (light_.shape() == LightShape::sphere &&
-        (origin - p).norm() > kParallax * (light_.centre() - p).norm())
-      return traced();
+        (origin - p).norm() > kParallax * (light_.centre() - p).norm()) {
+      const std::vector<std::uint32_t>& listed = tiles_.patches[patch_index(tx.x, tx.y)].candidates;
+      if (in_.culler->maybe_blocked(origin, p, n, light_, listed.empty() ? nullptr : &listed))
+        return traced();
+      out.route = TexelRoute::clear;
+      out.visibility = 1;
+      return;
+    }
     // The light's centre first, where the texel's blockers are many (not listed, a dense mesh's
     // outline, or more polygons than kRayFirst): where the ray to it meets a triangle that hides
     // all of the light alone, the texel lies in that triangle's umbra, exactly, whatever else its
