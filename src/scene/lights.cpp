@@ -32,6 +32,26 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr int kDiskPolygonSides = 128;
+// The regular kDiskPolygonSides-gon's corners on the unit circle, (cos t, sin t), and the radius
+// that gives it a disk's area, per unit radius: computed once (a form factor near a light's
+// horizon asked for 256 sines and cosines each time).
+struct DiskPolygon {
+  std::array<Vec2, kDiskPolygonSides> unit;
+  double area_radius;
+};
+const DiskPolygon& disk_polygon() {
+  static const DiskPolygon polygon = [] {
+    DiskPolygon p;
+    const double sides = kDiskPolygonSides;
+    p.area_radius = std::sqrt(2.0 * kPi / (sides * std::sin(2.0 * kPi / sides)));
+    for (int i = 0; i < kDiskPolygonSides; ++i) {
+      const double t = 2.0 * kPi * i / sides;
+      p.unit[std::size_t(i)] = Vec2(std::cos(t), std::sin(t));
+    }
+    return p;
+  }();
+  return polygon;
+}
 
 // Clips a polygon to the half-space n·x >= 0 (Sutherland–Hodgman, one plane).
 std::vector<Vec3> clip_to_horizon(const std::vector<Vec3>& poly, const Vec3& n) {
@@ -73,12 +93,12 @@ double disk_form_factor(const Vec3& c, const Vec3& m, const Vec3& right, const V
     return std::max(0.0, f);
   }
   // Cut by the horizon: a regular polygon with the disk's area.
-  const double sides = kDiskPolygonSides;
-  const double r_poly = R * std::sqrt(2.0 * kPi / (sides * std::sin(2.0 * kPi / sides)));
+  const DiskPolygon& unit = disk_polygon();
+  const double r_poly = R * unit.area_radius;
   std::array<Vec3, kDiskPolygonSides> poly;
   for (int i = 0; i < kDiskPolygonSides; ++i) {
-    const double t = 2.0 * kPi * i / sides;
-    poly[std::size_t(i)] = c + r_poly * (std::cos(t) * right + std::sin(t) * up);
+    const Vec2& u = unit.unit[std::size_t(i)];
+    poly[std::size_t(i)] = c + r_poly * (u.x() * right + u.y() * up);
   }
   return polygon_form_factor(poly.data(), kDiskPolygonSides, n);
 }
@@ -641,12 +661,9 @@ HorizonPart Light::above_horizon(const Vec3& y, const Vec3& n) const {
   // The light's outline (relative to y), as its closed form clips it.
   std::vector<Vec3> outline;
   const auto polygon = [&](const Vec3& centre, const Vec3& a, const Vec3& b, double radius) {
-    const double sides = kDiskPolygonSides;
-    const double r = radius * std::sqrt(2.0 * kPi / (sides * std::sin(2.0 * kPi / sides)));
-    for (int i = 0; i < kDiskPolygonSides; ++i) {
-      const double t = 2.0 * kPi * i / sides;
-      outline.push_back(centre + r * (std::cos(t) * a + std::sin(t) * b));
-    }
+    const DiskPolygon& unit = disk_polygon();
+    const double r = radius * unit.area_radius;
+    for (const Vec2& u : unit.unit) outline.push_back(centre + r * (u.x() * a + u.y() * b));
   };
   const Vec3 c = desc_.position - y;
   switch (desc_.shape) {

@@ -346,22 +346,25 @@ class LightPairs final : public PairSource {
     // fixed points are traced to where the reference aims.
     // Every ray traced there runs from the origin to the light, inside the origin's shaft: where
     // no blocker may lie in it (most such texels of a level's smooth-shaded curves), V is
-    // exactly 1 without them.
-    if (light_.shape() == LightShape::sphere &&
-        (origin - p).norm() > kParallax * (light_.centre() - p).norm()) {
+    // exactly 1 without them; where one triangle hides all of the light from the origin (below),
+    // exactly 0.
+    const bool parallax = light_.shape() == LightShape::sphere &&
+                          (origin - p).norm() > kParallax * (light_.centre() - p).norm();
+    if (parallax) {
       const std::vector<std::uint32_t>& listed = tiles_.patches[patch_index(tx.x, tx.y)].candidates;
-      if (in_.culler->maybe_blocked(origin, p, n, light_, listed.empty() ? nullptr : &listed))
-        return traced();
-      out.route = TexelRoute::clear;
-      out.visibility = 1;
-      return;
+      if (!in_.culler->maybe_blocked(origin, p, n, light_, listed.empty() ? nullptr : &listed)) {
+        out.route = TexelRoute::clear;
+        out.visibility = 1;
+        return;
+      }
     }
     // The light's centre first, where the texel's blockers are many (not listed, a dense mesh's
-    // outline, or more polygons than kRayFirst): where the ray to it meets a triangle that hides
-    // all of the light alone, the texel lies in that triangle's umbra, exactly, whatever else its
-    // shaft holds. (A few polygons or convex solids cost the estimator less than the ray.)
+    // outline, or more polygons than kRayFirst) or are to be traced: where the ray to it meets a
+    // triangle that hides all of the light alone, the texel lies in that triangle's umbra,
+    // exactly, whatever else its shaft holds. (A few polygons or convex solids cost the
+    // estimator less than the ray.)
     const std::int32_t at = prepared_of_[patch_index(tx.x, tx.y)];
-    const bool busy = at < 0 || !prepared_[std::size_t(at)].outlines.empty() ||
+    const bool busy = parallax || at < 0 || !prepared_[std::size_t(at)].outlines.empty() ||
                       prepared_[std::size_t(at)].polygons.size() > kRayFirst;
     if (const RayScene::Hit hit =
             busy ? in_.rays->first_hit_face(origin, light_.centre() - origin, 1.0)
@@ -380,6 +383,7 @@ class LightPairs final : public PairSource {
         return;
       }
     }
+    if (parallax) return traced();
     // The blockers: the tile's candidates as they are (the estimator cuts what lies beyond the
     // light or behind the origin, and ignores what projects outside the light), or, for a tile
     // without a list, the texel's own shaft's polygons from the whole hierarchy.
