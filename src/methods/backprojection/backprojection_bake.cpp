@@ -14,11 +14,13 @@
 #include <tbb/blocked_range.h>
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_pipeline.h>
 
 #include <algorithm>
 #include <array>
 #include <atomic>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <span>
 
@@ -700,18 +702,10 @@ MixedImages bake_backprojection(const TexelSpace& space, const BackprojectionInp
   const auto kept = kept_texels(space);
   const std::size_t kept0 = kept.first, kept1 = kept.second;
   const TexelGrid grid(space);  // built once: it does not depend on the light
-  for (std::size_t l = 0; l < lights.size(); ++l) {
-    // The tiles the light may reach (its lists' blocks): its cost follows its reach.
+  // Light l's field into the mix: distinct texels in parallel (LightMix::set allows it), tile by
+  // tile through the grid (so that no texel's record is read), each range counting its routes.
+  const auto apply = [&](std::size_t l, const LightField& field) {
     const std::span<const std::uint32_t> in_reach = lists.blocks_of(l);
-    if (in_reach.empty()) continue;
-    if (lights[l].textured() || lights[l].is_point()) {
-      bake_light_by_rays(space, grid, in, in_reach, l, lights[l].is_point() ? 1 : in.samples, mix,
-                         counts);
-      continue;
-    }
-    const LightField field = light_field(space, grid, in, in_reach, l);
-    // Distinct texels in parallel (LightMix::set allows it), tile by tile through the grid (so
-    // that no texel's record is read), each range counting its routes.
     tbb::combinable<RouteCounts> local;
     tbb::parallel_for(
         tbb::blocked_range<std::size_t>(0, in_reach.size(), 4), [&](const auto& range) {
@@ -737,7 +731,43 @@ MixedImages bake_backprojection(const TexelSpace& space, const BackprojectionInp
       for (std::size_t r = 0; r < c.pairs.size(); ++r) counts.pairs[r] += c.pairs[r];
       counts.rays += c.rays;
     });
-  }
+  };
+  // The lights in a pipeline: a few lights' fields found at once (a level's lights each reach a
+  // few tiles, too little work to keep both threads busy between a light's stages), each set
+  // into the mix in scene order, so that every texel's sums add its lights in that order.
+  // Lights baked by rays set the mix themselves, in their turn.
+  constexpr std::size_t kLightsInFlight = 4;
+  struct Step {
+    std::size_t light = 0;
+    std::shared_ptr<LightField> field;  // null: baked by rays, in its turn
+  };
+  std::size_t next = 0;
+  tbb::parallel_pipeline(
+      kLightsInFlight,
+      tbb::make_filter<void, Step>(tbb::filter_mode::serial_in_order, [&](tbb::flow_control&
+                                                                              control) {
+        // The tiles the light may reach (its lists' blocks): its cost follows its reach.
+        while (next < lights.size() && lists.blocks_of(next).empty()) ++next;
+        if (next == lights.size()) {
+          control.stop();
+          return Step();
+        }
+        return Step{next++, nullptr};
+      }) & tbb::make_filter<Step, Step>(tbb::filter_mode::parallel, [&](Step step) {
+        const Light& light = lights[step.light];
+        if (light.textured() || light.is_point()) return step;
+        step.field = std::make_shared<LightField>(
+            light_field(space, grid, in, lists.blocks_of(step.light), step.light));
+        return step;
+      }) & tbb::make_filter<Step, void>(tbb::filter_mode::serial_in_order, [&](const Step& step) {
+        const std::size_t l = step.light;
+        if (step.field) {
+          apply(l, *step.field);
+          return;
+        }
+        bake_light_by_rays(space, grid, in, lists.blocks_of(l), l,
+                           lights[l].is_point() ? 1 : in.samples, mix, counts);
+      }));
   if (routes) *routes = counts;
   return mix.finish();
 }
