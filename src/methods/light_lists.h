@@ -6,8 +6,9 @@
 // texel's lights, or a light's texels, through these lists spends nothing on the pairs beyond
 // the lights' reach, and its values are those of a visit of every pair.
 //
-// A level of a thousand lights, each lighting its own room, has a few dozen per block; a light
-// without a range (and every sun and sky) is on every block it faces.
+// In a level whose lights each light their own room, a texel sees a small share of them
+// (OpenArena's oacmpctf3: at most 197 of 1,916 reach one texel); a light without a range (and
+// every sun and sky) is on every block it faces.
 #pragma once
 
 #include <cstddef>
