@@ -3,7 +3,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace sb {
 
@@ -19,17 +21,34 @@ void apply_shadowmask_range(Image& light_visibility, const LightDesc& light,
   }
 }
 
-void add_overlaps(const std::vector<Image>& light_visibility,
-                  const std::vector<std::uint8_t>& covered, LightOverlaps& overlaps) {
-  const std::size_t lights = light_visibility.size();
+void add_overlaps(const TiledImages& light_visibility, const std::vector<std::uint8_t>& covered,
+                  LightOverlaps& overlaps) {
+  // The lights holding each tile (beyond its tiles a light has no influence), tile by tile.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> holders;  // (tile, light)
+  for (std::size_t l = 0; l < light_visibility.size(); ++l)
+    for (std::size_t s = 0; s < light_visibility.tiles(l).size(); ++s)
+      holders.emplace_back(light_visibility.tiles(l)[s], std::uint32_t(l));
+  std::sort(holders.begin(), holders.end());
+  constexpr int side = TiledImages::kSide;
+  const int width = light_visibility.width(), height = light_visibility.height();
   std::vector<std::size_t> present;
-  for (std::size_t i = 0; i < covered.size(); ++i) {
-    if (!covered[i]) continue;
-    present.clear();
-    for (std::size_t l = 0; l < lights; ++l)
-      if (light_visibility[l].pixels[2 * i + 1] > 0) present.push_back(l);
-    for (std::size_t a : present)
-      for (std::size_t b : present) overlaps.overlaps[a * overlaps.lights + b] = 1;
+  for (std::size_t first = 0; first < holders.size();) {
+    std::size_t last = first;
+    while (last < holders.size() && holders[last].first == holders[first].first) ++last;
+    const std::uint32_t tile = holders[first].first;
+    const int x0 = int(tile % std::uint32_t(light_visibility.tiles_x())) * side;
+    const int y0 = int(tile / std::uint32_t(light_visibility.tiles_x())) * side;
+    for (int y = y0; y < std::min(y0 + side, height); ++y)
+      for (int x = x0; x < std::min(x0 + side, width); ++x) {
+        if (!covered[std::size_t(y) * std::size_t(width) + std::size_t(x)]) continue;
+        present.clear();
+        for (std::size_t k = first; k < last; ++k)
+          if (light_visibility.at(holders[k].second, x, y)[1] > 0)
+            present.push_back(holders[k].second);
+        for (std::size_t a : present)
+          for (std::size_t b : present) overlaps.overlaps[a * overlaps.lights + b] = 1;
+      }
+    first = last;
   }
 }
 
@@ -64,15 +83,15 @@ ShadowmaskChannels assign_shadowmask_channels(const LightOverlaps& overlaps,
   return out;
 }
 
-Image compose_shadowmask(const std::vector<Image>& light_visibility,
-                         const std::vector<int>& channel, int width, int height) {
+Image compose_shadowmask(const TiledImages& light_visibility, const std::vector<int>& channel,
+                         int width, int height) {
   Image mask(width, height, kShadowmaskChannels, 1.0f);
-  const std::size_t texels = std::size_t(width) * std::size_t(height);
+  // Beyond a light's tiles its visibility is 1: only its tiles change the mask.
   for (std::size_t l = 0; l < light_visibility.size(); ++l) {
     if (channel[l] < 0) continue;
-    const auto& v = light_visibility[l].pixels;
-    for (std::size_t i = 0; i < texels; ++i)
-      mask.pixels[4 * i + std::size_t(channel[l])] *= v[2 * i];
+    light_visibility.each_pixel(l, [&](int x, int y, const float* v) {
+      if (x < width && y < height) mask.at(x, y)[channel[l]] *= v[0];
+    });
   }
   return mask;
 }

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/image.h"
+#include "core/tiled_images.h"
 #include "scene/lights.h"
 #include "texels/texel_space.h"
 
@@ -41,8 +42,8 @@ struct LightOverlaps {
 };
 
 // Adds the overlaps one receiver's images show at its covered texels.
-void add_overlaps(const std::vector<Image>& light_visibility,
-                  const std::vector<std::uint8_t>& covered, LightOverlaps& overlaps);
+void add_overlaps(const TiledImages& light_visibility, const std::vector<std::uint8_t>& covered,
+                  LightOverlaps& overlaps);
 
 struct ShadowmaskChannels {
   std::vector<int> channel;           // per light: 0–3 (R, G, B, A), or −1: left out
@@ -57,8 +58,8 @@ ShadowmaskChannels assign_shadowmask_channels(const LightOverlaps& overlaps,
 // A receiver's RGBA mask: channel c is the product, over the lights given channel c, of their
 // visibility images' channel 0 (at most one of them influences any texel); 1 where no light
 // holds the channel.
-Image compose_shadowmask(const std::vector<Image>& light_visibility,
-                         const std::vector<int>& channel, int width, int height);
+Image compose_shadowmask(const TiledImages& light_visibility, const std::vector<int>& channel,
+                         int width, int height);
 
 // "R", "G", "B", "A".
 const char* shadowmask_channel_name(int channel);

@@ -5,10 +5,19 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <iterator>
 
 #include "methods/terminator_fill.h"
 
 namespace sb {
+
+TiledImages per_light_values(std::size_t lights, int width, int height) {
+  return TiledImages(lights, width, height, {0, 0, 0});
+}
+
+TiledImages per_light_visibilities(std::size_t lights, int width, int height) {
+  return TiledImages(lights, width, height, {1, 0});
+}
 
 LightMix::LightMix(const TexelSpace& space, const std::vector<Light>& lights, Quantity quantity,
                    Order order, KeepPerLight keep, const LightLists* lists)
@@ -31,11 +40,32 @@ LightMix::LightMix(const TexelSpace& space, const std::vector<Light>& lights, Qu
                       });
   }
   const std::size_t outputs = output_count(lights);
-  if (keep_.values) out_.per_light.assign(outputs, Image(space.width, space.height, 3, unset));
-  if (keep_.visibility) {
-    Image unreached(space.width, space.height, 2, 0.0f);
-    for (std::size_t i = 0; i < unreached.pixels.size(); i += 2) unreached.pixels[i] = 1.0f;
-    out_.per_light_visibility.assign(outputs, unreached);
+  if (keep_.values) out_.per_light = per_light_values(outputs, space.width, space.height);
+  if (keep_.visibility)
+    out_.per_light_visibility = per_light_visibilities(outputs, space.width, space.height);
+  if (keep_.any()) {
+    // Each output's tiles: the blocks its parts' lists give them, or every one without lists. A
+    // value image's start there is `unset`, as the combined image's; a visibility image's (1, 0).
+    std::vector<std::vector<std::uint32_t>> tiles(outputs);
+    const TiledImages& shape = keep_.values ? out_.per_light : out_.per_light_visibility;
+    const std::size_t all = std::size_t(shape.tiles_x()) * std::size_t(shape.tiles_y());
+    for (std::size_t l = 0; l < lights.size(); ++l) {
+      std::vector<std::uint32_t>& t = tiles[std::size_t(lights[l].output())];
+      if (!lists) {
+        t.resize(all);
+        for (std::size_t k = 0; k < all; ++k) t[k] = std::uint32_t(k);
+        continue;
+      }
+      const auto blocks = lists->blocks_of(l);
+      std::vector<std::uint32_t> both;
+      std::set_union(t.begin(), t.end(), blocks.begin(), blocks.end(), std::back_inserter(both));
+      t.swap(both);
+    }
+    const float value_start[3] = {unset, unset, unset}, visibility_start[2] = {1, 0};
+    for (std::size_t o = 0; o < outputs; ++o) {
+      if (keep_.values) out_.per_light.reserve(o, tiles[o], value_start);
+      if (keep_.visibility) out_.per_light_visibility.reserve(o, tiles[o], visibility_start);
+    }
   }
   // A mesh light's parts are summed per texel until finish(): Σ H0·V and Σ H0.
   if (keep_.any()) {
@@ -66,8 +96,11 @@ void LightMix::keep(std::size_t light, std::size_t texel, const Vec3& h0, const 
 void LightMix::keep_output(std::size_t output, std::size_t texel, const Vec3& h0, const Vec3& v) {
   const Texel& t = space_.texels[texel];
   const bool counts = h0.maxCoeff() > 0;
-  if (keep_.values && (counts || quantity_ == Quantity::irradiance)) {
-    float* px = out_.per_light[output].at(t.x, t.y);
+  // A light's pairs lie in its lists' blocks, where its tiles are.
+  float* px = keep_.values && (counts || quantity_ == Quantity::irradiance)
+                  ? out_.per_light.at(output, t.x, t.y)
+                  : nullptr;
+  if (px) {
     for (int c = 0; c < 3; ++c) {
       const double value =
           quantity_ == Quantity::irradiance ? h0[c] * v[c] : (h0[c] > 0 ? v[c] : 0);
@@ -75,10 +108,10 @@ void LightMix::keep_output(std::size_t output, std::size_t texel, const Vec3& h0
     }
   }
   const double weight = h0.sum();
-  if (keep_.visibility && weight > 0) {
-    float* px = out_.per_light_visibility[output].at(t.x, t.y);
-    px[0] = float(h0.dot(v) / weight);
-    px[1] = 1.0f;
+  if (float* mask = keep_.visibility && weight > 0 ? out_.per_light_visibility.at(output, t.x, t.y)
+                                                   : nullptr) {
+    mask[0] = float(h0.dot(v) / weight);
+    mask[1] = 1.0f;
   }
 }
 
@@ -148,16 +181,26 @@ MixedImages LightMix::finish() {
   for (std::size_t l = 0; l < every.size(); ++l) every[l] = l;
   if (quantity_ == Quantity::visibility)
     fill_terminators(space_, lights_, every, UncountedMark::value, out_.image, lists_);
+  // Each light's images made whole one at a time (beyond its tiles: no light counts), filled
+  // over its tiles, and kept by tiles again.
   const std::size_t outputs = std::max(out_.per_light.size(), out_.per_light_visibility.size());
   for (std::size_t o = 0; o < outputs; ++o) {
     std::vector<std::size_t> parts;
     for (std::size_t l = 0; l < lights_.size(); ++l)
       if (std::size_t(lights_[l].output()) == o) parts.push_back(l);
-    if (quantity_ == Quantity::visibility && o < out_.per_light.size())
-      fill_terminators(space_, lights_, parts, UncountedMark::value, out_.per_light[o], lists_);
-    if (o < out_.per_light_visibility.size())
-      fill_terminators(space_, lights_, parts, UncountedMark::flag_off,
-                       out_.per_light_visibility[o], lists_);
+    if (quantity_ == Quantity::visibility && o < out_.per_light.size()) {
+      const float uncounted[3] = {kNoLightCounts, kNoLightCounts, kNoLightCounts};
+      Image image = out_.per_light.dense(o, uncounted);
+      fill_terminators(space_, lights_, parts, UncountedMark::value, image, lists_,
+                       out_.per_light.tiles(o));
+      out_.per_light.assign(o, image);
+    }
+    if (o < out_.per_light_visibility.size()) {
+      Image image = out_.per_light_visibility.dense(o);
+      fill_terminators(space_, lights_, parts, UncountedMark::flag_off, image, lists_,
+                       out_.per_light_visibility.tiles(o));
+      out_.per_light_visibility.assign(o, image);
+    }
   }
   return std::move(out_);
 }

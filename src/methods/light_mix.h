@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/image.h"
+#include "core/tiled_images.h"
 #include "methods/light_lists.h"
 #include "scene/lights.h"
 #include "texels/texel_space.h"
@@ -34,13 +35,20 @@ struct KeepPerLight {
 //  - per_light_visibility: two channels, light l's visibility (its H0-weighted mean over colour
 //    channels, Σ_c H0_c·V_c / Σ_c H0_c) and 1 where it counts at the texel; (1, 0) elsewhere,
 //    uncovered texels included (what a shadow mask holds, lightmaps/shadowmask.h).
+// Each is kept by tiles (TiledImages): with light lists, a light's tiles are the blocks its lists
+// give it (its parts' together), so the images cost what the lights reach, not lights × texels.
 struct MixedImages {
   Image image;
   // The most lights that reach any one texel (H0 > 0 there): how many a texel sums at most.
   std::uint32_t most_lights = 0;
-  std::vector<Image> per_light;             // empty unless kept
-  std::vector<Image> per_light_visibility;  // empty unless kept
+  TiledImages per_light;             // empty unless kept
+  TiledImages per_light_visibility;  // empty unless kept
 };
+
+// Empty per-light images of a width × height receiver: values (0 beyond a light's tiles) and
+// visibility ((1, 0) beyond them).
+TiledImages per_light_values(std::size_t lights, int width, int height);
+TiledImages per_light_visibilities(std::size_t lights, int width, int height);
 
 class LightMix {
  public:

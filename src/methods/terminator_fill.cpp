@@ -89,7 +89,8 @@ bool square_reaches(const TexelSpace& space, const Texel& texel, const H0& h0) {
 
 void fill_terminators(const TexelSpace& space, const std::vector<Light>& all,
                       const std::vector<std::size_t>& lights, UncountedMark mark, Image& image,
-                      const LightLists* lists) {
+                      const LightLists* lists,
+                      std::optional<std::span<const std::uint32_t>> blocks) {
   const int values = mark == UncountedMark::value ? 3 : 1;
   if (space.face_shading.empty()) {
     if (mark == UncountedMark::value) clear_uncounted(image);
@@ -101,14 +102,28 @@ void fill_terminators(const TexelSpace& space, const std::vector<Light>& all,
     std::size_t pixel;
     float v[3];
   };
+  // The texels visited: all, or those of `blocks`.
+  std::vector<std::size_t> visited;
+  if (blocks) {
+    const int blocks_x = (space.width + LightLists::kSide - 1) / LightLists::kSide;
+    for (const std::uint32_t b : *blocks) {
+      const int x0 = int(b % std::uint32_t(blocks_x)) * LightLists::kSide;
+      const int y0 = int(b / std::uint32_t(blocks_x)) * LightLists::kSide;
+      for (int y = y0; y < std::min(y0 + LightLists::kSide, space.height); ++y)
+        for (int x = x0; x < std::min(x0 + LightLists::kSide, space.width); ++x)
+          if (space.covered[std::size_t(y) * std::size_t(space.width) + std::size_t(x)])
+            visited.push_back(texel_at(space, x, y));
+    }
+  }
+  const std::size_t count = blocks ? visited.size() : space.texels.size();
   tbb::enumerable_thread_specific<std::vector<Fill>> fills;
   tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, space.texels.size(), 1024),
+      tbb::blocked_range<std::size_t>(0, count, 1024),
       [&](const tbb::blocked_range<std::size_t>& range) {
         std::vector<Fill>& mine = fills.local();
         std::vector<std::size_t> listed;  // the texel's block's among `lights`
-        for (std::size_t t = range.begin(); t != range.end(); ++t) {
-          const Texel& texel = space.texels[t];
+        for (std::size_t k = range.begin(); k != range.end(); ++k) {
+          const Texel& texel = space.texels[blocks ? visited[k] : k];
           if (counted(image.at(texel.x, texel.y), mark)) continue;
           const Vec3 p = texel.position.cast<double>(), n = texel.normal.cast<double>();
           const std::vector<std::size_t>* weighed = &lights;

@@ -16,6 +16,9 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
 #include <vector>
 
 #include "core/image.h"
@@ -39,9 +42,12 @@ enum class UncountedMark {
 // Fills `image`'s uncounted covered texels as above from the lights `lights` (indices into
 // `all`, ascending) and then, for UncountedMark::value, sets every texel still kNoLightCounts to
 // 0. With `lists`, a texel weighs only those of `lights` its block lists (the rest give H0 = 0
-// there under every normal of its square).
+// there under every normal of its square). With `blocks` (ascending, of LightLists::kSide²
+// texels), only their texels are filled: a light's own image, beyond whose blocks it gives
+// H0 = 0.
 void fill_terminators(const TexelSpace& space, const std::vector<Light>& all,
                       const std::vector<std::size_t>& lights, UncountedMark mark, Image& image,
-                      const LightLists* lists = nullptr);
+                      const LightLists* lists = nullptr,
+                      std::optional<std::span<const std::uint32_t>> blocks = std::nullopt);
 
 }  // namespace sb

@@ -70,6 +70,15 @@ Status load_scene_for(const Scene& scene, const MethodEntry& method, const BakeO
         !fits)
       return fits.error();
   }
+  // The per-light images, once the lights' reach is known.
+  std::vector<const Mesh*> baked;
+  for (const std::size_t object : loaded->receivers) baked.push_back(&all[object]);
+  if (const auto per_light = per_light_memory(scene, baked, loaded->sides, loaded->lights)) {
+    loaded->estimate.push_back(*per_light);
+    if (Status fits = check_memory(scene, loaded->estimate, memory_budget(scene.bake), advice);
+        !fits)
+      return fits.error();
+  }
   if (scene.output.atlas && !options.shard)
     result->atlas = pack_atlases(sides, *scene.output.atlas);
   if (scene.output.gltf && (!options.shard || options.shard->index == 0)) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/image.h"
+#include "core/tiled_images.h"
 #include "lightmaps/gltf_export.h"
 #include "methods/method.h"
 #include "pipeline/receiver_record.h"
@@ -82,9 +83,10 @@ struct ReceiverBake : ReceiverRecord {
   double seconds_texels = 0, seconds_method = 0, seconds_dilate = 0, seconds_seams = 0;
   // Per light, in scene order, when kept: its own V (or H0·V), dilated like the image; and what
   // its shadow mask needs (MixedImages::per_light_visibility, its influence cleared beyond its
-  // shadowmask_range), dilated too.
-  std::vector<Image> per_light;
-  std::vector<Image> per_light_visibility;
+  // shadowmask_range), dilated too. Kept by tiles (TiledImages): each holds what its light
+  // reaches, with the dilation and stitching around it.
+  TiledImages per_light;
+  TiledImages per_light_visibility;
   // The receiver's mesh as a glTF carries it, when [output] gltf.
   std::shared_ptr<const GltfMesh> gltf_mesh;
   // What the method reports beyond its values: named figures, its own manifest entries, what

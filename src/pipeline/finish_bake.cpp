@@ -46,7 +46,16 @@ void finish_bake(const Scene& scene, BakeResult& result, bool whole) {
       add_overlaps(r.per_light_visibility, r.covered, overlaps);
     ShadowmaskChannels channels = assign_shadowmask_channels(overlaps, scene.lights, scene.file);
     result.shadowmask_channels = std::move(channels.channel);
-    for (std::string& w : channels.warnings) warnings.push_back(std::move(w));
+    // A level's thousand lights leave most without a channel: the first few by name, then a
+    // count.
+    constexpr std::size_t kNamed = 5;
+    for (std::size_t i = 0; i < channels.warnings.size() && i < kNamed; ++i)
+      warnings.push_back(std::move(channels.warnings[i]));
+    if (channels.warnings.size() > kNamed)
+      warnings.push_back(fmt::format(
+          "{}: {} more lights have no free shadow-mask channel where they reach; the shadow "
+          "masks leave them out (a mask holds four lights per texel)",
+          scene.file.string(), channels.warnings.size() - kNamed));
   }
   result.warnings = std::move(warnings);
 }

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "methods/method.h"
 #include "texels/lightmap_sizes.h"
@@ -25,10 +26,13 @@ constexpr double kResultBytesPerTexel = 3 * 4 + 1;
 // composed first (RGB float).
 constexpr double kWriteBytesPerTexel = 3 * 4 + 3 + 4 + 1;
 constexpr double kAtlasBytesPerTexel = 3 * 4;
-// Kept per receiver, texel and light until written: its value (RGB float), or what its shadow
-// mask needs (visibility and influence, 2 floats).
+// Kept per receiver, texel and light until written, at the texels the light reaches (by tiles,
+// TiledImages): its value (RGB float), or what its shadow mask needs (visibility and influence,
+// 2 floats).
 constexpr double kPerLightValueBytesPerTexel = 3 * 4;
 constexpr double kPerLightMaskBytesPerTexel = 2 * 4;
+// Faces per piece of a receiver's surface whose box a light's reach is tested against.
+constexpr std::size_t kFacesPerPiece = 64;
 
 }  // namespace
 
@@ -62,13 +66,9 @@ std::vector<MemoryItem> bake_memory_estimate(const Scene& scene, const std::vect
   // What a file written at once holds: the largest receiver's, or an atlas.
   const double written =
       scene.output.atlas ? double(scene.output.atlas->size) * scene.output.atlas->size : largest;
-  const double lights = double(scene.lights.size());
-  const double per_light_bytes = (scene.output.per_light ? kPerLightValueBytesPerTexel : 0) +
-                                 (scene.output.shadowmask ? kPerLightMaskBytesPerTexel : 0);
   std::vector<MemoryItem> items;
   items.push_back({"texel space", largest * kRasterBytesPerTexel});
   items.push_back({"lightmaps", all * kResultBytesPerTexel});
-  if (per_light_bytes > 0) items.push_back({"per-light images", all * lights * per_light_bytes});
   items.push_back({"writing", written * (kWriteBytesPerTexel +
                                          (scene.output.atlas ? kAtlasBytesPerTexel : 0))});
   // The method's own arrays and maps (its registry entry says what they are).
@@ -76,6 +76,48 @@ std::vector<MemoryItem> bake_memory_estimate(const Scene& scene, const std::vect
     for (MemoryItem& item : method->memory(scene, largest)) items.push_back(std::move(item));
   }
   return items;
+}
+
+std::optional<MemoryItem> per_light_memory(const Scene& scene,
+                                           const std::vector<const Mesh*>& receivers,
+                                           const std::vector<int>& sides,
+                                           const std::vector<Light>& lights) {
+  const double bytes = (scene.output.per_light ? kPerLightValueBytesPerTexel : 0) +
+                       (scene.output.shadowmask ? kPerLightMaskBytesPerTexel : 0);
+  if (!(bytes > 0)) return std::nullopt;
+  double total = 0;
+  for (std::size_t r = 0; r < receivers.size(); ++r) {
+    // The receiver's surface in pieces of consecutive faces (a level's file keeps a room's
+    // faces together), each a box and an area.
+    const TriMesh& m = receivers[r]->mesh;
+    std::vector<std::pair<Bounds3, double>> pieces;
+    double area = 0;
+    std::size_t in_piece = 0;
+    for (const auto f : m.faces()) {
+      if (in_piece++ % kFacesPerPiece == 0) pieces.emplace_back();
+      Vec3 corner[3];
+      int k = 0;
+      for (const auto v : m.fv_range(f)) {
+        const auto& p = m.point(v);
+        corner[k] = Vec3(p[0], p[1], p[2]);
+        pieces.back().first.extend(corner[k++]);
+      }
+      const double a = 0.5 * (corner[1] - corner[0]).cross(corner[2] - corner[0]).norm();
+      pieces.back().second += a;
+      area += a;
+    }
+    if (!(area > 0)) continue;
+    // Each light's share: the pieces it may reach.
+    double shares = 0;
+    for (const Light& light : lights) {
+      double reached = 0;
+      for (const auto& [box, piece_area] : pieces)
+        if (light.may_reach(box)) reached += piece_area;
+      shares += reached / area;
+    }
+    total += double(sides[r]) * double(sides[r]) * shares * bytes;
+  }
+  return MemoryItem{"per-light images", total};
 }
 
 Status check_memory(const Scene& scene, const std::vector<MemoryItem>& items, std::uint64_t budget,

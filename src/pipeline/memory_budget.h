@@ -6,11 +6,14 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/error.h"
 #include "core/memory_size.h"
+#include "scene/lights.h"
+#include "scene/mesh.h"
 #include "scene/scene.h"
 
 namespace sb {
@@ -23,10 +26,19 @@ double total_bytes(const std::vector<MemoryItem>& items);
 std::vector<int> sides_from_settings(const Scene& scene);
 
 // The bake's memory for receivers of these `sides`: texel space of the largest receiver (every
-// texel covered, the upper bound), every receiver's lightmap, coverage and per-light images
-// ([output] per_light, shadowmask) kept until they are written, the images written (an atlas at
-// a time with an atlas), and the method's own per-texel arrays and maps.
+// texel covered, the upper bound), every receiver's lightmap and coverage kept until they are
+// written, the images written (an atlas at a time with an atlas), and the method's own
+// per-texel arrays and maps.
 std::vector<MemoryItem> bake_memory_estimate(const Scene& scene, const std::vector<int>& sides);
+
+// The per-light images ([output] per_light, shadowmask) of receivers with these meshes and
+// sides, kept until written, once the meshes and lights are known: each light's share of each
+// receiver's surface its reach may touch (by pieces of 64 faces: an estimate from above),
+// times the texels. None where no per-light image is kept.
+std::optional<MemoryItem> per_light_memory(const Scene& scene,
+                                           const std::vector<const Mesh*>& receivers,
+                                           const std::vector<int>& sides,
+                                           const std::vector<Light>& lights);
 
 // An error when the items need more than `budget` bytes: "<scene file>: [bake] max_memory: the
 // bake needs about 21.4 GiB (texel space 16 GiB, ...), more than max_memory = 17.9 GiB; <advice>".

@@ -165,13 +165,25 @@ double covered_peak(const ReceiverBake& r, const Image& image) {
   return peak;
 }
 
+// The same over a per-light image's tiles (beyond them it holds 0).
+double covered_peak(const ReceiverBake& r, const TiledImages& images, std::size_t l) {
+  double peak = 0;
+  images.each_pixel(l, [&](int x, int y, const float* px) {
+    if (!r.covered[std::size_t(y) * std::size_t(images.width()) + std::size_t(x)]) return;
+    for (int c = 0; c < images.channels(); ++c)
+      if (std::isfinite(px[c])) peak = std::max(peak, double(px[c]));
+  });
+  return peak;
+}
+
 // The largest of the lightmaps' (per_light false) or of the per-light images'.
 double covered_peak(const BakeResult& result, bool per_light) {
   double peak = 0;
   for (const ReceiverBake& r : result.receivers) {
     if (!per_light) peak = std::max(peak, covered_peak(r, r.image));
     if (per_light)
-      for (const Image& image : r.per_light) peak = std::max(peak, covered_peak(r, image));
+      for (std::size_t l = 0; l < r.per_light.size(); ++l)
+        peak = std::max(peak, covered_peak(r, r.per_light, l));
   }
   return peak;
 }
@@ -242,7 +254,7 @@ Expected<ManifestFiles> write_sheet(OutputFolder& folder, const Scene& scene,
 
   for (std::size_t l = 0; l < names.per_light.size(); ++l) {
     const Image light = sheet_image(sheet, result, 3, 0.0f, true,
-                                    [l](const ReceiverBake& r) { return r.per_light[l]; });
+                                    [l](const ReceiverBake& r) { return r.per_light.dense(l); });
     if (Status s =
             write_encoded(folder.staged(names.per_light[l]), light, out.encoding, scales.per_light);
         !s)

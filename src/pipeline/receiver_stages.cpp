@@ -33,8 +33,7 @@ std::vector<std::uint8_t> arbitrary_texels(bool visibility, const TexelSpace& sp
                                            std::optional<std::size_t> output = std::nullopt) {
   std::vector<std::uint8_t> arbitrary;
   if (!visibility) return arbitrary;
-  arbitrary.assign(space.covered.size(), 0);
-  for (const Texel& t : space.texels) {
+  const auto decide = [&](const Texel& t) {
     const Vec3 y = t.position.cast<double>(), n = t.normal.cast<double>();
     // Its block's lights: the others reach none of its texels.
     const auto listed = lists.lights_of(lists.block_of(t.x, t.y));
@@ -42,24 +41,36 @@ std::vector<std::uint8_t> arbitrary_texels(bool visibility, const TexelSpace& sp
       return (!output || std::size_t(lights[l].output()) == *output) && lights[l].reaches(y, n);
     });
     arbitrary[std::size_t(t.y) * std::size_t(space.width) + std::size_t(t.x)] = !reached;
+  };
+  if (!output) {
+    arbitrary.assign(space.covered.size(), 0);
+    for (const Texel& t : space.texels) decide(t);
+    return arbitrary;
+  }
+  // One scene light's: every covered texel but those of the blocks its parts' lists give it.
+  arbitrary = space.covered;
+  std::vector<std::uint32_t> blocks;
+  for (std::size_t l = 0; l < lights.size(); ++l)
+    if (std::size_t(lights[l].output()) == *output) {
+      const auto mine = lists.blocks_of(l);
+      blocks.insert(blocks.end(), mine.begin(), mine.end());
+    }
+  std::sort(blocks.begin(), blocks.end());
+  blocks.erase(std::unique(blocks.begin(), blocks.end()), blocks.end());
+  constexpr int side = LightLists::kSide;
+  for (const std::uint32_t b : blocks) {
+    const int x0 = int(b % std::uint32_t(lists.blocks_x())) * side;
+    const int y0 = int(b / std::uint32_t(lists.blocks_x())) * side;
+    for (int y = y0; y < std::min(y0 + side, space.height); ++y) {
+      // The row's texels in the block (texels are in row-major order).
+      auto t = std::lower_bound(space.texels.begin(), space.texels.end(), std::pair(y, x0),
+                                [](const Texel& a, const std::pair<int, int>& key) {
+                                  return std::pair<int, int>(a.y, a.x) < key;
+                                });
+      for (; t != space.texels.end() && t->y == y && t->x < x0 + side; ++t) decide(*t);
+    }
   }
   return arbitrary;
-}
-
-// A receiver's images with their arbitrary texels, for stitch_seams: the value image (every
-// light), then each light's value and visibility images (that light alone), so that a light's
-// image is stitched as a bake of that light alone would stitch it.
-std::vector<SeamImage> seam_images(const Scene& scene, ReceiverBake& out, const TexelSpace& space,
-                                   const std::vector<Light>& lights, const LightLists& lists) {
-  const bool visibility = scene.bake.quantity == Quantity::visibility;
-  std::vector<SeamImage> images = {
-      {&out.image, arbitrary_texels(visibility, space, lights, lists)}};
-  for (std::size_t l = 0; l < out.per_light.size(); ++l)
-    images.push_back({&out.per_light[l], arbitrary_texels(visibility, space, lights, lists, l)});
-  for (std::size_t l = 0; l < out.per_light_visibility.size(); ++l)
-    images.push_back(
-        {&out.per_light_visibility[l], arbitrary_texels(true, space, lights, lists, l)});
-  return images;
 }
 
 // What a seam's lookup difference is measured against (SeamReport): 1 for a visibility, the
@@ -248,21 +259,66 @@ Expected<std::vector<std::string>> layout_warnings(const Scene& scene, const Obj
   return warnings;
 }
 
+namespace {
+
+// Each of light l's images made whole, given its shadow-mask range, dilated and stitched as a
+// bake of that light alone would be, and kept by tiles again: one light's images whole at a
+// time (a level's thousand lights would not fit whole together).
+void finish_light(const Scene& scene, const TexelSpace& space, const std::vector<Light>& lights,
+                  const LightLists& lists, const SeamStitcher* stitcher, std::size_t l,
+                  ReceiverBake& out, double& seconds_dilate, double& seconds_seams) {
+  const bool visibility = scene.bake.quantity == Quantity::visibility;
+  const auto finish = [&](TiledImages& images, bool mask) {
+    if (l >= images.size()) return;
+    Image image = images.dense(l);
+    if (mask) apply_shadowmask_range(image, scene.lights[l], space);
+    const auto dilate_start = std::chrono::steady_clock::now();
+    dilate(image, space.covered, scene.bake.margin);
+    seconds_dilate += seconds_since(dilate_start);
+    if (stitcher) {
+      const auto seams_start = std::chrono::steady_clock::now();
+      stitcher->stitch(image, arbitrary_texels(mask || visibility, space, lights, lists, l),
+                       SeamSolver::automatic);
+      seconds_seams += seconds_since(seams_start);
+    }
+    images.assign(l, image);
+  };
+  finish(out.per_light, false);
+  finish(out.per_light_visibility, true);
+}
+
+}  // namespace
+
 void finish_receiver(const Scene& scene, const Mesh& mesh, const TexelSpace& space,
                      const std::vector<Light>& lights, const LightLists& lists, ReceiverBake& out) {
-  for (std::size_t l = 0; l < out.per_light_visibility.size(); ++l)
-    apply_shadowmask_range(out.per_light_visibility[l], scene.lights[l], space);
   const auto dilate_start = std::chrono::steady_clock::now();
   dilate(out.image, space.covered, scene.bake.margin);
-  for (Image& image : out.per_light) dilate(image, space.covered, scene.bake.margin);
-  for (Image& image : out.per_light_visibility) dilate(image, space.covered, scene.bake.margin);
   out.seconds_dilate = seconds_since(dilate_start);
   const auto seams_start = std::chrono::steady_clock::now();
   // The arbitrary-texel masks cost a reach test per texel and light: only for a mesh with seams.
-  if (const std::vector<SeamEdge> seams = find_seams(mesh); !seams.empty()) {
-    out.seams = stitch_seams(seams, space.covered, seam_images(scene, out, space, lights, lists),
-                             seam_scale(scene, out.image), scene.bake.seams);
+  const std::vector<SeamEdge> seams = find_seams(mesh);
+  std::optional<SeamStitcher> stitcher;
+  if (!seams.empty()) {
+    stitcher.emplace(seams, out.image.width, out.image.height, space.covered);
+    const bool visibility = scene.bake.quantity == Quantity::visibility;
+    const std::vector<std::uint8_t> arbitrary = arbitrary_texels(visibility, space, lights, lists);
+    const double scale = seam_scale(scene, out.image);
+    out.seams.edges = std::int64_t(seams.size());
+    out.seams.before = stitcher->difference(out.image, arbitrary, scale);
+    out.seams.after = out.seams.before;
+    if (scene.bake.seams) {
+      out.seams.texels = stitcher->texels();
+      stitcher->stitch(out.image, arbitrary, SeamSolver::automatic);
+      out.seams.after = stitcher->difference(out.image, arbitrary, scale);
+    } else {
+      stitcher.reset();
+    }
   }
+  out.seconds_seams = seconds_since(seams_start);
+  const std::size_t per_light = std::max(out.per_light.size(), out.per_light_visibility.size());
+  for (std::size_t l = 0; l < per_light; ++l)
+    finish_light(scene, space, lights, lists, stitcher ? &*stitcher : nullptr, l, out,
+                 out.seconds_dilate, out.seconds_seams);
   out.seams.stitched = scene.bake.seams;
   out.seconds_seams = seconds_since(seams_start);
   out.covered_texels = std::int64_t(space.texels.size());

@@ -1,6 +1,7 @@
 // A shard's receivers on disk (shard_files.h).
 #include "pipeline/shard_files.h"
 
+#include "methods/light_mix.h"
 #include "pipeline/json_fields.h"
 #include "pipeline/receiver_record.h"
 
@@ -22,8 +23,8 @@ using json = nlohmann::ordered_json;
 constexpr std::uint32_t kReceiverMagic = 0x52535342;  // "SBSR"
 constexpr std::uint32_t kMeshMagic = 0x4D535342;      // "SBSM"
 // 2: receivers' seams; 3: UV stretch, density spread; 4: tiles, the method's tallies; 5: the
-// receiver's record as the manifest writes it (receiver_record.h).
-constexpr std::uint32_t kVersion = 5;
+// receiver's record as the manifest writes it (receiver_record.h); 6: per-light images by tiles.
+constexpr std::uint32_t kVersion = 6;
 // A lightmap side no bake makes (resolution ≤ 16384), so that a damaged header cannot make the
 // reader allocate terabytes.
 constexpr std::uint64_t kMaxSide = 16384;
@@ -157,9 +158,13 @@ std::string receiver_data(const ReceiverBake& r) {
   put(out, header, 4);
   put(out, r.image.pixels.data(), r.image.pixels.size());
   put(out, r.covered.data(), r.covered.size());
-  for (const Image& image : r.per_light) put(out, image.pixels.data(), image.pixels.size());
-  for (const Image& image : r.per_light_visibility)
-    put(out, image.pixels.data(), image.pixels.size());
+  // Per-light images by their tiles: a count, the tiles, their values.
+  for (const TiledImages* images : {&r.per_light, &r.per_light_visibility})
+    for (std::size_t l = 0; l < images->size(); ++l) {
+      put_u64(out, images->tiles(l).size());
+      put(out, images->tiles(l).data(), images->tiles(l).size());
+      put(out, images->values(l).data(), images->values(l).size());
+    }
   if (r.gltf_mesh) put_mesh(out, *r.gltf_mesh);
   return out;
 }
@@ -216,10 +221,16 @@ Expected<ReceiverBake> read_receiver(const json& meta, const std::filesystem::pa
   in.take(r.image.pixels.data(), r.image.pixels.size());
   r.covered.resize(texels);
   in.take(r.covered.data(), r.covered.size());
-  r.per_light.assign(per_light, Image(side, rows, 3));
-  for (Image& image : r.per_light) in.take(image.pixels.data(), image.pixels.size());
-  r.per_light_visibility.assign(visibility, Image(side, rows, 2));
-  for (Image& image : r.per_light_visibility) in.take(image.pixels.data(), image.pixels.size());
+  r.per_light = per_light_values(per_light, side, rows);
+  r.per_light_visibility = per_light_visibilities(visibility, side, rows);
+  for (TiledImages* images : {&r.per_light, &r.per_light_visibility})
+    for (std::size_t l = 0; l < images->size(); ++l) {
+      std::vector<std::uint32_t> tiles = in.vector<std::uint32_t>(in.u64());
+      const std::size_t values = tiles.size() * std::size_t(TiledImages::kSide) *
+                                 std::size_t(TiledImages::kSide) * std::size_t(images->channels());
+      if (!images->restore(l, std::move(tiles), in.vector<float>(values)))
+        return damaged(data.string(), "receiver '" + r.name + "'s per-light images are damaged");
+    }
   if (mesh) r.gltf_mesh = std::make_shared<const GltfMesh>(take_mesh(in));
   if (!in.at_end()) return damaged(data.string(), "its size does not match its header");
   return r;

@@ -9,6 +9,7 @@
 #include <map>
 
 #include "core/stopwatch.h"
+#include "methods/light_mix.h"
 #include "pipeline/receiver_stages.h"
 #include "texels/lightmap_sizes.h"
 #include "texels/uv_checks.h"
@@ -117,8 +118,17 @@ void crop_to_tile(ReceiverBake& r, const TexelSpace& space, RowRange rows) {
     image = std::move(out);
   };
   crop(r.image);
-  for (Image& image : r.per_light) crop(image);
-  for (Image& image : r.per_light_visibility) crop(image);
+  const auto crop_each = [&](TiledImages& images) {
+    TiledImages cropped(images.size(), images.width(), rows.end - rows.begin, images.fill());
+    for (std::size_t l = 0; l < images.size(); ++l) {
+      Image image = images.dense(l);
+      crop(image);
+      cropped.assign(l, image);
+    }
+    images = std::move(cropped);
+  };
+  crop_each(r.per_light);
+  crop_each(r.per_light_visibility);
   const std::size_t width = std::size_t(space.width);
   r.covered.assign(space.covered.begin() + std::ptrdiff_t(std::size_t(rows.begin) * width),
                    space.covered.begin() + std::ptrdiff_t(std::size_t(rows.end) * width));
@@ -175,16 +185,23 @@ Expected<std::vector<ReceiverBake>> join_tiles(const Scene& scene,
     out.name = first.name;
     out.uv_channel = first.uv_channel;
     out.image = Image(side, side, first.image.channels);
-    out.per_light.assign(first.per_light.size(), Image(side, side, 3));
-    out.per_light_visibility.assign(first.per_light_visibility.size(), Image(side, side, 2));
+    // Each light's images from its tiles' rows, one light at a time.
+    const auto join_each = [&](TiledImages ReceiverBake::*member, TiledImages made) {
+      for (std::size_t l = 0; l < made.size(); ++l) {
+        Image whole(side, side, made.channels());
+        for (const ReceiverBake& t : tiles)
+          copy_rows((t.*member).dense(l), 0, t.tile->end - t.tile->begin, whole, t.tile->begin);
+        made.assign(l, whole);
+      }
+      out.*member = std::move(made);
+    };
+    join_each(&ReceiverBake::per_light, per_light_values(first.per_light.size(), side, side));
+    join_each(&ReceiverBake::per_light_visibility,
+              per_light_visibilities(first.per_light_visibility.size(), side, side));
     std::vector<std::uint8_t> covered(std::size_t(side) * std::size_t(side), 0);
     for (const ReceiverBake& t : tiles) {
       const int rows = t.tile->end - t.tile->begin;
       copy_rows(t.image, 0, rows, out.image, t.tile->begin);
-      for (std::size_t l = 0; l < t.per_light.size(); ++l)
-        copy_rows(t.per_light[l], 0, rows, out.per_light[l], t.tile->begin);
-      for (std::size_t l = 0; l < t.per_light_visibility.size(); ++l)
-        copy_rows(t.per_light_visibility[l], 0, rows, out.per_light_visibility[l], t.tile->begin);
       out.most_lights_per_texel = std::max(out.most_lights_per_texel, t.most_lights_per_texel);
       std::copy(t.covered.begin(), t.covered.end(),
                 covered.begin() + std::ptrdiff_t(std::size_t(t.tile->begin) * std::size_t(side)));

@@ -105,33 +105,6 @@ void add_crossings(const Vec2& p0, const Vec2& p1, int width, int height,
   }
 }
 
-// The least-squares system of a receiver's seams at one lightmap size, built once and solved for
-// each of its images (the value image, per-light images, shadow-mask visibility).
-class SeamStitcher {
- public:
-  SeamStitcher(const std::vector<SeamEdge>& seams, int width, int height,
-               const std::vector<std::uint8_t>& covered);
-
-  std::int64_t texels() const { return std::int64_t(texel_.size()); }
-  // |lookup on side a − lookup on side b| over the measured samples and the channels: the
-  // largest, and the share of samples above scale / 255.
-  SeamDifference difference(const Image& image, const std::vector<std::uint8_t>& arbitrary,
-                            double scale) const;
-  // Solves for the image's seam texels, every channel, each kept within the values around it.
-  void stitch(Image& image, const std::vector<std::uint8_t>& arbitrary, SeamSolver solver) const;
-
- private:
-  struct Sample {
-    int texel[8];    // side a's four bilinear texels, then side b's (pixel indices)
-    int unknown[8];  // the same texels as indices into texel_
-    double weight[8];
-  };
-  bool measured(const Sample& s, const std::vector<std::uint8_t>& arbitrary) const;
-  std::vector<Sample> samples_;
-  std::vector<int> texel_;             // the solve's unknowns: pixel indices
-  std::vector<std::uint8_t> covered_;  // per unknown
-};
-
 }  // namespace
 
 std::vector<SeamEdge> find_seams(const Mesh& mesh) {

@@ -59,6 +59,34 @@ struct SeamImage {
 // and by conjugate gradients where it would fill in (automatic), or always one way (for tests).
 enum class SeamSolver { automatic, factorised, iterative };
 
+// The least-squares system of a receiver's seams at one lightmap size, built once and solved for
+// each of its images (the value image, per-light images, shadow-mask visibility): a receiver's
+// per-light images are stitched one at a time (pipeline/receiver_stages.cpp).
+class SeamStitcher {
+ public:
+  SeamStitcher(const std::vector<SeamEdge>& seams, int width, int height,
+               const std::vector<std::uint8_t>& covered);
+
+  std::int64_t texels() const { return std::int64_t(texel_.size()); }
+  // |lookup on side a − lookup on side b| over the measured samples and the channels: the
+  // largest, and the share of samples above scale / 255.
+  SeamDifference difference(const Image& image, const std::vector<std::uint8_t>& arbitrary,
+                            double scale) const;
+  // Solves for the image's seam texels, every channel, each kept within the values around it.
+  void stitch(Image& image, const std::vector<std::uint8_t>& arbitrary, SeamSolver solver) const;
+
+ private:
+  struct Sample {
+    int texel[8];    // side a's four bilinear texels, then side b's (pixel indices)
+    int unknown[8];  // the same texels as indices into texel_
+    double weight[8];
+  };
+  bool measured(const Sample& s, const std::vector<std::uint8_t>& arbitrary) const;
+  std::vector<Sample> samples_;
+  std::vector<int> texel_;             // the solve's unknowns: pixel indices
+  std::vector<std::uint8_t> covered_;  // per unknown
+};
+
 // Stitches `images` (all width × height of one receiver) along `seams`, each on its own, and
 // reports on the first (its differences against `scale`: 1 for a visibility, the largest value
 // for an irradiance); with `solve` false, only measures them (after = before, texels 0).

@@ -2,6 +2,7 @@
 // different channels, lights that never meet share one, a fifth overlapping light is left out
 // with a warning naming it, and the mask holds each channel's light's visibility.
 #include "lightmaps/shadowmask.h"
+#include "methods/light_mix.h"
 
 #include <gtest/gtest.h>
 
@@ -43,6 +44,13 @@ TEST(ShadowmaskChannels, LightsThatNeverMeetShareAChannel) {
   EXPECT_TRUE(c.warnings.empty());
 }
 
+// Visibility images as a bake keeps them, by tiles.
+TiledImages tiled(const std::vector<Image>& images) {
+  TiledImages out = per_light_visibilities(images.size(), images[0].width, images[0].height);
+  for (std::size_t l = 0; l < images.size(); ++l) out.assign(l, images[l]);
+  return out;
+}
+
 TEST(ShadowmaskChannels, OverlapsComeFromCoveredTexelsWhereBothReach) {
   // Three texels; light 0 reaches texels 0 and 1, light 1 texel 1, light 2 texel 2 (uncovered).
   std::vector<Image> v(3, Image(3, 1, 2, 0.0f));
@@ -50,7 +58,7 @@ TEST(ShadowmaskChannels, OverlapsComeFromCoveredTexelsWhereBothReach) {
   v[1].pixels[3] = 1;
   v[2].pixels[5] = 1;
   LightOverlaps o(3);
-  add_overlaps(v, {1, 1, 0}, o);
+  add_overlaps(tiled(v), {1, 1, 0}, o);
   EXPECT_TRUE(o.meet(0, 1));
   EXPECT_TRUE(o.meet(1, 0));
   EXPECT_FALSE(o.meet(0, 2));
@@ -65,7 +73,7 @@ TEST(ShadowmaskImage, EachChannelHoldsItsLightsVisibility) {
       {0.25f, 1, 1, 0}, {0.5f, 1, 0.75f, 1}, {1, 0, 0.125f, 1}, {0, 1, 0, 1}};
   for (int l = 0; l < 4; ++l)
     for (int i = 0; i < 4; ++i) v[std::size_t(l)].pixels[std::size_t(i)] = values[l][i];
-  const Image mask = compose_shadowmask(v, {0, 1, 0, -1}, 2, 1);
+  const Image mask = compose_shadowmask(tiled(v), {0, 1, 0, -1}, 2, 1);
   ASSERT_EQ(mask.channels, 4);
   EXPECT_FLOAT_EQ(mask.at(0, 0)[0], 0.25f);
   EXPECT_FLOAT_EQ(mask.at(1, 0)[0], 0.125f);

@@ -176,7 +176,7 @@ TEST(MeshLight, PerLightImageIsTheMeshLightAlone) {
     ASSERT_TRUE(alone) << alone.error().message;
     const ReceiverBake& r = baked_both->receivers.at(0);
     ASSERT_EQ(r.per_light.size(), 2u);
-    const Image& tent = r.per_light[0];
+    const Image tent = r.per_light.dense(0);
     const Image& expected = alone->receivers.at(0).image;
     for (std::size_t i = 0; i < tent.pixels.size(); ++i)
       ASSERT_NEAR(tent.pixels[i], expected.pixels[i], 1e-5) << i;

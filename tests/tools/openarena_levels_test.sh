@@ -7,7 +7,10 @@
 #     both against the reference at 1,024);
 #   - peak resident memory under 512 MiB (/usr/bin/time's %M);
 #   - the manifest says how many lights reach a texel at most, and no library message (OpenMesh's
-#     "add_face") reaches the terminal.
+#     "add_face") reaches the terminal;
+#   - oacmpdm5 with each light's own image and the shadow masks (--per-light --shadowmask): peak
+#     under 512 MiB (224 full-size images took 1,391 MiB; they are kept by the tiles each light
+#     reaches) and a file per light.
 # Usage: openarena_levels_test.sh SHADOWBAKE ASSETS_DIR WORK_DIR. Exits 77 (skipped) where the
 # levels are missing.
 set -euo pipefail
@@ -48,4 +51,21 @@ sys.exit(0 if all(r.get('most_lights_per_texel', 0) > 0 for r in m['receivers'])
     status=1
   fi
 done
+
+map=oacmpdm5
+/usr/bin/time -f %M -o "$work/$map.per_light.peak" "$shadowbake" bake "$assets/openarena/$map.toml" \
+  -o "$work/$map.per_light" --no-cache -q --per-light --shadowmask
+peak_kib=$(tail -1 "$work/$map.per_light.peak")
+echo "$map --per-light --shadowmask: peak $((peak_kib / 1024)) MiB"
+if ((peak_kib >= 512 * 1024)); then
+  echo "FAIL: $map with per-light images peaks at $((peak_kib / 1024)) MiB, not under 512"
+  status=1
+fi
+lights=$(python3 -c "import json,sys; print(len(json.load(open(sys.argv[1]))['lights']))" \
+  "$work/$map.per_light/manifest.json")
+files=$(find "$work/$map.per_light" -name 'world.*.exr' | wc -l)
+if ((files != lights)); then
+  echo "FAIL: $map: $files per-light images for $lights lights"
+  status=1
+fi
 exit $status

@@ -44,6 +44,8 @@ def main():
     parser.add_argument("--samples", type=int, default=16)
     parser.add_argument("--scenes", nargs="*", help="scene files (default: scenes/*/*.toml)")
     parser.add_argument("--methods", nargs="*", default=METHODS)
+    parser.add_argument("--flags", default="",
+                        help="more bake flags, e.g. '--per-light --shadowmask'")
     args = parser.parse_args()
     root = pathlib.Path(__file__).resolve().parents[2]
     exe = (pathlib.Path(args.build) / "shadowbake").resolve()
@@ -57,7 +59,7 @@ def main():
                 proc = subprocess.run(
                     [str(exe), "bake", scene, "-o", str(out), "--method", method, "-q",
                      "--resolution", str(args.resolution), "--samples", str(args.samples),
-                     "--threads", "2", "--no-cache"],
+                     "--threads", "2", "--no-cache"] + args.flags.split(),
                     cwd=root, capture_output=True, text=True)
                 if proc.returncode != 0:
                     last = (proc.stderr.strip().splitlines() or ["?"])[-1]
