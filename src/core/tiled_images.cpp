@@ -41,13 +41,13 @@ Image TiledImages::dense(std::size_t i, std::span<const float> outside) const {
   const std::span<const float> background =
       outside.empty() ? std::span<const float>(fill_) : outside;
   const int c = channels();
-  Image image(width_, height_, c);
-  // Image's constructor fills with one value; a per-channel background is written here.
+  // Image's constructor fills with one value; a per-channel background is written pixel by pixel.
   bool uniform = true;
   for (float v : background) uniform = uniform && v == background[0];
-  if (!uniform || background[0] != 0.0f)
-    for (std::size_t k = 0; k < image.pixels.size(); ++k)
-      image.pixels[k] = background[k % std::size_t(c)];
+  Image image(width_, height_, c, uniform ? background[0] : 0.0f);
+  if (!uniform)
+    for (std::size_t k = 0; k < image.pixels.size(); k += std::size_t(c))
+      std::copy(background.begin(), background.end(), &image.pixels[k]);
   const Tiles& t = images_[i];
   for (std::size_t s = 0; s < t.tiles.size(); ++s) {
     const int x0 = int(t.tiles[s] % std::uint32_t(tiles_x())) * kSide;

@@ -184,10 +184,11 @@ MixedImages LightMix::finish() {
   // Each light's images made whole one at a time (beyond its tiles: no light counts), filled
   // over its tiles, and kept by tiles again.
   const std::size_t outputs = std::max(out_.per_light.size(), out_.per_light_visibility.size());
-  for (std::size_t o = 0; o < outputs; ++o) {
-    std::vector<std::size_t> parts;
-    for (std::size_t l = 0; l < lights_.size(); ++l)
-      if (std::size_t(lights_[l].output()) == o) parts.push_back(l);
+  std::vector<std::vector<std::size_t>> parts_of(outputs);
+  for (std::size_t l = 0; l < lights_.size() && outputs > 0; ++l)
+    parts_of[std::size_t(lights_[l].output())].push_back(l);
+  tbb::parallel_for(std::size_t(0), outputs, [&](std::size_t o) {
+    const std::vector<std::size_t>& parts = parts_of[o];
     if (quantity_ == Quantity::visibility && o < out_.per_light.size()) {
       const float uncounted[3] = {kNoLightCounts, kNoLightCounts, kNoLightCounts};
       Image image = out_.per_light.dense(o, uncounted);
@@ -201,7 +202,7 @@ MixedImages LightMix::finish() {
                        out_.per_light_visibility.tiles(o));
       out_.per_light_visibility.assign(o, image);
     }
-  }
+  });
   return std::move(out_);
 }
 

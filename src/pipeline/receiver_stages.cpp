@@ -2,6 +2,9 @@
 #include "pipeline/receiver_stages.h"
 
 #include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/combinable.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
@@ -273,7 +276,18 @@ void finish_light(const Scene& scene, const TexelSpace& space, const std::vector
     Image image = images.dense(l);
     if (mask) apply_shadowmask_range(image, scene.lights[l], space);
     const auto dilate_start = std::chrono::steady_clock::now();
-    dilate(image, space.covered, scene.bake.margin);
+    // Beyond its tiles the image holds its fill: dilation visits the tiles within reach of them
+    // where the fill's neighbours may matter.
+    const int tx = images.tiles_x(), ty = images.tiles_y();
+    const int around = (2 * scene.bake.margin + 2 + TiledImages::kSide - 1) / TiledImages::kSide;
+    std::vector<std::uint8_t> visit(std::size_t(tx) * std::size_t(ty), 0);
+    for (const std::uint32_t tile : images.tiles(l)) {
+      const int x = int(tile % std::uint32_t(tx)), y = int(tile / std::uint32_t(tx));
+      for (int v = std::max(0, y - around); v <= std::min(ty - 1, y + around); ++v)
+        for (int u = std::max(0, x - around); u <= std::min(tx - 1, x + around); ++u)
+          visit[std::size_t(v) * std::size_t(tx) + std::size_t(u)] = 1;
+    }
+    dilate(image, space.covered, scene.bake.margin, visit, TiledImages::kSide);
     seconds_dilate += seconds_since(dilate_start);
     if (stitcher) {
       const auto seams_start = std::chrono::steady_clock::now();
@@ -315,10 +329,19 @@ void finish_receiver(const Scene& scene, const Mesh& mesh, const TexelSpace& spa
     }
   }
   out.seconds_seams = seconds_since(seams_start);
+  // The lights in parallel, each its own images whole (two lights' at a time on two cores).
   const std::size_t per_light = std::max(out.per_light.size(), out.per_light_visibility.size());
-  for (std::size_t l = 0; l < per_light; ++l)
-    finish_light(scene, space, lights, lists, stitcher ? &*stitcher : nullptr, l, out,
-                 out.seconds_dilate, out.seconds_seams);
+  tbb::combinable<std::pair<double, double>> seconds;  // dilation, seams
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, per_light, 1), [&](const auto& range) {
+    auto& [dilation, seams_time] = seconds.local();
+    for (std::size_t l = range.begin(); l != range.end(); ++l)
+      finish_light(scene, space, lights, lists, stitcher ? &*stitcher : nullptr, l, out, dilation,
+                   seams_time);
+  });
+  seconds.combine_each([&](const std::pair<double, double>& s) {
+    out.seconds_dilate += s.first;
+    out.seconds_seams += s.second;
+  });
   out.seams.stitched = scene.bake.seams;
   out.seconds_seams = seconds_since(seams_start);
   out.covered_texels = std::int64_t(space.texels.size());

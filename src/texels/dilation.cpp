@@ -23,10 +23,19 @@
 namespace sb {
 
 void dilate(Image& image, const std::vector<std::uint8_t>& covered, int margin) {
+  dilate(image, covered, margin, {}, 0);
+}
+
+void dilate(Image& image, const std::vector<std::uint8_t>& covered, int margin,
+            const std::vector<std::uint8_t>& visit, int tile) {
   const int width = image.width, height = image.height, channels = image.channels;
   assert(covered.size() == std::size_t(width) * std::size_t(height));
   if (margin <= 0 || width <= 0 || height <= 0) return;
-
+  const int tiles_x = tile > 0 ? (width + tile - 1) / tile : 0;
+  const auto visited = [&](int x, int y) {
+    return visit.empty() ||
+           visit[std::size_t(y / tile) * std::size_t(tiles_x) + std::size_t(x / tile)];
+  };
   std::vector<std::uint8_t> filled(covered.begin(), covered.end());
   std::vector<std::uint8_t> next = filled;
   for (int ring = 0; ring < margin; ++ring) {
@@ -36,6 +45,10 @@ void dilate(Image& image, const std::vector<std::uint8_t>& covered, int margin) 
       bool rows_filled = false;
       for (int y = rows.begin(); y != rows.end(); ++y) {
         for (int x = 0; x < width; ++x) {
+          if (!visited(x, y)) {
+            x += tile - 1 - x % tile;  // past the tile
+            continue;
+          }
           const std::size_t index = std::size_t(y) * std::size_t(width) + std::size_t(x);
           if (filled[index]) continue;
           std::fill(sum.begin(), sum.end(), 0.0);

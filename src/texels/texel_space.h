@@ -128,4 +128,11 @@ TexelSpace rasterise_texels(const Mesh& mesh, int width, int height, RowRange ro
 // near chart borders do not pull in black. Texels further than `margin` stay as they are.
 void dilate(Image& image, const std::vector<std::uint8_t>& covered, int margin);
 
+// The same where the image holds one value at every pixel but those within 2 · margin + 2 of
+// the tiles (of tile × tile pixels, row-major) that `visit` marks (a light's own image beyond the
+// tiles it reaches): there dilation takes the mean of equal values, so only the marked tiles'
+// pixels are visited, with the same result.
+void dilate(Image& image, const std::vector<std::uint8_t>& covered, int margin,
+            const std::vector<std::uint8_t>& visit, int tile);
+
 }  // namespace sb
