@@ -271,6 +271,14 @@ void finish_light(const Scene& scene, const TexelSpace& space, const std::vector
                   const LightLists& lists, const SeamStitcher* stitcher, std::size_t l,
                   ReceiverBake& out, double& seconds_dilate, double& seconds_seams) {
   const bool visibility = scene.bake.quantity == Quantity::visibility;
+  // The light's arbitrary texels, by whether the image is a visibility: found once, as the value
+  // image of a visibility bake and the mask's visibility share them.
+  std::optional<std::vector<std::uint8_t>> arbitrary[2];
+  const auto arbitrary_of = [&](bool of_visibility) -> const std::vector<std::uint8_t>& {
+    std::optional<std::vector<std::uint8_t>>& a = arbitrary[of_visibility];
+    if (!a) a = arbitrary_texels(of_visibility, space, lights, lists, l);
+    return *a;
+  };
   const auto finish = [&](TiledImages& images, bool mask) {
     if (l >= images.size()) return;
     Image image = images.dense(l);
@@ -291,8 +299,7 @@ void finish_light(const Scene& scene, const TexelSpace& space, const std::vector
     seconds_dilate += seconds_since(dilate_start);
     if (stitcher) {
       const auto seams_start = std::chrono::steady_clock::now();
-      stitcher->stitch(image, arbitrary_texels(mask || visibility, space, lights, lists, l),
-                       SeamSolver::automatic);
+      stitcher->stitch(image, arbitrary_of(mask || visibility), SeamSolver::automatic);
       seconds_seams += seconds_since(seams_start);
     }
     images.assign(l, image);
