@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -56,8 +57,40 @@ void clip(const Polygon& p, const Vec2& a, const Vec2& b, bool left, Polygon& ou
   }
 }
 
+// Removes from `points` those strictly inside the polygon of their extremes in 8 directions
+// (Akl and Toussaint's filter): none of them is a corner of their hull, and sorting them is the
+// hull's main cost (a box's 4 or 8 corners to a sphere light's 8 give 32 or 64 points, about 10
+// of them corners).
+void discard_inside(std::vector<Vec2>& points) {
+  if (points.size() < 16) return;
+  // The directions counter-clockwise; the point farthest along each.
+  static constexpr std::array<std::array<double, 2>, 8> kDirections = {
+      {{1, 0}, {1, 1}, {0, 1}, {-1, 1}, {-1, 0}, {-1, -1}, {0, -1}, {1, -1}}};
+  std::array<Vec2, 8> extreme;
+  std::array<double, 8> best;
+  best.fill(-std::numeric_limits<double>::infinity());
+  for (const Vec2& p : points)
+    for (std::size_t i = 0; i < 8; ++i) {
+      const double along = kDirections[i][0] * p.x() + kDirections[i][1] * p.y();
+      if (along > best[i]) best[i] = along, extreme[i] = p;
+    }
+  std::array<Vec2, 8> corners;
+  std::size_t count = 0;
+  for (const Vec2& e : extreme)
+    if (count == 0 || e != corners[count - 1]) corners[count++] = e;
+  while (count > 1 && corners[count - 1] == corners[0]) --count;
+  if (count < 3) return;
+  const auto inside = [&](const Vec2& p) {
+    for (std::size_t i = 0; i < count; ++i)
+      if (!(side(corners[i], corners[(i + 1) % count], p) > 0)) return false;
+    return true;
+  };
+  points.erase(std::remove_if(points.begin(), points.end(), inside), points.end());
+}
+
 // The convex hull of `points` (sorted in place), counter-clockwise (Andrew's monotone chain).
 void convex_hull(std::vector<Vec2>& points, Polygon& hull) {
+  discard_inside(points);
   std::sort(points.begin(), points.end(), [](const Vec2& a, const Vec2& b) {
     return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
   });
@@ -134,10 +167,16 @@ bool plane_covers(const ShaftCuller& culler, std::uint32_t seed, const std::arra
   const auto in_plane = [&](const Vec3& p) { return Vec2(u.dot(p), v.dot(p)); };
   thread_local std::vector<Vec2> crossings;
   crossings.clear();
-  for (std::size_t a = 0; a < 8; ++a)
+  for (std::size_t a = 0; a < 8; ++a) {
+    // A corner equal to an earlier one (a box flat in an axis: a patch of floor or wall) adds
+    // the same crossings again.
+    if (std::find(box.begin(), box.begin() + std::ptrdiff_t(a), box[a]) !=
+        box.begin() + std::ptrdiff_t(a))
+      continue;
     for (std::size_t b = 0; b < ends.size(); ++b)
       crossings.push_back(
           in_plane((-h_end[b] * box[a] + h_box[a] * ends[b]) / (h_box[a] - h_end[b])));
+  }
   thread_local Polygon hull;
   convex_hull(crossings, hull);
   const double hull_area = hull.empty() ? 0.0 : area(hull);
@@ -169,11 +208,30 @@ bool plane_covers(const ShaftCuller& culler, std::uint32_t seed, const std::arra
     if (twice < 0) std::swap(t[1], t[2]);
     triangles.push_back(t);
   }
+  // Whether they can cover it at all: its area is what they cover of it, what is left, and the
+  // slivers dropped (each under `negligible`, at most 4 per piece and triangle, below), and a
+  // triangle covers no more of it than of its box. Most polygons a plane fails to cover (a
+  // pillar's face, a floor's edge) fail here, before the subtraction.
+  const double negligible = kUncovered * hull_area;
+  {
+    const std::array<Vec2, 4> frame = {lo, Vec2(hi.x(), lo.y()), hi, Vec2(lo.x(), hi.y())};
+    thread_local Polygon part, cut;
+    double reach = 0;
+    for (const auto& t : triangles) {
+      part.assign(t.begin(), t.end());
+      for (std::size_t e = 0; e < 4 && part.size() >= 3; ++e) {
+        clip(part, frame[e], frame[(e + 1) % 4], true, cut);
+        part.swap(cut);
+      }
+      if (part.size() >= 3) reach += area(part);
+    }
+    const double dropped = 4.0 * double(kMaxPieces) * double(triangles.size()) * negligible;
+    if (reach + dropped < hull_area * (1 - 1e-9)) return false;
+  }
   // The largest first: a wall's big triangles leave the fewest pieces.
   std::sort(triangles.begin(), triangles.end(), [](const auto& a, const auto& b) {
     return side(a[0], a[1], a[2]) > side(b[0], b[1], b[2]);
   });
-  const double negligible = kUncovered * hull_area;
   // The pieces left, each with its box; a piece the triangle's box misses passes on whole.
   struct Piece {
     Polygon polygon;

@@ -34,13 +34,13 @@ namespace {
 // A light baked by rays alone: clear tiles and texels are 1, the rest the reference's own
 // estimate at `samples` rays: a textured light's (the estimator weighs a uniform light only), or a
 // point's at one ray, which is exact (its shadows are hard: nothing to estimate or interpolate).
-void bake_light_by_rays(const TexelSpace& space, const TexelGrid& grid,
+void bake_light_by_rays(const TexelSpace& space, const TexelGrid& grid, const TileJoins& joins,
                         const BackprojectionInputs& in, std::span<const std::uint32_t> in_reach,
                         std::size_t l, int samples, LightMix& mix, RouteCounts& counts) {
   const Light& light = (*in.lights)[l];
   const double offset = in.rays->surface_offset();
-  const TileShafts tiles = tile_shafts(space, grid, *in.culler, *in.rays, light, kTileCandidates,
-                                       /*umbrae=*/false, in_reach);
+  const TileShafts tiles = tile_shafts(space, grid, joins, *in.culler, *in.rays, light,
+                                       kTileCandidates, /*umbrae=*/false, in_reach);
   // Counted: the kept rows' texels (a tile's halo is not).
   const auto kept = kept_texels(space);
   const std::size_t kept0 = kept.first, kept1 = kept.second;
@@ -100,12 +100,12 @@ namespace {
 
 // Light l's field over the receiver whose texel grid (light-independent) is `grid`, over the
 // tiles `in_reach` (the rest are empty).
-LightField light_field(const TexelSpace& space, const TexelGrid& grid,
+LightField light_field(const TexelSpace& space, const TexelGrid& grid, const TileJoins& joins,
                        const BackprojectionInputs& in, std::span<const std::uint32_t> in_reach,
                        std::size_t l) {
   const Light& light = (*in.lights)[l];
-  const TileShafts tiles = tile_shafts(space, grid, *in.culler, *in.rays, light, kTileCandidates,
-                                       /*umbrae=*/true, in_reach);
+  const TileShafts tiles = tile_shafts(space, grid, joins, *in.culler, *in.rays, light,
+                                       kTileCandidates, /*umbrae=*/true, in_reach);
   const std::unique_ptr<PairSource> pairs = light_pairs(space, light, in, tiles);
   return refine_light(space, grid, tiles, *pairs, in.refinement);
 }
@@ -115,7 +115,8 @@ LightField light_field(const TexelSpace& space, const TexelGrid& grid,
 LightField backprojection_light(const TexelSpace& space, const BackprojectionInputs& in,
                                 std::size_t l) {
   const LightLists lists(space, *in.lights);
-  return light_field(space, TexelGrid(space), in, lists.blocks_of(l), l);
+  const TexelGrid grid(space);
+  return light_field(space, grid, TileJoins(space, grid), in, lists.blocks_of(l), l);
 }
 
 MixedImages bake_backprojection(const TexelSpace& space, const BackprojectionInputs& in,
@@ -128,7 +129,9 @@ MixedImages bake_backprojection(const TexelSpace& space, const BackprojectionInp
   // Counted: the kept rows' texels (a tile's halo is not).
   const auto kept = kept_texels(space);
   const std::size_t kept0 = kept.first, kept1 = kept.second;
-  const TexelGrid grid(space);  // built once: it does not depend on the light
+  // Built once: they do not depend on the light.
+  const TexelGrid grid(space);
+  const TileJoins joins(space, grid);
   // Light l's field into the mix: distinct texels in parallel (LightMix::set allows it), tile by
   // tile through the grid (so that no texel's record is read), each range counting its routes.
   const auto apply = [&](std::size_t l, const LightField& field) {
@@ -184,7 +187,7 @@ MixedImages bake_backprojection(const TexelSpace& space, const BackprojectionInp
         const Light& light = lights[step.light];
         if (light.textured() || light.is_point()) return step;
         step.field = std::make_shared<LightField>(
-            light_field(space, grid, in, lists.blocks_of(step.light), step.light));
+            light_field(space, grid, joins, in, lists.blocks_of(step.light), step.light));
         return step;
       }) & tbb::make_filter<Step, void>(tbb::filter_mode::serial_in_order, [&](const Step& step) {
         const std::size_t l = step.light;
@@ -192,7 +195,7 @@ MixedImages bake_backprojection(const TexelSpace& space, const BackprojectionInp
           apply(l, *step.field);
           return;
         }
-        bake_light_by_rays(space, grid, in, lists.blocks_of(l), l,
+        bake_light_by_rays(space, grid, joins, in, lists.blocks_of(l), l,
                            lights[l].is_point() ? 1 : in.samples, mix, counts);
       }));
   if (routes) *routes = counts;

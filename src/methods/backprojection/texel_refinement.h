@@ -5,6 +5,7 @@
 // change in the field, not chance.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
@@ -32,6 +33,26 @@ class TexelGrid {
     const std::uint64_t bit = std::uint64_t(1) << (x & 63);
     if (!(bits_[word] & bit)) return -1;
     return first_[word] + std::popcount(bits_[word] & (bit - 1));
+  }
+  // The texels of the tile of kSide × kSide pixels whose corner is (kSide·tx, kSide·ty), by
+  // pixel (row-major within the tile), -1 where none: a count of bits per row, not per pixel.
+  static constexpr int kSide = 8;
+  void tile_texels(int tx, int ty, std::array<std::int32_t, kSide * kSide>& out) const {
+    const int x0 = tx * kSide;
+    const std::size_t shift = std::size_t(x0 & 63);
+    for (int row = 0; row < kSide; ++row) {
+      const int y = ty * kSide + row;
+      std::int32_t* at = out.data() + row * kSide;
+      if (y >= height) {
+        std::fill(at, at + kSide, -1);
+        continue;
+      }
+      const std::size_t word = std::size_t(y) * words_per_row_ + std::size_t(x0 >> 6);
+      std::int32_t next =
+          first_[word] + std::popcount(bits_[word] & ((std::uint64_t(1) << shift) - 1));
+      const std::uint64_t bits = bits_[word] >> shift;
+      for (int k = 0; k < kSide; ++k) at[k] = (bits >> k & 1) ? next++ : -1;
+    }
   }
   // Calls f(texel, x, y) for each covered pixel of rows [y0, y1), in row-major order: the texels
   // with their pixels, without reading their records.

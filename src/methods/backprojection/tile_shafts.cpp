@@ -35,6 +35,26 @@ struct TilePatches {
   std::uint64_t reached = 0;  // its texels the light reaches (TileShafts::reached)
 };
 
+// Whether the segment from a to b meets the triangle `corners` (its barycentric coordinates and
+// the segment's parameter within a millionth of their ranges; parallel to its plane counts):
+// a triangle that hides all of a light from a box meets the segment from the box's centre to
+// the light's centre, and this costs a tenth of the test of hiding.
+bool segment_meets(const Vec3* corners, const Vec3& a, const Vec3& b) {
+  constexpr double margin = 1e-6;
+  const Vec3 d = b - a, e1 = corners[1] - corners[0], e2 = corners[2] - corners[0];
+  const Vec3 p = d.cross(e2);
+  const double det = e1.dot(p);
+  if (det == 0) return true;
+  const Vec3 s = a - corners[0];
+  const double u = s.dot(p) / det;
+  if (!(u >= -margin && u <= 1 + margin)) return false;
+  const Vec3 q = s.cross(e1);
+  const double v = d.dot(q) / det;
+  if (!(v >= -margin && u + v <= 1 + margin)) return false;
+  const double t = e2.dot(q) / det;
+  return t >= -margin && t <= 1 + margin;
+}
+
 int root_of(std::array<std::uint8_t, kTile * kTile>& parent, int i) {
   while (parent[std::size_t(i)] != i) {
     parent[std::size_t(i)] = parent[std::size_t(parent[std::size_t(i)])];
@@ -86,6 +106,7 @@ namespace {
 struct TileTester {
   const TexelSpace& space;
   const TexelGrid& grid;
+  const TileJoins& joins;
   const ShaftCuller& culler;
   const RayScene& rays;
   const Light& light;
@@ -123,39 +144,37 @@ void TileTester::find_patches(int tx, int ty, TilePatches& tile) const {
       patch.origins.extend(Vec3(lo + shift));
       patch.origins.extend(Vec3(hi + shift));
       // Every covered texel of it is reached.
+      std::array<std::int32_t, kTile * kTile> texel;
+      grid.tile_texels(tx, ty, texel);
       for (int j = 0; j < kTile * kTile; ++j)
-        if (grid.texel(tx * kTile + j % kTile, ty * kTile + j / kTile) >= 0)
-          tile.reached |= std::uint64_t(1) << j;
+        if (texel[std::size_t(j)] >= 0) tile.reached |= std::uint64_t(1) << j;
       return;
     }
   }
-  // Texel by texel: which the light reaches, and their pieces of surface.
+  // Texel by texel: which the light reaches, and their pieces of surface (the receiver's joins
+  // between texels it reaches).
   std::array<std::int32_t, kTile * kTile> texel;
   std::array<std::uint8_t, kTile * kTile> parent;
+  grid.tile_texels(tx, ty, texel);
   for (int j = 0; j < kTile * kTile; ++j) {
     parent[std::size_t(j)] = std::uint8_t(j);
-    const std::int32_t t = grid.texel(tx * kTile + j % kTile, ty * kTile + j / kTile);
-    texel[std::size_t(j)] = -1;
+    const std::int32_t t = texel[std::size_t(j)];
     if (t < 0) continue;
     const Texel& record = space.texels[std::size_t(t)];
-    if (!light.reaches(record.position.cast<double>(), record.normal.cast<double>())) continue;
-    tile.reached |= std::uint64_t(1) << j;
-    texel[std::size_t(j)] = t;
+    if (light.reaches(record.position.cast<double>(), record.normal.cast<double>()))
+      tile.reached |= std::uint64_t(1) << j;
+    else
+      texel[std::size_t(j)] = -1;
   }
-  const auto joined = [&](std::int32_t a, std::int32_t b) {
-    if (!sizes) return true;
-    const Texel& ta = space.texels[std::size_t(a)];
-    const Texel& tb = space.texels[std::size_t(b)];
-    const float step = std::max(space.face_texel_sizes[std::size_t(ta.face)],
-                                space.face_texel_sizes[std::size_t(tb.face)]);
-    return (ta.position - tb.position).norm() <= kJoinSteps * step;
-  };
+  const std::size_t at = std::size_t(ty) * std::size_t(joins.tiles_x) + std::size_t(tx);
+  const std::uint64_t right = joins.right[at] & tile.reached & (tile.reached >> 1);
+  const std::uint64_t down = joins.down[at] & tile.reached & (tile.reached >> kTile);
   for (int j = 0; j < kTile * kTile; ++j) {
     if (texel[std::size_t(j)] < 0) continue;
-    for (const int k : {j % kTile + 1 < kTile ? j + 1 : -1, j + kTile})
-      if (k >= 0 && k < kTile * kTile && texel[std::size_t(k)] >= 0 &&
-          joined(texel[std::size_t(j)], texel[std::size_t(k)]))
-        parent[std::size_t(root_of(parent, k))] = std::uint8_t(root_of(parent, j));
+    if (right >> j & 1)
+      parent[std::size_t(root_of(parent, j + 1))] = std::uint8_t(root_of(parent, j));
+    if (down >> j & 1)
+      parent[std::size_t(root_of(parent, j + kTile))] = std::uint8_t(root_of(parent, j));
   }
   // Patches in order of their first pixel; past kMaxPatches, the rest join the last.
   std::array<std::int8_t, kTile * kTile> patch_of_root;
@@ -204,8 +223,11 @@ void TileTester::test(TileShafts::Patch& patch, const std::vector<std::uint32_t>
   // tried where they are few; where they are many (a dense mesh's small triangles, none of
   // which hides a light alone: trying them all cost the dense scene a third of its bake), only
   // the one the ray from the box's centre meets (above, for a patch tested down the hierarchy).
+  const Vec3 from = patch.origins.centre(), to = light.centre();
   if (patch.kind == Kind::listed && list.size() <= kUmbraCandidates &&
-      std::any_of(list.begin(), list.end(), hides))
+      std::any_of(list.begin(), list.end(), [&](std::uint32_t triangle) {
+        return segment_meets(culler.triangle_corners(triangle), from, to) && hides(triangle);
+      }))
     patch.kind = Kind::umbra;
   else if (among && dark(patch.origins, hides))
     patch.kind = Kind::umbra;
@@ -314,11 +336,45 @@ void TileTester::test_groups(const TileShafts& tiles, int ty0, int ty1,
 
 }  // namespace
 
-TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const ShaftCuller& culler,
-                       const RayScene& rays, const Light& light, std::size_t max, bool umbrae,
-                       std::span<const std::uint32_t> in_reach) {
+TileJoins::TileJoins(const TexelSpace& space, const TexelGrid& grid)
+    : tiles_x((space.width + kTile - 1) / kTile) {
+  const int tiles_y = (space.height + kTile - 1) / kTile;
+  const std::size_t count = std::size_t(tiles_x) * std::size_t(tiles_y);
+  right.assign(count, 0);
+  down.assign(count, 0);
+  const bool sizes = !space.face_texel_sizes.empty();
+  const auto joined = [&](std::int32_t a, std::int32_t b) {
+    if (!sizes) return true;
+    const Texel& ta = space.texels[std::size_t(a)];
+    const Texel& tb = space.texels[std::size_t(b)];
+    const float step = std::max(space.face_texel_sizes[std::size_t(ta.face)],
+                                space.face_texel_sizes[std::size_t(tb.face)]);
+    return (ta.position - tb.position).norm() <= kJoinSteps * step;
+  };
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count), [&](const auto& r) {
+    std::array<std::int32_t, kTile * kTile> texel;
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      grid.tile_texels(int(i % std::size_t(tiles_x)), int(i / std::size_t(tiles_x)), texel);
+      for (int j = 0; j < kTile * kTile; ++j) {
+        const std::int32_t a = texel[std::size_t(j)];
+        if (a < 0) continue;
+        if (j % kTile + 1 < kTile && texel[std::size_t(j + 1)] >= 0 &&
+            joined(a, texel[std::size_t(j + 1)]))
+          right[i] |= std::uint64_t(1) << j;
+        if (j + kTile < kTile * kTile && texel[std::size_t(j + kTile)] >= 0 &&
+            joined(a, texel[std::size_t(j + kTile)]))
+          down[i] |= std::uint64_t(1) << j;
+      }
+    }
+  });
+}
+
+TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const TileJoins& joins,
+                       const ShaftCuller& culler, const RayScene& rays, const Light& light,
+                       std::size_t max, bool umbrae, std::span<const std::uint32_t> in_reach) {
   const double offset = rays.surface_offset();
-  static_assert(TileShafts::kTile == TexelBlock::kSide, "a tile is a block of the texel space");
+  static_assert(TileShafts::kTile == TexelBlock::kSide && kTile == TexelGrid::kSide,
+                "a tile is a block of the texel space and of its grid");
   TileShafts tiles;
   tiles.tiles_x = (space.width + kTile - 1) / kTile;
   tiles.tiles_y = (space.height + kTile - 1) / kTile;
@@ -341,7 +397,8 @@ TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const Sha
     if (bands.empty() || bands.back() != band) bands.push_back(band);
   }
   std::vector<std::vector<TilePatches>> found(bands.size());
-  const TileTester tester{space, grid, culler, rays, light, max, umbrae, offset, blocks, sizes};
+  const TileTester tester{space, grid,   joins,  culler, rays, light,
+                          max,   umbrae, offset, blocks, sizes};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, bands.size()), [&](const auto& r) {
     for (std::size_t k = r.begin(); k != r.end(); ++k) {
       const int ty0 = bands[k] * g, ty1 = std::min(ty0 + g, tiles.tiles_y);

@@ -3,7 +3,9 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <span>
+#include <vector>
 
 #include "core/geometry.h"
 #include "methods/backprojection/texel_refinement.h"
@@ -19,6 +21,17 @@ namespace sb {
 bool hides_from_all(const Light& light, const Vec3* corners, std::span<const Vec3> points,
                     double offset);
 
+// Which neighbouring texels of each tile lie on one piece of surface (no farther apart than
+// their faces' texel steps allow; every neighbour where the space has no steps): what splits a
+// tile into patches, whatever the light. Built once per receiver (tile_shafts.cpp).
+struct TileJoins {
+  int tiles_x = 0;
+  // Per tile, a bit per pixel j (row-major within the tile): j joined to j + 1 (`right`, never
+  // in the tile's last column) or to j + kTile (`down`).
+  std::vector<std::uint64_t> right, down;
+  TileJoins(const TexelSpace& space, const TexelGrid& grid);
+};
+
 // The shaft test of each of the tiles `in_reach` (indices, ascending: the blocks the light's
 // lists give it, methods/light_lists.h; every other tile is empty) for `light`, patch by patch
 // (TileShafts; ShaftCuller::tile_candidates, at most `max` candidates a patch): clear, listed,
@@ -26,8 +39,9 @@ bool hides_from_all(const Light& light, const Vec3* corners, std::span<const Vec
 // corners of its box of ray origins (so from every one of them: a triangle's umbra is convex):
 // the triangle the ray from the box's centre to the light's centre meets, or one of its
 // candidates. `rays`: those rays, and the surface offset.
-TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const ShaftCuller& culler,
-                       const RayScene& rays, const Light& light, std::size_t max, bool umbrae,
-                       std::span<const std::uint32_t> in_reach);
+// `joins` are the receiver's.
+TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const TileJoins& joins,
+                       const ShaftCuller& culler, const RayScene& rays, const Light& light,
+                       std::size_t max, bool umbrae, std::span<const std::uint32_t> in_reach);
 
 }  // namespace sb

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cmath>
 #include <functional>
+#include <vector>
 
 #include "methods/backprojection/texel_refinement.h"
 
@@ -114,6 +115,44 @@ Outcome refine(const TexelSpace& space, FieldSource& source,
         field.route_at(space.texels[t].x, space.texels[t].y) == TexelRoute::interpolated;
   }
   return o;
+}
+
+// A tile's texels read a row's bits at a time (TexelGrid::tile_texels) are each pixel's own,
+// on a lightmap whose width crosses words of 64 pixels and ends inside a tile, half covered.
+TEST(TexelGrid, ATilesTexelsAreItsPixelsTexels) {
+  TexelSpace space;
+  space.width = 150, space.height = 21;
+  space.covered.assign(std::size_t(space.width * space.height), 0);
+  std::uint32_t state = 12345;
+  for (std::uint8_t& c : space.covered) {
+    state = state * 1664525u + 1013904223u;
+    c = std::uint8_t(state >> 31);
+  }
+  // Texels are numbered in row-major order of their pixels.
+  std::vector<std::int32_t> index(space.covered.size(), -1);
+  std::int32_t count = 0;
+  for (std::size_t i = 0; i < index.size(); ++i)
+    if (space.covered[i]) index[i] = count++;
+  const TexelGrid grid(space);
+  std::array<std::int32_t, TexelGrid::kSide * TexelGrid::kSide> texels;
+  std::int32_t covered = 0;
+  for (int ty = 0; ty * TexelGrid::kSide < space.height; ++ty)
+    for (int tx = 0; tx * TexelGrid::kSide < space.width; ++tx) {
+      grid.tile_texels(tx, ty, texels);
+      for (int j = 0; j < TexelGrid::kSide * TexelGrid::kSide; ++j) {
+        const int x = tx * TexelGrid::kSide + j % TexelGrid::kSide;
+        const int y = ty * TexelGrid::kSide + j / TexelGrid::kSide;
+        const std::int32_t expected =
+            x < space.width && y < space.height
+                ? index[std::size_t(y) * std::size_t(space.width) + std::size_t(x)]
+                : -1;
+        ASSERT_EQ(texels[std::size_t(j)], expected) << x << ", " << y;
+        ASSERT_EQ(grid.texel(x, y), expected) << x << ", " << y;
+        covered += texels[std::size_t(j)] >= 0;
+      }
+    }
+  EXPECT_EQ(covered, count);
+  EXPECT_GT(count, 0);
 }
 
 TEST(TexelRefinement, InterpolatesASmoothFieldExactlyWithFewSamples) {
