@@ -624,6 +624,52 @@ void Rasteriser::settle(const BlockerSolidRef& ref, bool reaches, double gap,
 
 }  // namespace
 
+bool nearest_hide_all(const RasterTarget& target, const std::vector<BlockerPolygon>& polygons,
+                      std::size_t fewest, std::size_t budget) {
+  if (polygons.size() <= fewest) return false;
+  // The attempt's own sample: the target's is written only where it succeeds.
+  PenumbraSample scratch;
+  RasterTarget attempt = target;
+  attempt.out = &scratch;
+  attempt.blocking = nullptr;
+  Rasteriser rasteriser(attempt);
+  if (!rasteriser.usable()) return false;
+  // The polygons in the shaft (add_polygon's first tests), by their boxes' distance.
+  thread_local std::vector<std::pair<double, std::uint32_t>> in_shaft;
+  in_shaft.clear();
+  for (std::size_t i = 0; i < polygons.size(); ++i) {
+    const BlockerPolygon& poly = polygons[i];
+    Vec3 box_lo = poly.v[0], box_hi = poly.v[0];
+    for (int k = 1; k < poly.count; ++k) {
+      box_lo = box_lo.cwiseMin(poly.v[k]);
+      box_hi = box_hi.cwiseMax(poly.v[k]);
+    }
+    if (rasteriser.beside_plane(poly.v[0], poly.normal) || rasteriser.outside_cone(box_lo, box_hi))
+      continue;
+    in_shaft.emplace_back(rasteriser.gap_to(box_lo, box_hi), std::uint32_t(i));
+  }
+  if (in_shaft.size() <= fewest) return false;
+  budget = std::min(budget, in_shaft.size());
+  std::partial_sort(in_shaft.begin(), in_shaft.begin() + std::ptrdiff_t(budget), in_shaft.end());
+  // Nearest first, the rows checked after 2, 4, 6, 9, 13, 19, … of them.
+  bool hidden = false;
+  for (std::size_t k = 0, check = 2; k < budget && !hidden; ++k) {
+    rasteriser.add_polygon(polygons[in_shaft[k].second]);
+    if (k + 1 == check || k + 1 == budget) {
+      hidden = every_row_hidden(*target.rows, *target.blocked);
+      check += std::max<std::size_t>(2, check / 2);
+    }
+  }
+  if (!hidden) return false;
+  // What every polygon of the shaft may hide, as the whole rasterisation would bound it.
+  for (const auto& [gap, i] : in_shaft) {
+    target.out->nearest_blocker =
+        std::min(target.out->nearest_blocker, std::max(gap, target.light_offset));
+    if (target.blocking) target.blocking->push_back(polygons[i].triangle);
+  }
+  return true;
+}
+
 void rasterise_polygons_and_solids(const RasterTarget& target,
                                    const std::vector<BlockerPolygon>& polygons,
                                    const std::vector<BlockerSolidRef>& solids) {

@@ -354,10 +354,12 @@ class LightPairs final : public PairSource {
     const std::int32_t at = prepared_of_[patch_index(tx.x, tx.y)];
     const bool busy = parallax || at < 0 || !prepared_[std::size_t(at)].outlines.empty() ||
                       prepared_[std::size_t(at)].polygons.size() > kRayFirst;
+    bool centre_hidden = false;
     if (const RayScene::Hit hit =
             busy ? in_.rays->first_hit_face(origin, light_.centre() - origin, 1.0)
                  : RayScene::Hit();
         hit.face >= 0) {
+      centre_hidden = true;
       const std::uint32_t triangle = in_.culler->triangle_of_face(hit.face);
       if (triangle_hides_light(light_, in_.culler->triangle_corners(triangle), origin, offset_)) {
         out.route = TexelRoute::umbra;
@@ -382,7 +384,8 @@ class LightPairs final : public PairSource {
     if (at >= 0) {
       const TileBlockers& prepared = prepared_[std::size_t(at)];
       sample = estimator_.visibility(
-          p, n, origin, Blockers{&prepared.polygons, &prepared.solids, &prepared.outlines},
+          p, n, origin,
+          Blockers{&prepared.polygons, &prepared.solids, &prepared.outlines, centre_hidden},
           form_factor, &out.triangles);
     } else {
       const ShaftCuller::Polygons listed = in_.culler->shaft_polygons(
@@ -494,7 +497,11 @@ class LightPairs final : public PairSource {
         }
         unlisted.push_back(i);
       }
-      if (!unlisted.empty())
+      // The run's box first: a triangle in no shaft from it is in no texel's (most cells'
+      // runs, whose every texel would otherwise search the list).
+      thread_local std::vector<std::uint32_t> found;
+      if (!unlisted.empty() &&
+          (end - k == 1 || in_.culler->tile_candidates(box, light_, 0, found, &unlisted)))
         for (std::size_t j = k; j < end; ++j) {
           const Texel& tx = space_.texels[texels[j]];
           if (in_.culler->maybe_blocked(origins[j - k], tx.position.cast<double>(),

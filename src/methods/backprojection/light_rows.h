@@ -64,7 +64,8 @@ struct BlockedRows {
   std::array<Row, LightRows::kMaxRows> rows;
 
   // Rows [0, n) empty; the others are not read.
-  explicit BlockedRows(int n) {
+  explicit BlockedRows(int n) { clear(n); }
+  void clear(int n) {
     for (int r = 0; r < n; ++r) rows[std::size_t(r)].count = 0, rows[std::size_t(r)].cells = 0;
   }
 
@@ -88,6 +89,21 @@ struct RasterTarget {
   PenumbraSample* out = nullptr;                   // nearest_blocker and umbra are updated
   std::vector<std::uint32_t>* blocking = nullptr;  // keys that reach the light, unsorted
 };
+
+// Whether every row of the light is hidden from end to end, as the estimator's integral sweeps
+// it (penumbra_estimator.cpp).
+bool every_row_hidden(const LightRows& rows, const BlockedRows& blocked);
+
+// A wall of several polygons that hides all of the light, found without the rest of a crowded
+// shaft (blocker_rasteriser.cpp): the polygons in the shaft are rasterised nearest first (by
+// their boxes' distance from the origin), a few at a time, until every row is hidden or
+// `budget` of them are in; false at once where the shaft holds no more than `fewest`. True where
+// every row is hidden: V is then 0 whatever the others hide, `target.blocked` holds the rows,
+// `target.out->nearest_blocker` is a lower bound on every polygon of the shaft's distance, and
+// `*target.blocking` lists them all (what the refinement's checks read of a sample: a bound on
+// what may hide the light near it).
+bool nearest_hide_all(const RasterTarget& target, const std::vector<BlockerPolygon>& polygons,
+                      std::size_t fewest, std::size_t budget);
 
 // Polygons one by one, and convex solids by their silhouette edges (blocker_rasteriser.cpp).
 void rasterise_polygons_and_solids(const RasterTarget& target,

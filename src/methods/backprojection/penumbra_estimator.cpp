@@ -59,6 +59,13 @@ namespace sb {
 
 namespace {
 
+// The most polygons tried nearest first where the light's centre is hidden (Blockers::
+// centre_hidden; on OpenArena's oacmpdm9, 32 of them hide all of the light behind 97 % of the
+// walls tried, 16 behind 83 %), in shafts of more than kNearestFewest (fewer cost the estimator
+// less than the attempt).
+constexpr std::size_t kNearestFirst = 32;
+constexpr std::size_t kNearestFewest = 8;
+
 // The closed-form integral of the weight along one row (the file's opening comment).
 // atan to within 2e-8 (Abramowitz & Stegun 4.4.49 on [0, 1], and π/2 − atan(1/x) beyond): the
 // rows' integrals take hundreds per texel, and std::atan is four times slower.
@@ -330,8 +337,10 @@ std::array<BlockedRows::Interval, kExactIntervals> sorted_intervals(const Blocke
   return sorted;
 }
 
-// Whether every row of the light is hidden from end to end, as integrate's sweep decides it: a
-// texel in an umbra, most of what a sun's refinement evaluates, needs none of the rows' integrals.
+}  // namespace
+
+// A texel in an umbra, most of what a sun's refinement evaluates, needs none of the rows'
+// integrals.
 bool every_row_hidden(const LightRows& rows, const BlockedRows& blocked) {
   for (int r = 0; r < rows.count; ++r) {
     const BlockedRows::Row& row = blocked.rows[std::size_t(r)];
@@ -354,8 +363,6 @@ bool every_row_hidden(const LightRows& rows, const BlockedRows& blocked) {
   }
   return true;
 }
-
-}  // namespace
 
 void PenumbraEstimator::integrate(const LightFrame& f, const LightRows& rows, const Vec3& position,
                                   const Vec3& normal, const BlockedRows& blocked,
@@ -465,6 +472,34 @@ PenumbraSample PenumbraEstimator::visibility(const Vec3& position, const Vec3& n
   if (blocking) blocking->clear();
   const RasterTarget target{&f,       &rows, origin,  position, normal, light_offset_,
                             &blocked, &out,  blocking};
+  // Behind a wall of many polygons, the nearest few may hide all of the light: V is 0, and the
+  // rest need not be rasterised (OpenArena's oacmpdm9: texels in shafts of a hundred polygons,
+  // each cut and projected, where the nearest wall's few hide the light). Only where the whole
+  // light is integrated (V = 0 is then exact). The solids and dense meshes are not rasterised
+  // then either: each is bounded as its rasterisation would bound it, at its distance, by key.
+  if (blockers.centre_hidden && blockers.polygons && rows.whole && weight_bias == 1.0 &&
+      nearest_hide_all(target, *blockers.polygons, kNearestFewest, kNearestFirst)) {
+    const auto bound = [&](double distance, std::uint32_t key) {
+      out.nearest_blocker = std::min(out.nearest_blocker, std::max(distance, light_offset_));
+      if (blocking) blocking->push_back(key);
+    };
+    if (blockers.solids)
+      for (const BlockerSolidRef& ref : *blockers.solids) {
+        const Bounds3& box = ref.solid->bounds;
+        bound(std::max((box.lo - origin).cwiseMax(origin - box.hi).cwiseMax(Vec3::Zero()).norm(),
+                       ref.distance),
+              ref.key);
+      }
+    if (blockers.outlines)  // its distance bounds the triangles it takes apart too
+      for (const BlockerOutline& outline : *blockers.outlines) bound(outline.distance, outline.key);
+    if (blocking) {
+      std::sort(blocking->begin(), blocking->end());
+      blocking->erase(std::unique(blocking->begin(), blocking->end()), blocking->end());
+    }
+    integrate(f, rows, position, normal, blocked, form_factor, out);
+    return out;
+  }
+  if (blockers.centre_hidden) blocked.clear(rows.count);  // what the attempt left
   static const std::vector<BlockerPolygon> no_polygons;
   static const std::vector<BlockerSolidRef> no_solids;
   rasterise_polygons_and_solids(target, blockers.polygons ? *blockers.polygons : no_polygons,

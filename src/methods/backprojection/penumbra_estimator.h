@@ -108,6 +108,10 @@ struct Blockers {
   const std::vector<BlockerPolygon>* polygons = nullptr;  // one by one
   const std::vector<BlockerSolidRef>* solids = nullptr;   // convex solids, by silhouette
   const std::vector<BlockerOutline>* outlines = nullptr;  // dense meshes, by outline
+  // The ray from the texel's origin to the light's centre meets a blocker (which hides not all
+  // of the light alone): the nearest polygons are tried first, for a wall of several that hides
+  // all of it (PenumbraEstimator::visibility).
+  bool centre_hidden = false;
 };
 
 // What a texel's evaluation found, beside V.

@@ -4,6 +4,7 @@
 // a wrong estimator (a triangle dropped, a weight off by a percent) fails that comparison.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -171,6 +172,60 @@ TEST(PenumbraEstimator, OnePolygonCoveringTheLightIsAnUmbra) {
   const PenumbraSample partly = estimator.visibility(y, n, y, polygons(part));
   EXPECT_GT(partly.visibility, 0.0);
   EXPECT_EQ(partly.umbra, PenumbraSample::kNoUmbra);
+}
+
+// Where the ray to the light's centre is hidden (Blockers::centre_hidden), the nearest polygons
+// of a crowded shaft are tried first for a wall that hides all of the light: behind a whole wall
+// of 72 triangles (none hiding the light alone) V is 0, as the whole rasterisation finds it, and
+// what the sample reports of its blockers bounds what the whole pass reports (the nearest no
+// farther, every key it lists listed). Through a hole in the wall, V is the whole pass's,
+// exactly.
+TEST(PenumbraEstimator, AWallTriedNearestFirstGivesTheWholePasssV) {
+  const Light light(rectangle_light());
+  const PenumbraEstimator estimator(light, 32, 1e-4);
+  const Vec3 n(0, 0, 1);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (const bool hole : {false, true}) {
+    // Squares of 0.2 m at z = 1 over [-1.5, 1.5]², less the one over the axis for a hole; and
+    // small triangles behind the wall, off the hole.
+    std::vector<Triangle3> triangles;
+    for (int i = 0; i < 6; ++i)
+      for (int j = 0; j < 6; ++j) {
+        const double x = -1.5 + 0.5 * i, y = -1.5 + 0.5 * j;
+        if (hole && i == 3 && j == 2) continue;  // [0, 0.5] × [-0.5, 0]
+        triangles.push_back({Vec3(x, y, 1), Vec3(x + 0.5, y, 1), Vec3(x + 0.5, y + 0.5, 1)});
+        triangles.push_back({Vec3(x, y, 1), Vec3(x + 0.5, y + 0.5, 1), Vec3(x, y + 0.5, 1)});
+      }
+    for (int k = 0; k < 40; ++k) {
+      const Vec3 c(-0.6 + 1.2 * u(rng), -0.3 - 0.6 * u(rng), 1.2 + 0.6 * u(rng));
+      triangles.push_back({c, c + Vec3(0.1, 0, 0.02), c + Vec3(0, 0.1, -0.02)});
+    }
+    const std::vector<BlockerPolygon> polys = polygons(triangles);
+    for (int k = 0; k < 10; ++k) {
+      const Vec3 y(0.15 + 0.05 * u(rng), -0.25 + 0.05 * u(rng), 0.0);
+      std::vector<std::uint32_t> whole_keys, nearest_keys;
+      const PenumbraSample whole = estimator.visibility(
+          y, n, y, Blockers{&polys, nullptr, nullptr, /*centre_hidden=*/false}, 0, &whole_keys);
+      const PenumbraSample nearest = estimator.visibility(
+          y, n, y, Blockers{&polys, nullptr, nullptr, /*centre_hidden=*/true}, 0, &nearest_keys);
+      ASSERT_TRUE(whole.contributes && nearest.contributes);
+      if (hole) {
+        EXPECT_EQ(nearest.visibility, whole.visibility) << "texel " << k;
+        EXPECT_GT(whole.visibility, 0.01);
+        continue;
+      }
+      EXPECT_EQ(whole.visibility, 0.0) << "texel " << k;
+      EXPECT_EQ(nearest.visibility, 0.0) << "texel " << k;
+      EXPECT_LE(nearest.nearest_blocker, whole.nearest_blocker);
+      EXPECT_TRUE(std::includes(nearest_keys.begin(), nearest_keys.end(), whole_keys.begin(),
+                                whole_keys.end()))
+          << "every blocker the whole pass lists is listed";
+      // The short way was taken: it lists every polygon of the shaft, the whole pass those whose
+      // projection reaches the light (the triangles behind the wall reach past its edge).
+      EXPECT_GT(nearest_keys.size(), whole_keys.size());
+    }
+  }
 }
 
 // A polygon listed by a key that names many triangles (a dense mesh's: ShaftCuller::kMeshKey)
