@@ -76,6 +76,15 @@ struct Span {
   double a, b;
 };
 
+// The box of a polygon's corners.
+void box_of(const BlockerPolygon& poly, Vec3& lo, Vec3& hi) {
+  lo = poly.v[0], hi = poly.v[0];
+  for (int k = 1; k < poly.count; ++k) {
+    lo = lo.cwiseMin(poly.v[k]);
+    hi = hi.cwiseMax(poly.v[k]);
+  }
+}
+
 // One texel's rasterisation of polygons and convex solids into its light rows: the light's frame
 // as the texel's ray origin sees it, and the convex region being rasterised (the rows it holds,
 // r0 to r1, and each one's chord, lo to hi), which every step reads and writes.
@@ -407,11 +416,8 @@ void Rasteriser::found(bool reaches, double gap, std::uint32_t key) {
 }
 
 void Rasteriser::add_polygon(const BlockerPolygon& poly) {
-  Vec3 box_lo = poly.v[0], box_hi = poly.v[0];
-  for (int k = 1; k < poly.count; ++k) {
-    box_lo = box_lo.cwiseMin(poly.v[k]);
-    box_hi = box_hi.cwiseMax(poly.v[k]);
-  }
+  Vec3 box_lo, box_hi;
+  box_of(poly, box_lo, box_hi);
   const double gap = gap_to(box_lo, box_hi);
   covers = false;
   // It hides none of the light where no ray to the light crosses its plane or comes near it.
@@ -624,9 +630,10 @@ void Rasteriser::settle(const BlockerSolidRef& ref, bool reaches, double gap,
 
 }  // namespace
 
-bool nearest_hide_all(const RasterTarget& target, const std::vector<BlockerPolygon>& polygons,
-                      std::size_t fewest, std::size_t budget) {
-  if (polygons.size() <= fewest) return false;
+bool nearest_hide_all(const RasterTarget& target, const Blockers& blockers, std::size_t fewest,
+                      std::size_t budget) {
+  if (!blockers.polygons || blockers.polygons->size() <= fewest) return false;
+  const std::vector<BlockerPolygon>& polygons = *blockers.polygons;
   // The attempt's own sample: the target's is written only where it succeeds.
   PenumbraSample scratch;
   RasterTarget attempt = target;
@@ -639,11 +646,8 @@ bool nearest_hide_all(const RasterTarget& target, const std::vector<BlockerPolyg
   in_shaft.clear();
   for (std::size_t i = 0; i < polygons.size(); ++i) {
     const BlockerPolygon& poly = polygons[i];
-    Vec3 box_lo = poly.v[0], box_hi = poly.v[0];
-    for (int k = 1; k < poly.count; ++k) {
-      box_lo = box_lo.cwiseMin(poly.v[k]);
-      box_hi = box_hi.cwiseMax(poly.v[k]);
-    }
+    Vec3 box_lo, box_hi;
+    box_of(poly, box_lo, box_hi);
     if (rasteriser.beside_plane(poly.v[0], poly.normal) || rasteriser.outside_cone(box_lo, box_hi))
       continue;
     in_shaft.emplace_back(rasteriser.gap_to(box_lo, box_hi), std::uint32_t(i));
@@ -660,13 +664,25 @@ bool nearest_hide_all(const RasterTarget& target, const std::vector<BlockerPolyg
       check += std::max<std::size_t>(2, check / 2);
     }
   }
-  if (!hidden) return false;
-  // What every polygon of the shaft may hide, as the whole rasterisation would bound it.
-  for (const auto& [gap, i] : in_shaft) {
+  if (!hidden) {
+    target.blocked->clear(target.rows->count);  // for the whole pass
+    return false;
+  }
+  // What every blocker of the shaft may hide, bounded as its rasterisation would bound it: at
+  // its distance (a solid's as add_solid takes it; a dense mesh's outline's bounds the
+  // triangles it takes apart too), by its key.
+  const auto bound = [&](double gap, std::uint32_t key) {
     target.out->nearest_blocker =
         std::min(target.out->nearest_blocker, std::max(gap, target.light_offset));
-    if (target.blocking) target.blocking->push_back(polygons[i].triangle);
-  }
+    if (target.blocking) target.blocking->push_back(key);
+  };
+  for (const auto& [gap, i] : in_shaft) bound(gap, polygons[i].triangle);
+  if (blockers.solids)
+    for (const BlockerSolidRef& ref : *blockers.solids)
+      bound(std::max(rasteriser.gap_to(ref.solid->bounds.lo, ref.solid->bounds.hi), ref.distance),
+            ref.key);
+  if (blockers.outlines)
+    for (const BlockerOutline& outline : *blockers.outlines) bound(outline.distance, outline.key);
   return true;
 }
 

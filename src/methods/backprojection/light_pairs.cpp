@@ -15,6 +15,7 @@
 #include "methods/backprojection/penumbra_estimator.h"
 #include "methods/backprojection/piercing_blockers.h"
 #include "methods/backprojection/tile_shafts.h"
+#include "methods/backprojection/umbra_proofs.h"
 #include "occluders/blocker_solids.h"
 #include "occluders/shadow_rays.h"
 

@@ -95,15 +95,16 @@ struct RasterTarget {
 bool every_row_hidden(const LightRows& rows, const BlockedRows& blocked);
 
 // A wall of several polygons that hides all of the light, found without the rest of a crowded
-// shaft (blocker_rasteriser.cpp): the polygons in the shaft are rasterised nearest first (by
-// their boxes' distance from the origin), a few at a time, until every row is hidden or
-// `budget` of them are in; false at once where the shaft holds no more than `fewest`. True where
-// every row is hidden: V is then 0 whatever the others hide, `target.blocked` holds the rows,
-// `target.out->nearest_blocker` is a lower bound on every polygon of the shaft's distance, and
-// `*target.blocking` lists them all (what the refinement's checks read of a sample: a bound on
-// what may hide the light near it).
-bool nearest_hide_all(const RasterTarget& target, const std::vector<BlockerPolygon>& polygons,
-                      std::size_t fewest, std::size_t budget);
+// shaft (blocker_rasteriser.cpp): the blockers' polygons in the shaft are rasterised nearest
+// first (by their boxes' distance from the origin), a few at a time, until every row is hidden
+// or `budget` of them are in; false at once where the shaft holds no more than `fewest`. True
+// where every row is hidden: V is then 0 whatever the rest hide, `target.blocked` holds the
+// rows, `target.out->nearest_blocker` is a lower bound on every blocker's distance (polygons,
+// solids and dense meshes) and `*target.blocking` lists them all (what the refinement's checks
+// read of a sample: a bound on what may hide the light near it). False: `target.blocked` is
+// left empty, for the whole pass.
+bool nearest_hide_all(const RasterTarget& target, const Blockers& blockers, std::size_t fewest,
+                      std::size_t budget);
 
 // Polygons one by one, and convex solids by their silhouette edges (blocker_rasteriser.cpp).
 void rasterise_polygons_and_solids(const RasterTarget& target,

@@ -189,22 +189,6 @@ class PenumbraEstimator {
   double ball_radius_ = 0;        // of a ball about the light's centre that holds it
 };
 
-// Whether the triangle `corners` hides all of `light` from `origin` (exactly: every segment from
-// the origin to the light passes through it), clear of the origin and of the light's plane by
-// `light_offset` as a shadow ray is (RayScene::surface_offset). Its umbra, the points from which
-// it does, is convex under a convex light (the intersection of its shadows from each point of the
-// light). Rectangles, disks, polygons and spheres; false for the others.
-bool triangle_hides_light(const Light& light, const Vec3* corners, const Vec3& origin,
-                          double light_offset);
-
-// Whether the ball (centre, radius) hides all of a rectangle, disk or polygon `light` from
-// `origin`: the ball between the origin and the light's plane, clear of the plane by
-// `light_offset`, and every direction from the origin to the light inside the cone from the origin
-// that touches the ball (a disk by the cone that holds its bounding sphere, as good as exact for
-// a sun). Sufficient, not necessary; its umbra is convex under a convex light.
-bool ball_hides_light(const Light& light, const Vec3& centre, double radius, const Vec3& origin,
-                      double light_offset);
-
 // The angle between a light's own axes and its rows, radians: far from 0°, 45° and 90°, the
 // directions furniture and panels share most.
 constexpr double kRowAngle = 0.4;

@@ -10,7 +10,7 @@
 #include <numeric>
 #include <vector>
 
-#include "methods/backprojection/penumbra_estimator.h"
+#include "methods/backprojection/umbra_proofs.h"
 #include "occluders/plane_occlusion.h"
 
 namespace sb {

@@ -11,6 +11,7 @@
 #include <random>
 
 #include "methods/backprojection/penumbra_estimator.h"
+#include "methods/backprojection/umbra_proofs.h"
 #include "support/exact_visibility.h"
 
 namespace sb {
