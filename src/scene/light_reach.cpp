@@ -164,18 +164,20 @@ bool Light::reaches(const Vec3& y, const Vec3& n) const {
   return false;
 }
 
+bool Light::within_range_throughout(const Bounds3& ys) const {
+  if (!std::isfinite(desc_.range)) return true;
+  // Its farthest corner is (by a margin against rounding).
+  double farthest = 0;
+  for (int k = 0; k < 8; ++k) farthest = std::max(farthest, (ys.corner(k) - desc_.position).norm());
+  return farthest < desc_.range * (1 - 1e-9);
+}
+
 bool Light::reaches_all(const Bounds3& ys, const Vec3& n) const {
   if (desc_.spot_outer > 0 || ys.empty()) return false;
   if (desc_.shape != LightShape::rectangle && desc_.shape != LightShape::disk &&
       desc_.shape != LightShape::polygon)
     return false;
-  if (std::isfinite(desc_.range)) {
-    // Within the range at every point: its farthest corner is (by a margin against rounding).
-    double farthest = 0;
-    for (int k = 0; k < 8; ++k)
-      farthest = std::max(farthest, (ys.corner(k) - desc_.position).norm());
-    if (!(farthest < desc_.range * (1 - 1e-9))) return false;
-  }
+  if (!within_range_throughout(ys)) return false;
   // For one normal both of flat_reach's terms are linear in y: positive at the box's corners
   // (by a margin against rounding), they are positive throughout.
   for (int k = 0; k < 8; ++k) {
@@ -185,6 +187,49 @@ bool Light::reaches_all(const Bounds3& ys, const Vec3& n) const {
     if (!(r.front > margin && r.above > margin)) return false;
   }
   return true;
+}
+
+bool Light::reaches_all(const Bounds3& ys, const Bounds3& ns) const {
+  if (ns.empty()) return false;
+  if (desc_.shape != LightShape::sphere) return ns.lo == ns.hi && reaches_all(ys, Vec3(ns.lo));
+  if (desc_.spot_outer > 0 || ys.empty()) return false;
+  const Vec3& c = desc_.position;
+  const double r = desc_.radius;
+  if (!within_range_throughout(ys)) return false;
+  // Outside the sphere: its nearest point is.
+  if (!((c.cwiseMax(ys.lo).cwiseMin(ys.hi) - c).norm() > r * (1 + 1e-6))) return false;
+  // Wholly above each horizon (reaches(): n·(c − y) >= r), by a margin for rounding.
+  const double margin = 1e-9 * ((c - ys.centre()).norm() + ys.diagonal() + r);
+  return height_over_horizons(ys, ns).first >= r + margin;
+}
+
+bool Light::reaches_none(const Bounds3& ys, const Bounds3& ns) const {
+  if (ys.empty() || ns.empty()) return false;
+  const Vec3& c = desc_.position;
+  if (std::isfinite(desc_.range)) {
+    // range_factor is 0 from the range on: the box's nearest point lies beyond it.
+    if (!(desc_.range > 0)) return true;
+    if ((c.cwiseMax(ys.lo).cwiseMin(ys.hi) - c).norm() > desc_.range * (1 + 1e-9)) return true;
+  }
+  if (desc_.shape != LightShape::sphere) return false;
+  // Wholly below each horizon, n·(c − y) <= −r: so is its silhouette, and F = 0.
+  const double r = desc_.radius;
+  const double margin = 1e-9 * ((c - ys.centre()).norm() + ys.diagonal() + r);
+  return height_over_horizons(ys, ns).second <= -r - margin;
+}
+
+std::pair<double, double> Light::height_over_horizons(const Bounds3& ys, const Bounds3& ns) const {
+  // n·(c − y) summed over components, each a product of two ranges: its least and greatest
+  // products bound it.
+  const Vec3& c = desc_.position;
+  double least = 0, greatest = 0;
+  for (int i = 0; i < 3; ++i) {
+    const double a = c[i] - ys.hi[i], b = c[i] - ys.lo[i];
+    const double p[4] = {ns.lo[i] * a, ns.lo[i] * b, ns.hi[i] * a, ns.hi[i] * b};
+    least += std::min({p[0], p[1], p[2], p[3]});
+    greatest += std::max({p[0], p[1], p[2], p[3]});
+  }
+  return {least, greatest};
 }
 
 }  // namespace sb

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "core/error.h"
@@ -118,6 +119,13 @@ class Light {
   // polygon's conditions are linear in y, so they hold inside if they hold at its corners (with
   // a margin against rounding). False where it cannot tell (a sphere, a spot, a mesh or sky).
   bool reaches_all(const Bounds3& ys, const Vec3& n) const;
+  // The same for every point of ys with every normal of the box `ns` (a curved receiver's): a
+  // sphere wholly above every such horizon (its height over it bounded below term by term);
+  // another shape where the box is of one normal, as reaches_all(ys, n).
+  bool reaches_all(const Bounds3& ys, const Bounds3& ns) const;
+  // True only where reaches(y, n) fails at every point y of the box with every normal of `ns`:
+  // beyond the range throughout (any shape), or a sphere wholly below every such horizon.
+  bool reaches_none(const Bounds3& ys, const Bounds3& ns) const;
   // The form factor F alone (dimensionless, H0 = E · F · spot_factor).
   double form_factor(const Vec3& y, const Vec3& n) const;
   // A spot's cone at y (LightDesc::spot_axis): 1 inside the inner cone, 0 outside the outer one,
@@ -158,6 +166,11 @@ class Light {
     double front = 0, above = 0;
   };
   Reach flat_reach(const Vec3& y, const Vec3& n) const;
+  // Whether every point of the box lies within the range (always, without one).
+  bool within_range_throughout(const Bounds3& ys) const;
+  // Bounds on the centre's height n·(c − y) over the horizons of points y of ys with normals n
+  // of ns: (least, greatest).
+  std::pair<double, double> height_over_horizons(const Bounds3& ys, const Bounds3& ns) const;
 
   LightDesc desc_;
   Vec3 right_, up_;

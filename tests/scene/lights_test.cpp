@@ -290,6 +290,55 @@ TEST(Lambert, ReachesAllHoldsAtEveryPointOfTheBox) {
   EXPECT_FALSE(Light(sphere(0.2)).reaches_all(below, Vec3::UnitZ()));
 }
 
+// Over a box of points and a box of normals (a curved receiver's piece): reaches_all claims
+// only where every point reaches every normal that made the box, reaches_none only where none
+// does; a sphere, ranged or not, and a ranged rectangle are claimed often both ways.
+TEST(Lambert, ReachesAllAndNoneOverNormalBoxesHoldEverywhere) {
+  Rng rng(11);
+  LightDesc ranged = sphere(0.125), panel = rectangle(0.5, 0.3);
+  ranged.range = 1.5;
+  panel.range = 1.5;  // none only beyond it: a flat light's horizon is not bounded here
+  for (const LightDesc& d : {sphere(0.2), ranged, panel}) {
+    const Light light(d);
+    int all = 0, none = 0;
+    for (int i = 0; i < 4000; ++i) {
+      const Vec3 a(4 * rng.next_double() - 2, 4 * rng.next_double() - 2, 3 * rng.next_double() - 1);
+      const Vec3 b = a + 0.3 * rng.next_double() *
+                             Vec3(rng.next_double(), rng.next_double(), rng.next_double());
+      Bounds3 box, normals;
+      box.extend(a);
+      box.extend(b);
+      const Vec3 axis =
+          Vec3(rng.next_double() - 0.5, rng.next_double() - 0.5, rng.next_double() - 0.5)
+              .normalized();
+      // One normal in a quarter of the cases (a flat piece), else four within about 10°.
+      std::vector<Vec3> ns{axis};
+      if (i % 4 != 0)
+        for (int k = 0; k < 3; ++k)
+          ns.push_back((axis + 0.2 * Vec3(rng.next_double() - 0.5, rng.next_double() - 0.5,
+                                          rng.next_double() - 0.5))
+                           .normalized());
+      for (const Vec3& n : ns) normals.extend(n);
+      const bool claims_all = light.reaches_all(box, normals);
+      const bool claims_none = light.reaches_none(box, normals);
+      ASSERT_FALSE(claims_all && claims_none);
+      if (!claims_all && !claims_none) continue;
+      ++(claims_all ? all : none);
+      for (int k = 0; k < 64; ++k) {
+        const Vec3 y =
+            k < 8 ? box.corner(k)
+                  : Vec3(a + (b - a).cwiseProduct(
+                                 Vec3(rng.next_double(), rng.next_double(), rng.next_double())));
+        for (const Vec3& n : ns)
+          EXPECT_EQ(light.reaches(y, n), claims_all)
+              << d.name << " range " << d.range << " " << y.transpose() << " / " << n.transpose();
+      }
+    }
+    EXPECT_GT(all, 50) << d.name << " range " << d.range;  // a rectangle: one normal only
+    EXPECT_GT(none, 200) << d.name << " range " << d.range;
+  }
+}
+
 TEST(Lambert, DiskOnAxisIsClassicFormula) {
   // On the axis of a disk of radius R at height h, facing it: F = R² / (R² + h²).
   LightDesc d = tilted_disk(0.4);

@@ -116,7 +116,8 @@ LightField backprojection_light(const TexelSpace& space, const BackprojectionInp
                                 std::size_t l) {
   const LightLists lists(space, *in.lights);
   const TexelGrid grid(space);
-  return light_field(space, grid, TileJoins(space, grid), in, lists.blocks_of(l), l);
+  return light_field(space, grid, TileJoins(space, grid, in.rays->surface_offset()), in,
+                     lists.blocks_of(l), l);
 }
 
 MixedImages bake_backprojection(const TexelSpace& space, const BackprojectionInputs& in,
@@ -131,7 +132,7 @@ MixedImages bake_backprojection(const TexelSpace& space, const BackprojectionInp
   const std::size_t kept0 = kept.first, kept1 = kept.second;
   // Built once: they do not depend on the light.
   const TexelGrid grid(space);
-  const TileJoins joins(space, grid);
+  const TileJoins joins(space, grid, in.rays->surface_offset());
   // Light l's field into the mix: distinct texels in parallel (LightMix::set allows it), tile by
   // tile through the grid (so that no texel's record is read), each range counting its routes.
   const auto apply = [&](std::size_t l, const LightField& field) {

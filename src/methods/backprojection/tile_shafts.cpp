@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cstdint>
 #include <numeric>
 #include <vector>
@@ -61,6 +62,36 @@ int root_of(std::array<std::uint8_t, kTile * kTile>& parent, int i) {
     i = parent[std::size_t(i)];
   }
   return i;
+}
+
+// Numbers the pieces of surface among tile `at`'s pixels `reached`, joined as `joins` says:
+// in order of their first pixel, past kMaxPatches the rest with the last. Returns how many;
+// patch[j] for each pixel j reached.
+int number_pieces(const TileJoins& joins, std::size_t at, std::uint64_t reached,
+                  std::array<std::uint8_t, kTile * kTile>& patch) {
+  std::array<std::uint8_t, kTile * kTile> parent;
+  for (int j = 0; j < kTile * kTile; ++j) parent[std::size_t(j)] = std::uint8_t(j);
+  const std::uint64_t right = joins.right[at] & reached & (reached >> 1);
+  const std::uint64_t down = joins.down[at] & reached & (reached >> kTile);
+  for (int j = 0; j < kTile * kTile; ++j) {
+    if (right >> j & 1)
+      parent[std::size_t(root_of(parent, j + 1))] = std::uint8_t(root_of(parent, j));
+    if (down >> j & 1)
+      parent[std::size_t(root_of(parent, j + kTile))] = std::uint8_t(root_of(parent, j));
+  }
+  std::array<std::int8_t, kTile * kTile> patch_of_root;
+  patch_of_root.fill(-1);
+  int count = 0;
+  for (int j = 0; j < kTile * kTile; ++j) {
+    if (!(reached >> j & 1)) continue;
+    const int root = root_of(parent, j);
+    if (patch_of_root[std::size_t(root)] < 0) {
+      if (count < TileShafts::kMaxPatches) ++count;
+      patch_of_root[std::size_t(root)] = std::int8_t(count - 1);
+    }
+    patch[std::size_t(j)] = std::uint8_t(patch_of_root[std::size_t(root)]);
+  }
+  return count;
 }
 
 }  // namespace
@@ -151,47 +182,56 @@ void TileTester::find_patches(int tx, int ty, TilePatches& tile) const {
       return;
     }
   }
-  // Texel by texel: which the light reaches, and their pieces of surface (the receiver's joins
-  // between texels it reaches).
-  std::array<std::int32_t, kTile * kTile> texel;
-  std::array<std::uint8_t, kTile * kTile> parent;
-  grid.tile_texels(tx, ty, texel);
-  for (int j = 0; j < kTile * kTile; ++j) {
-    parent[std::size_t(j)] = std::uint8_t(j);
-    const std::int32_t t = texel[std::size_t(j)];
-    if (t < 0) continue;
-    const Texel& record = space.texels[std::size_t(t)];
-    if (light.reaches(record.position.cast<double>(), record.normal.cast<double>()))
-      tile.reached |= std::uint64_t(1) << j;
-    else
-      texel[std::size_t(j)] = -1;
-  }
+  // Piece by piece: which texels the light reaches, read one by one only where the piece's
+  // boxes cannot tell.
   const std::size_t at = std::size_t(ty) * std::size_t(joins.tiles_x) + std::size_t(tx);
-  const std::uint64_t right = joins.right[at] & tile.reached & (tile.reached >> 1);
-  const std::uint64_t down = joins.down[at] & tile.reached & (tile.reached >> kTile);
-  for (int j = 0; j < kTile * kTile; ++j) {
-    if (texel[std::size_t(j)] < 0) continue;
-    if (right >> j & 1)
-      parent[std::size_t(root_of(parent, j + 1))] = std::uint8_t(root_of(parent, j));
-    if (down >> j & 1)
-      parent[std::size_t(root_of(parent, j + kTile))] = std::uint8_t(root_of(parent, j));
-  }
-  // Patches in order of their first pixel; past kMaxPatches, the rest join the last.
-  std::array<std::int8_t, kTile * kTile> patch_of_root;
-  patch_of_root.fill(-1);
-  for (int j = 0; j < kTile * kTile; ++j) {
-    if (texel[std::size_t(j)] < 0) continue;
-    const int root = root_of(parent, j);
-    if (patch_of_root[std::size_t(root)] < 0) {
-      if (int(tile.patches.size()) < TileShafts::kMaxPatches) tile.patches.emplace_back();
-      patch_of_root[std::size_t(root)] = std::int8_t(tile.patches.size() - 1);
+  std::array<std::int32_t, kTile * kTile> texel;
+  bool read = false;  // texel[] filled
+  const auto texels = [&] {
+    if (!read) grid.tile_texels(tx, ty, texel);
+    read = true;
+    return std::span<const std::int32_t, kTile * kTile>(texel);
+  };
+  const auto test_texels = [&](std::uint64_t pixels) {
+    for (int j = 0; j < kTile * kTile; ++j) {
+      if (!(pixels >> j & 1)) continue;
+      const Texel& record = space.texels[std::size_t(texels()[std::size_t(j)])];
+      if (light.reaches(record.position.cast<double>(), record.normal.cast<double>()))
+        tile.reached |= std::uint64_t(1) << j;
     }
-    const std::uint8_t p = std::uint8_t(patch_of_root[std::size_t(root)]);
+  };
+  const std::span<const TileJoins::Piece> pieces = joins.pieces_of(at);
+  std::uint64_t whole = 0;  // the pixels of pieces reached throughout
+  for (const TileJoins::Piece& piece : pieces) {
+    if (light.reaches_none(piece.positions, piece.normals)) continue;
+    if (light.reaches_all(piece.positions, piece.normals))
+      whole |= piece.pixels;
+    else
+      test_texels(piece.pixels);
+  }
+  tile.reached |= whole;
+  if (pieces.empty()) {
+    std::uint64_t covered = 0;
+    for (int j = 0; j < kTile * kTile; ++j)
+      if (texels()[std::size_t(j)] >= 0) covered |= std::uint64_t(1) << j;
+    test_texels(covered);
+  }
+  // Their pieces of surface (the receiver's joins between texels it reaches) as patches: a
+  // piece reached throughout is one (unless patches ran out) whose box is known.
+  const int count = number_pieces(joins, at, tile.reached, tile.at);
+  tile.patches.resize(std::size_t(count));
+  if (count >= TileShafts::kMaxPatches) whole = 0;
+  for (const TileJoins::Piece& piece : pieces) {
+    if ((piece.pixels & whole) == 0) continue;
+    tile.patches[tile.at[std::size_t(std::countr_zero(piece.pixels))]].origins = piece.origins;
+    tile.step = std::max(tile.step, piece.step);
+  }
+  for (int j = 0; j < kTile * kTile; ++j) {
+    if (!((tile.reached & ~whole) >> j & 1)) continue;
+    const std::size_t t = std::size_t(texels()[std::size_t(j)]);
     if (sizes)
-      tile.step = std::max(tile.step, space.face_texel_sizes[std::size_t(
-                                          space.texels[std::size_t(texel[std::size_t(j)])].face)]);
-    tile.at[std::size_t(j)] = p;
-    tile.patches[p].origins.extend(space.ray_origin(std::size_t(texel[std::size_t(j)]), offset));
+      tile.step = std::max(tile.step, space.face_texel_sizes[std::size_t(space.texels[t].face)]);
+    tile.patches[tile.at[std::size_t(j)]].origins.extend(space.ray_origin(t, offset));
   }
 }
 
@@ -336,7 +376,7 @@ void TileTester::test_groups(const TileShafts& tiles, int ty0, int ty1,
 
 }  // namespace
 
-TileJoins::TileJoins(const TexelSpace& space, const TexelGrid& grid)
+TileJoins::TileJoins(const TexelSpace& space, const TexelGrid& grid, double offset)
     : tiles_x((space.width + kTile - 1) / kTile) {
   const int tiles_y = (space.height + kTile - 1) / kTile;
   const std::size_t count = std::size_t(tiles_x) * std::size_t(tiles_y);
@@ -351,13 +391,17 @@ TileJoins::TileJoins(const TexelSpace& space, const TexelGrid& grid)
                                 space.face_texel_sizes[std::size_t(tb.face)]);
     return (ta.position - tb.position).norm() <= kJoinSteps * step;
   };
+  std::vector<std::vector<Piece>> found(count);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count), [&](const auto& r) {
     std::array<std::int32_t, kTile * kTile> texel;
+    std::array<std::uint8_t, kTile * kTile> piece_of;
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
       grid.tile_texels(int(i % std::size_t(tiles_x)), int(i / std::size_t(tiles_x)), texel);
+      std::uint64_t covered = 0;
       for (int j = 0; j < kTile * kTile; ++j) {
         const std::int32_t a = texel[std::size_t(j)];
         if (a < 0) continue;
+        covered |= std::uint64_t(1) << j;
         if (j % kTile + 1 < kTile && texel[std::size_t(j + 1)] >= 0 &&
             joined(a, texel[std::size_t(j + 1)]))
           right[i] |= std::uint64_t(1) << j;
@@ -365,8 +409,30 @@ TileJoins::TileJoins(const TexelSpace& space, const TexelGrid& grid)
             joined(a, texel[std::size_t(j + kTile)]))
           down[i] |= std::uint64_t(1) << j;
       }
+      // Its pieces: the patches of a light that reaches every texel (find_patches).
+      const int pieces = number_pieces(*this, i, covered, piece_of);
+      if (pieces >= TileShafts::kMaxPatches) continue;
+      found[i].resize(std::size_t(pieces));
+      for (int j = 0; j < kTile * kTile; ++j) {
+        if (!(covered >> j & 1)) continue;
+        const std::size_t t = std::size_t(texel[std::size_t(j)]);
+        Piece& piece = found[i][piece_of[std::size_t(j)]];
+        piece.pixels |= std::uint64_t(1) << j;
+        piece.positions.extend(space.texels[t].position.cast<double>());
+        piece.normals.extend(space.texels[t].normal.cast<double>());
+        piece.origins.extend(space.ray_origin(t, offset));
+        if (sizes)
+          piece.step =
+              std::max(piece.step, space.face_texel_sizes[std::size_t(space.texels[t].face)]);
+      }
     }
   });
+  first.assign(count + 1, 0);
+  for (std::size_t i = 0; i < count; ++i) {
+    first[i] = std::uint32_t(pieces.size());
+    pieces.insert(pieces.end(), found[i].begin(), found[i].end());
+  }
+  first[count] = std::uint32_t(pieces.size());
 }
 
 TileShafts tile_shafts(const TexelSpace& space, const TexelGrid& grid, const TileJoins& joins,

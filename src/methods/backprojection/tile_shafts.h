@@ -23,13 +23,30 @@ bool hides_from_all(const Light& light, const Vec3* corners, std::span<const Vec
 
 // Which neighbouring texels of each tile lie on one piece of surface (no farther apart than
 // their faces' texel steps allow; every neighbour where the space has no steps): what splits a
-// tile into patches, whatever the light. Built once per receiver (tile_shafts.cpp).
+// tile into patches, whatever the light; and those pieces, which say for a light whether it
+// reaches all or none of a piece's texels without their records. Built once per receiver
+// (tile_shafts.cpp), for ray origins `offset` off their surfaces.
 struct TileJoins {
   int tiles_x = 0;
   // Per tile, a bit per pixel j (row-major within the tile): j joined to j + 1 (`right`, never
   // in the tile's last column) or to j + kTile (`down`).
   std::vector<std::uint64_t> right, down;
-  TileJoins(const TexelSpace& space, const TexelGrid& grid);
+  // One piece of a tile's covered texels, joined: its pixels, the boxes of its texels'
+  // positions and shading normals (Light::reaches_all and reaches_none read them), of their
+  // ray origins, and the largest texel step of their faces.
+  struct Piece {
+    std::uint64_t pixels = 0;
+    Bounds3 positions, normals, origins;
+    float step = 0;
+  };
+  // Tile i's pieces: pieces[first[i], first[i + 1]), none where it has TileShafts::kMaxPatches
+  // or more (its texels are then read one by one).
+  std::vector<std::uint32_t> first;
+  std::vector<Piece> pieces;
+  std::span<const Piece> pieces_of(std::size_t tile) const {
+    return {pieces.data() + first[tile], pieces.data() + first[tile + 1]};
+  }
+  TileJoins(const TexelSpace& space, const TexelGrid& grid, double offset);
 };
 
 // The shaft test of each of the tiles `in_reach` (indices, ascending: the blocks the light's
