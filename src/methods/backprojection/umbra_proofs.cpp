@@ -9,6 +9,18 @@ namespace sb {
 
 namespace {
 
+// The unit normal of the plane through `origin` and the triangle's edge k (corners k, k + 1),
+// turned towards its third corner: false where the edge and the origin are collinear.
+bool inward_edge_plane(const Vec3* corners, int k, const Vec3& origin, Vec3& n) {
+  const Vec3 a = corners[k] - origin, b = corners[(k + 1) % 3] - origin;
+  n = a.cross(b);
+  const double norm = n.norm();
+  if (!(norm > 0)) return false;
+  n /= norm;
+  if (n.dot(corners[(k + 2) % 3] - origin) < 0) n = -n;
+  return true;
+}
+
 // triangle_hides_light for a sphere: every segment from the origin to the ball crosses the
 // triangle exactly where the ball lies beyond the triangle's plane (seen from the origin) and
 // inside the three planes through the origin and each edge, each by the radius (distances to a
@@ -27,12 +39,8 @@ bool triangle_hides_sphere(const Light& light, const Vec3* corners, const Vec3& 
   if (!(h_origin > light_offset && -h_centre > radius + 2 * light_offset)) return false;
   const double reach = (c - origin).norm();
   for (int k = 0; k < 3; ++k) {
-    const Vec3 a = corners[k] - origin, b = corners[(k + 1) % 3] - origin;
-    Vec3 n = a.cross(b);
-    const double norm = n.norm();
-    if (!(norm > 0)) return false;
-    n /= norm;
-    if (n.dot(corners[(k + 2) % 3] - origin) < 0) n = -n;
+    Vec3 n;
+    if (!inward_edge_plane(corners, k, origin, n)) return false;
     if (!(n.dot(c - origin) > radius + 1e-9 * reach)) return false;
   }
   return true;
@@ -82,12 +90,8 @@ bool triangle_hides_light(const Light& light, const Vec3* corners, const Vec3& o
   std::array<Vec3, 4> outline;
   const int count = light.outline(outline);
   for (int k = 0; k < 3; ++k) {
-    const Vec3 a = corners[k] - origin, b = corners[(k + 1) % 3] - origin;
-    Vec3 n = a.cross(b);
-    const double norm = n.norm();
-    if (!(norm > 0)) return false;
-    n /= norm;
-    if (n.dot(corners[(k + 2) % 3] - origin) < 0) n = -n;
+    Vec3 n;
+    if (!inward_edge_plane(corners, k, origin, n)) return false;
     if (count > 0) {
       for (int c = 0; c < count; ++c) {
         const Vec3 d = outline[std::size_t(c)] - origin;
