@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <span>
 #include <utility>
 
 namespace sb {
@@ -23,31 +25,39 @@ void apply_shadowmask_range(Image& light_visibility, const LightDesc& light,
 
 void add_overlaps(const TiledImages& light_visibility, const std::vector<std::uint8_t>& covered,
                   LightOverlaps& overlaps) {
-  // The lights holding each tile (beyond its tiles a light has no influence), tile by tile.
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> holders;  // (tile, light)
-  for (std::size_t l = 0; l < light_visibility.size(); ++l)
-    for (std::size_t s = 0; s < light_visibility.tiles(l).size(); ++s)
-      holders.emplace_back(light_visibility.tiles(l)[s], std::uint32_t(l));
-  std::sort(holders.begin(), holders.end());
+  // Where each light has influence (covered pixels with influence > 0), as a mask of its tile's
+  // pixels, read one light at a time (its values may be in a scratch file); beyond its tiles a
+  // light has none. Two lights meet where their masks of one tile share a pixel.
+  struct Held {
+    std::uint32_t tile, light;
+    std::uint64_t pixels;
+    bool operator<(const Held& o) const { return tile != o.tile ? tile < o.tile : light < o.light; }
+  };
   constexpr int side = TiledImages::kSide;
-  const int width = light_visibility.width(), height = light_visibility.height();
-  std::vector<std::size_t> present;
-  for (std::size_t first = 0; first < holders.size();) {
+  static_assert(side * side == 64, "a tile's pixels are the bits of one 64-bit mask");
+  const std::size_t width = std::size_t(light_visibility.width());
+  std::vector<Held> held;
+  for (std::size_t l = 0; l < light_visibility.size(); ++l) {
+    const std::span<const std::uint32_t> tiles = light_visibility.tiles(l);
+    const std::size_t first = held.size();
+    for (const std::uint32_t tile : tiles) held.push_back({tile, std::uint32_t(l), 0});
+    light_visibility.each_pixel(l, [&](int x, int y, const float* v) {
+      if (!covered[std::size_t(y) * width + std::size_t(x)] || !(v[1] > 0)) return;
+      const std::uint32_t tile = std::uint32_t(y / side) * std::uint32_t(light_visibility.tiles_x()) +
+                                 std::uint32_t(x / side);
+      const std::size_t s = std::size_t(std::lower_bound(tiles.begin(), tiles.end(), tile) -
+                                        tiles.begin());
+      held[first + s].pixels |= std::uint64_t(1) << ((y % side) * side + x % side);
+    });
+  }
+  std::sort(held.begin(), held.end());
+  for (std::size_t first = 0; first < held.size();) {
     std::size_t last = first;
-    while (last < holders.size() && holders[last].first == holders[first].first) ++last;
-    const std::uint32_t tile = holders[first].first;
-    const int x0 = int(tile % std::uint32_t(light_visibility.tiles_x())) * side;
-    const int y0 = int(tile / std::uint32_t(light_visibility.tiles_x())) * side;
-    for (int y = y0; y < std::min(y0 + side, height); ++y)
-      for (int x = x0; x < std::min(x0 + side, width); ++x) {
-        if (!covered[std::size_t(y) * std::size_t(width) + std::size_t(x)]) continue;
-        present.clear();
-        for (std::size_t k = first; k < last; ++k)
-          if (light_visibility.at(holders[k].second, x, y)[1] > 0)
-            present.push_back(holders[k].second);
-        for (std::size_t a : present)
-          for (std::size_t b : present) overlaps.overlaps[a * overlaps.lights + b] = 1;
-      }
+    while (last < held.size() && held[last].tile == held[first].tile) ++last;
+    for (std::size_t a = first; a < last; ++a)
+      for (std::size_t b = first; b < last; ++b)
+        if (held[a].pixels & held[b].pixels)
+          overlaps.overlaps[std::size_t(held[a].light) * overlaps.lights + held[b].light] = 1;
     first = last;
   }
 }

@@ -12,11 +12,11 @@
 namespace sb {
 
 TiledImages per_light_values(std::size_t lights, int width, int height) {
-  return TiledImages(lights, width, height, {0, 0, 0});
+  return TiledImages(lights, width, height, {0, 0, 0}, TiledImages::Spill::to_file);
 }
 
 TiledImages per_light_visibilities(std::size_t lights, int width, int height) {
-  return TiledImages(lights, width, height, {1, 0});
+  return TiledImages(lights, width, height, {1, 0}, TiledImages::Spill::to_file);
 }
 
 LightMix::LightMix(const TexelSpace& space, const std::vector<Light>& lights, Quantity quantity,
@@ -29,9 +29,9 @@ LightMix::LightMix(const TexelSpace& space, const std::vector<Light>& lights, Qu
   // One light's visibility, set light by light: its V is the texel's value wherever it reaches
   // (H0·V / H0), so set() writes it straight into the image and nothing waits for finish() (a
   // 4096² receiver's per-light buffer alone would be 260 MB).
-  direct_ = order == Order::light_major && lights.size() == 1 && quantity == Quantity::visibility &&
-            !keep.any();
-  if (order == Order::light_major && !direct_) {
+  const bool by_light = order != Order::texel_major;
+  direct_ = by_light && lights.size() == 1 && quantity == Quantity::visibility && !keep.any();
+  if (by_light && !direct_) {
     set_sums_.resize(space.texels.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, set_sums_.size(), 1 << 14),
                       [&](const tbb::blocked_range<std::size_t>& range) {
@@ -61,19 +61,61 @@ LightMix::LightMix(const TexelSpace& space, const std::vector<Light>& lights, Qu
       std::set_union(t.begin(), t.end(), blocks.begin(), blocks.end(), std::back_inserter(both));
       t.swap(both);
     }
-    const float value_start[3] = {unset, unset, unset}, visibility_start[2] = {1, 0};
-    for (std::size_t o = 0; o < outputs; ++o) {
-      if (keep_.values) out_.per_light.reserve(o, tiles[o], value_start);
-      if (keep_.visibility) out_.per_light_visibility.reserve(o, tiles[o], visibility_start);
-    }
-  }
-  // A mesh light's parts are summed per texel until finish(): Σ H0·V and Σ H0.
-  if (keep_.any()) {
     std::vector<int> parts(outputs, 0);
     for (const Light& l : lights) ++parts[std::size_t(l.output())];
+    by_turn_ = order == Order::light_by_light &&
+               std::all_of(parts.begin(), parts.end(), [](int p) { return p == 1; });
+    if (by_turn_) {
+      turn_tiles_ = std::move(tiles);
+    } else {
+      for (std::size_t o = 0; o < outputs; ++o) reserve(o, tiles[o]);
+    }
+    // A mesh light's parts are summed per texel until finish(): Σ H0·V and Σ H0.
     sums_.resize(outputs);
     for (std::size_t o = 0; o < outputs; ++o)
       if (parts[o] > 1) sums_[o].assign(space.texels.size(), Sum{});
+  }
+}
+
+std::array<float, 3> LightMix::value_start() const {
+  // A value image's start over its tiles is the combined image's (kNoLightCounts for visibility).
+  const float unset = quantity_ == Quantity::visibility ? kNoLightCounts : 0.0f;
+  return {unset, unset, unset};
+}
+
+void LightMix::reserve(std::size_t output, std::span<const std::uint32_t> tiles) {
+  const float visibility_start[2] = {1, 0};
+  if (keep_.values) out_.per_light.reserve(output, tiles, value_start());
+  if (keep_.visibility) out_.per_light_visibility.reserve(output, tiles, visibility_start);
+}
+
+void LightMix::begin_light(std::size_t light) {
+  if (!by_turn_) return;
+  const std::size_t o = std::size_t(lights_[light].output());
+  reserve(o, turn_tiles_[o]);
+  turn_tiles_[o] = std::vector<std::uint32_t>();
+}
+
+void LightMix::end_light(std::size_t light) {
+  if (by_turn_) finish_output(std::size_t(lights_[light].output()), {light});
+}
+
+void LightMix::finish_output(std::size_t o, const std::vector<std::size_t>& parts) {
+  if (o < out_.per_light.size()) {
+    if (quantity_ == Quantity::visibility) {
+      const float uncounted[3] = {kNoLightCounts, kNoLightCounts, kNoLightCounts};
+      Image image = out_.per_light.dense(o, uncounted);
+      fill_terminators(space_, lights_, parts, UncountedMark::value, image, lists_,
+                       out_.per_light.tiles(o));
+      out_.per_light.assign(o, image);
+    }
+    out_.per_light.park(o);
+  }
+  if (o < out_.per_light_visibility.size()) {
+    Image image = out_.per_light_visibility.dense(o);
+    fill_terminators(space_, lights_, parts, UncountedMark::flag_off, image, lists_,
+                     out_.per_light_visibility.tiles(o));
+    out_.per_light_visibility.assign(o, image);
   }
 }
 
@@ -189,19 +231,7 @@ MixedImages LightMix::finish() {
     parts_of[std::size_t(lights_[l].output())].push_back(l);
   tbb::parallel_for(std::size_t(0), outputs, [&](std::size_t o) {
     const std::vector<std::size_t>& parts = parts_of[o];
-    if (quantity_ == Quantity::visibility && o < out_.per_light.size()) {
-      const float uncounted[3] = {kNoLightCounts, kNoLightCounts, kNoLightCounts};
-      Image image = out_.per_light.dense(o, uncounted);
-      fill_terminators(space_, lights_, parts, UncountedMark::value, image, lists_,
-                       out_.per_light.tiles(o));
-      out_.per_light.assign(o, image);
-    }
-    if (o < out_.per_light_visibility.size()) {
-      Image image = out_.per_light_visibility.dense(o);
-      fill_terminators(space_, lights_, parts, UncountedMark::flag_off, image, lists_,
-                       out_.per_light_visibility.tiles(o));
-      out_.per_light_visibility.assign(o, image);
-    }
+    if (!by_turn_) finish_output(o, parts);
   });
   return std::move(out_);
 }

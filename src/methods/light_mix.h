@@ -9,8 +9,10 @@
 // summed in double over lights in scene order and written as float.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "core/image.h"
@@ -45,8 +47,9 @@ struct MixedImages {
   TiledImages per_light_visibility;  // empty unless kept
 };
 
-// Empty per-light images of a width × height receiver: values (0 beyond a light's tiles) and
-// visibility ((1, 0) beyond them).
+// Empty per-light images of a width × height receiver, each spilling to a scratch file as it
+// is given back (TiledImages): values (0 beyond a light's tiles) and visibility ((1, 0) beyond
+// them).
 TiledImages per_light_values(std::size_t lights, int width, int height);
 TiledImages per_light_visibilities(std::size_t lights, int width, int height);
 
@@ -54,9 +57,12 @@ class LightMix {
  public:
   // How the method visits (light, texel) pairs: all of a texel's lights at once (add, write), or
   // light by light (set, then finish writes; each texel's sums are kept until then, not each
-  // light's values). `lists`, where given, says which lights may reach each block of texels
-  // (the terminators' fill weighs those alone; the others add exactly 0).
-  enum class Order { texel_major, light_major };
+  // light's values). light_by_light is light_major with each light's turn bracketed by
+  // begin_light and end_light: a kept light's values are then made at its turn and finished
+  // (and spilled, TiledImages) at its end, so that memory holds one light's values at a time.
+  // `lists`, where given, says which lights may reach each block of texels (the terminators'
+  // fill weighs those alone; the others add exactly 0).
+  enum class Order { texel_major, light_major, light_by_light };
   LightMix(const TexelSpace& space, const std::vector<Light>& lights, Quantity quantity,
            Order order, KeepPerLight keep, const LightLists* lists = nullptr);
 
@@ -81,11 +87,21 @@ class LightMix {
   // its record (a 4096² receiver's records are half a gigabyte).
   void set(std::size_t light, std::size_t texel, int x, int y, const Vec3& v);
 
+  // light_by_light: light l's turn begins (before its first set) and ends (after its last).
+  // A light whose turn never comes adds nothing, and its kept images are the fill.
+  void begin_light(std::size_t light);
+  void end_light(std::size_t light);
+
   MixedImages finish();
 
  private:
   void keep(std::size_t light, std::size_t texel, const Vec3& h0, const Vec3& v);
   void keep_output(std::size_t output, std::size_t texel, const Vec3& h0, const Vec3& v);
+  std::array<float, 3> value_start() const;  // a value image's start over its tiles
+  // Output o's kept images over `tiles`, at their start.
+  void reserve(std::size_t output, std::span<const std::uint32_t> tiles);
+  // Output o's kept images made final (the terminators filled), then spilled.
+  void finish_output(std::size_t output, const std::vector<std::size_t>& parts);
 
   const TexelSpace& space_;
   const std::vector<Light>& lights_;
@@ -94,6 +110,10 @@ class LightMix {
   KeepPerLight keep_;
   MixedImages out_;
   bool direct_ = false;  // one light's visibility, light-major: set() writes the image itself
+  // light_by_light, each output one light: its kept images are made at its turn, over
+  // turn_tiles_[output] (the blocks its lists give it).
+  bool by_turn_ = false;
+  std::vector<std::vector<std::uint32_t>> turn_tiles_;
   std::atomic<std::uint32_t> most_lights_{0};  // MixedImages::most_lights, as texels are written
   // Light-major methods' sums per texel until finish() (48 bytes a texel, whatever the number
   // of lights); empty for texel-major ones.

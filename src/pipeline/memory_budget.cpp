@@ -27,10 +27,12 @@ constexpr double kResultBytesPerTexel = 3 * 4 + 1;
 constexpr double kWriteBytesPerTexel = 3 * 4 + 3 + 4 + 1;
 constexpr double kAtlasBytesPerTexel = 3 * 4;
 // Kept per receiver, texel and light until written, at the texels the light reaches (by tiles,
-// TiledImages): its value (RGB float), or what its shadow mask needs (visibility and influence,
-// 2 floats).
-constexpr double kPerLightValueBytesPerTexel = 3 * 4;
+// TiledImages): what its shadow mask needs (visibility and influence, 2 floats). Its values
+// (RGB float) spill to a scratch file as each light is finished: in memory, a whole image per
+// light being finished or written, one per thread and one in the writer.
 constexpr double kPerLightMaskBytesPerTexel = 2 * 4;
+constexpr double kPerLightValueBytesPerTexel = 3 * 4;
+constexpr double kPerLightWholeValueImages = 3;
 // Faces per piece of a receiver's surface whose box a light's reach is tested against.
 constexpr std::size_t kFacesPerPiece = 64;
 
@@ -82,10 +84,14 @@ std::optional<MemoryItem> per_light_memory(const Scene& scene,
                                            const std::vector<const Mesh*>& receivers,
                                            const std::vector<int>& sides,
                                            const std::vector<Light>& lights) {
-  const double bytes = (scene.output.per_light ? kPerLightValueBytesPerTexel : 0) +
-                       (scene.output.shadowmask ? kPerLightMaskBytesPerTexel : 0);
-  if (!(bytes > 0)) return std::nullopt;
+  if (!scene.output.per_light && !scene.output.shadowmask) return std::nullopt;
   double total = 0;
+  if (scene.output.per_light)
+    for (const int side : sides)
+      total = std::max(total, kPerLightWholeValueImages * kPerLightValueBytesPerTexel *
+                                  double(side) * double(side));
+  if (!scene.output.shadowmask) return MemoryItem{"per-light images", total};
+  const double bytes = kPerLightMaskBytesPerTexel;
   for (std::size_t r = 0; r < receivers.size(); ++r) {
     // The receiver's surface in pieces of consecutive faces (a level's file keeps a room's
     // faces together), each a box and an area.

@@ -163,7 +163,8 @@ std::string receiver_data(const ReceiverBake& r) {
     for (std::size_t l = 0; l < images->size(); ++l) {
       put_u64(out, images->tiles(l).size());
       put(out, images->tiles(l).data(), images->tiles(l).size());
-      put(out, images->values(l).data(), images->values(l).size());
+      const std::vector<float> values = images->values(l);
+      put(out, values.data(), values.size());
     }
   if (r.gltf_mesh) put_mesh(out, *r.gltf_mesh);
   return out;

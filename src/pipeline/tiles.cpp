@@ -119,7 +119,7 @@ void crop_to_tile(ReceiverBake& r, const TexelSpace& space, RowRange rows) {
   };
   crop(r.image);
   const auto crop_each = [&](TiledImages& images) {
-    TiledImages cropped(images.size(), images.width(), rows.end - rows.begin, images.fill());
+    TiledImages cropped = images.like(images.size(), images.width(), rows.end - rows.begin);
     for (std::size_t l = 0; l < images.size(); ++l) {
       Image image = images.dense(l);
       crop(image);

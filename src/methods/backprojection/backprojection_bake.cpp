@@ -125,7 +125,8 @@ MixedImages bake_backprojection(const TexelSpace& space, const BackprojectionInp
   const std::vector<Light>& lights = *in.lights;
   std::optional<LightLists> own;
   const LightLists& lists = in.lists ? *in.lists : own.emplace(space, lights);
-  LightMix mix(space, lights, in.quantity, LightMix::Order::light_major, in.keep_per_light, &lists);
+  LightMix mix(space, lights, in.quantity, LightMix::Order::light_by_light, in.keep_per_light,
+               &lists);
   RouteCounts counts;
   // Counted: the kept rows' texels (a tile's halo is not).
   const auto kept = kept_texels(space);
@@ -192,12 +193,14 @@ MixedImages bake_backprojection(const TexelSpace& space, const BackprojectionInp
         return step;
       }) & tbb::make_filter<Step, void>(tbb::filter_mode::serial_in_order, [&](const Step& step) {
         const std::size_t l = step.light;
+        mix.begin_light(l);
         if (step.field) {
           apply(l, *step.field);
-          return;
+        } else {
+          bake_light_by_rays(space, grid, joins, in, lists.blocks_of(l), l,
+                             lights[l].is_point() ? 1 : in.samples, mix, counts);
         }
-        bake_light_by_rays(space, grid, joins, in, lists.blocks_of(l), l,
-                           lights[l].is_point() ? 1 : in.samples, mix, counts);
+        mix.end_light(l);
       }));
   if (routes) *routes = counts;
   return mix.finish();
