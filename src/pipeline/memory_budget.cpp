@@ -26,10 +26,11 @@ constexpr double kResultBytesPerTexel = 3 * 4 + 1;
 // composed first (RGB float).
 constexpr double kWriteBytesPerTexel = 3 * 4 + 3 + 4 + 1;
 constexpr double kAtlasBytesPerTexel = 3 * 4;
-// Kept per receiver, texel and light until written, at the texels the light reaches (by tiles,
-// TiledImages): what its shadow mask needs (visibility and influence, 2 floats). Its values
-// (RGB float) spill to a scratch file as each light is finished: in memory, a whole image per
-// light being finished or written, one per thread and one in the writer.
+// Per receiver, texel and light, at the texels the light reaches (by tiles, TiledImages): what
+// its shadow mask needs (visibility and influence, 2 floats), counted as if kept in memory
+// until written (they spill to a scratch file: an estimate from above). Its values (RGB float)
+// spill as each light is finished: in memory, a whole image per light being finished or
+// written, one per thread and one in the writer.
 constexpr double kPerLightMaskBytesPerTexel = 2 * 4;
 constexpr double kPerLightValueBytesPerTexel = 3 * 4;
 constexpr double kPerLightWholeValueImages = 3;

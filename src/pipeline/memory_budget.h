@@ -32,9 +32,11 @@ std::vector<int> sides_from_settings(const Scene& scene);
 std::vector<MemoryItem> bake_memory_estimate(const Scene& scene, const std::vector<int>& sides);
 
 // The per-light images ([output] per_light, shadowmask) of receivers with these meshes and
-// sides, kept until written, once the meshes and lights are known: each light's share of each
-// receiver's surface its reach may touch (by pieces of 64 faces: an estimate from above),
-// times the texels. None where no per-light image is kept.
+// sides, once the meshes and lights are known: per_light's values, a few whole images in
+// flight (the rest wait in a scratch file, TiledImages); shadowmask's, each light's share of
+// each receiver's surface its reach may touch (by pieces of 64 faces), times the texels, as if
+// they stayed in memory (they spill as well: an estimate from above). None where no per-light
+// image is kept.
 std::optional<MemoryItem> per_light_memory(const Scene& scene,
                                            const std::vector<const Mesh*>& receivers,
                                            const std::vector<int>& sides,
