@@ -88,8 +88,8 @@ class TiledImages {
  private:
   struct Tiles {
     std::vector<std::uint32_t> tiles;
-    std::vector<float> values;      // empty while parked
-    std::int64_t parked_at = -1;    // the values' offset in the scratch file, where parked
+    std::vector<float> values;    // empty while parked
+    std::int64_t parked_at = -1;  // the values' offset in the scratch file, where parked
   };
   std::size_t slot(const Tiles& t, int x, int y) const;  // t.tiles.size() where absent
   std::size_t value_count(const Tiles& t) const;

@@ -43,10 +43,11 @@ void add_overlaps(const TiledImages& light_visibility, const std::vector<std::ui
     for (const std::uint32_t tile : tiles) held.push_back({tile, std::uint32_t(l), 0});
     light_visibility.each_pixel(l, [&](int x, int y, const float* v) {
       if (!covered[std::size_t(y) * width + std::size_t(x)] || !(v[1] > 0)) return;
-      const std::uint32_t tile = std::uint32_t(y / side) * std::uint32_t(light_visibility.tiles_x()) +
-                                 std::uint32_t(x / side);
-      const std::size_t s = std::size_t(std::lower_bound(tiles.begin(), tiles.end(), tile) -
-                                        tiles.begin());
+      const std::uint32_t tile =
+          std::uint32_t(y / side) * std::uint32_t(light_visibility.tiles_x()) +
+          std::uint32_t(x / side);
+      const std::size_t s =
+          std::size_t(std::lower_bound(tiles.begin(), tiles.end(), tile) - tiles.begin());
       held[first + s].pixels |= std::uint64_t(1) << ((y % side) * side + x % side);
     });
   }

@@ -24,8 +24,7 @@ LightMix::LightMix(const TexelSpace& space, const std::vector<Light>& lights, Qu
     : space_(space), lights_(lights), lists_(lists), quantity_(quantity), keep_(keep) {
   // Visibility: texels where no light counts hold kNoLightCounts until finish() fills the
   // terminators' (terminator_fill.h).
-  const float unset = quantity == Quantity::visibility ? kNoLightCounts : 0.0f;
-  out_.image = Image(space.width, space.height, 3, unset);
+  out_.image = Image(space.width, space.height, 3, value_start()[0]);
   // One light's visibility, set light by light: its V is the texel's value wherever it reaches
   // (H0·V / H0), so set() writes it straight into the image and nothing waits for finish() (a
   // 4096² receiver's per-light buffer alone would be 260 MB).
@@ -45,7 +44,8 @@ LightMix::LightMix(const TexelSpace& space, const std::vector<Light>& lights, Qu
     out_.per_light_visibility = per_light_visibilities(outputs, space.width, space.height);
   if (keep_.any()) {
     // Each output's tiles: the blocks its parts' lists give them, or every one without lists. A
-    // value image's start there is `unset`, as the combined image's; a visibility image's (1, 0).
+    // value image's start there is value_start(), as the combined image's; a visibility
+    // image's (1, 0).
     std::vector<std::vector<std::uint32_t>> tiles(outputs);
     const TiledImages& shape = keep_.values ? out_.per_light : out_.per_light_visibility;
     const std::size_t all = std::size_t(shape.tiles_x()) * std::size_t(shape.tiles_y());
@@ -78,7 +78,8 @@ LightMix::LightMix(const TexelSpace& space, const std::vector<Light>& lights, Qu
 }
 
 std::array<float, 3> LightMix::value_start() const {
-  // A value image's start over its tiles is the combined image's (kNoLightCounts for visibility).
+  // The combined image's start, and a value image's over its tiles: kNoLightCounts for
+  // visibility.
   const float unset = quantity_ == Quantity::visibility ? kNoLightCounts : 0.0f;
   return {unset, unset, unset};
 }

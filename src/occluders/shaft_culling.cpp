@@ -20,13 +20,11 @@
 // over a small hierarchy.
 #include "occluders/shaft_culling.h"
 
-#include "core/nearest_point.h"
-#include "occluders/blocker_solids.h"
+#include "occluders/blocker_hierarchy.h"
 #include "occluders/ray_scene.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <array>
@@ -36,6 +34,11 @@
 namespace sb {
 
 namespace {
+
+using Box = BlockerHierarchy::Box;
+using Node = BlockerHierarchy::Node;
+using Tri = BlockerHierarchy::Tri;
+constexpr int kStack = BlockerHierarchy::kStack;
 
 struct Plane {
   Vec3 n;  // inside: n·x <= d
@@ -59,62 +62,12 @@ struct Planes {
   const Plane* end() const { return p.data() + n; }
 };
 
-struct Box {
-  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
-  Vec3 hi = Vec3::Constant(-std::numeric_limits<double>::infinity());
-  void extend(const Vec3& p) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  void extend(const Box& b) {
-    lo = lo.cwiseMin(b.lo);
-    hi = hi.cwiseMax(b.hi);
-  }
-};
-
-struct Node {
-  Box box;
-  int first = 0, count = 0;  // leaf: triangles [first, first + count)
-  int left = -1, right = -1;
-  int size = 0;  // triangles under it: [first, first + size)
-};
-
-struct Tri {
-  Vec3 v[3];
-  Vec3 normal;  // unit (zero for a degenerate triangle, which blocks nothing)
-  Vec3 lo, hi;  // bounding box
-  // Of a closed component whose normals point out (its index in Impl::solids), or -1: from a
-  // point outside the solid's box, a triangle facing away is never the first thing a ray meets.
-  int solid = -1;
-  int mesh = 0;                 // which blocker mesh it is of
-  std::array<int, 3> across{};  // the triangle across edge (v[k], v[k+1]), or -1
-  int source = 0;               // its index before the hierarchy's build reordered them
-};
-
 // A convex polygon being clipped: a triangle cut by at most 13 planes keeps at most 16 corners.
 struct Clip {
   std::array<Vec3, ShaftPolygon::kMaxVertices> v;
   int n = 0;
 };
 
-constexpr int kLeafSize = 4;
-// The hierarchy's build: bins of the surface area heuristic, and the depth past which it splits
-// at the median (the traversal's stack holds kStack nodes; a balanced split adds one a level).
-constexpr int kBins = 16;
-constexpr int kMaxDepth = 48;
-constexpr int kStack = 128;
-
-Vec3 centroid(const Tri& t) { return (t.v[0] + t.v[1] + t.v[2]) / 3.0; }
-
-double area(const Box& b) {
-  if (!(b.hi.x() >= b.lo.x())) return 0;
-  const Vec3 e = b.hi - b.lo;
-  return 2 * (e.x() * e.y() + e.y() * e.z() + e.z() * e.x());
-}
-
-int bin_of(double c, double lo, double extent) {
-  return std::clamp(int(kBins * (c - lo) / extent), 0, kBins - 1);
-}
 // Points within this distance (metres) of a triangle's plane count as on it.
 constexpr double kPlaneTolerance = 1e-9;
 
@@ -136,94 +89,12 @@ void clip(Clip& poly, Clip& scratch, const Plane& plane) {
 }  // namespace
 
 struct ShaftCuller::Impl {
-  std::vector<Tri> tris;
-  std::vector<Node> nodes;
-  std::vector<BlockerSolid> solids;  // the closed, outward components (blocker_solids.h)
-  struct MeshInfo {
-    Bounds3 bounds;
-    std::size_t count = 0;
-    std::vector<std::uint32_t> balls;  // its solids with an inner ball, as keys
-  };
+  BlockerHierarchy h;
+  // Per blocker mesh: its solids with an inner ball, as keys.
+  std::vector<std::vector<std::uint32_t>> balls;
   std::vector<std::uint32_t> ball_key;  // per solid: kSolidKey | it, where it has a ball
-  std::vector<MeshInfo> meshes;         // per blocker mesh
-  std::vector<std::uint32_t> of_face;   // per face of the blockers: its triangle's index
   // How much of its start a shadow ray skips (RayScene::surface_offset), metres.
   double skip = 0;
-
-  // Builds the subtree over tris[first, first + count): split where the surface area heuristic
-  // says (binned, Wald, "On fast Construction of SAH-based Bounding Volume Hierarchies", 2007):
-  // a shaft visits a node in proportion to its area, and a level's long floors and walls make a
-  // median split's boxes overlap everywhere. Past kMaxDepth, or where no bin separates the
-  // centroids, the median along the widest axis (a balanced tree within the traversal's stack).
-  int build(int first, int count, int depth = 0) {
-    Node node;
-    Box centroids;
-    for (int i = first; i < first + count; ++i) {
-      node.box.extend(Box{tris[std::size_t(i)].lo, tris[std::size_t(i)].hi});
-      centroids.extend(centroid(tris[std::size_t(i)]));
-    }
-    node.first = first;
-    node.count = count;
-    node.size = count;
-    const int index = int(nodes.size());
-    nodes.push_back(node);
-    if (count <= kLeafSize) return index;
-    const Vec3 extent = centroids.hi - centroids.lo;
-    int axis = 0;
-    if (extent.y() > extent[axis]) axis = 1;
-    if (extent.z() > extent[axis]) axis = 2;
-    int half = -1;
-    if (depth < kMaxDepth) {
-      double best = std::numeric_limits<double>::infinity();
-      int best_axis = -1, best_split = 0;
-      for (int a = 0; a < 3; ++a) {
-        if (!(extent[a] > 0)) continue;
-        std::array<Box, kBins> boxes;
-        std::array<int, kBins> counts{};
-        for (int i = first; i < first + count; ++i) {
-          const int b = bin_of(centroid(tris[std::size_t(i)])[a], centroids.lo[a], extent[a]);
-          boxes[std::size_t(b)].extend(Box{tris[std::size_t(i)].lo, tris[std::size_t(i)].hi});
-          ++counts[std::size_t(b)];
-        }
-        // Areas and counts left of each split, then right of it, summed up.
-        std::array<double, kBins> left_cost{};
-        Box grown;
-        int n = 0;
-        for (int b = 0; b < kBins - 1; ++b) {
-          grown.extend(boxes[std::size_t(b)]);
-          n += counts[std::size_t(b)];
-          left_cost[std::size_t(b)] = n > 0 ? area(grown) * n : 0;
-        }
-        grown = Box();
-        n = 0;
-        for (int b = kBins - 1; b > 0; --b) {
-          grown.extend(boxes[std::size_t(b)]);
-          n += counts[std::size_t(b)];
-          const double cost = left_cost[std::size_t(b - 1)] + (n > 0 ? area(grown) * n : 0);
-          if (n > 0 && n < count && cost < best) best = cost, best_axis = a, best_split = b;
-        }
-      }
-      if (best_axis >= 0) {
-        const double lo = centroids.lo[best_axis], ext = extent[best_axis];
-        const auto middle = std::partition(
-            tris.begin() + first, tris.begin() + first + count,
-            [&](const Tri& t) { return bin_of(centroid(t)[best_axis], lo, ext) < best_split; });
-        half = int(middle - (tris.begin() + first));
-      }
-    }
-    if (half <= 0 || half >= count) {
-      half = count / 2;
-      std::nth_element(
-          tris.begin() + first, tris.begin() + first + half, tris.begin() + first + count,
-          [axis](const Tri& a, const Tri& b) { return centroid(a)[axis] < centroid(b)[axis]; });
-    }
-    const int left = build(first, half, depth + 1);
-    const int right = build(first + half, count - half, depth + 1);
-    nodes[std::size_t(index)].left = left;
-    nodes[std::size_t(index)].right = right;
-    nodes[std::size_t(index)].count = 0;
-    return index;
-  }
 
   // The shaft between the apex and the light, as planes; false when the light cannot reach the
   // apex. The apex is a point (one texel's ray origin; with its surface point and normal, whose
@@ -388,7 +259,7 @@ struct ShaftCuller::Impl {
       // the ray's origin before it meets one facing away, so those facing away add nothing. A
       // ray skips the first `skip` of its segment (it may step over the face it enters by), so
       // the origin must lie outside the box by that much.
-      const Bounds3& solid = solids[std::size_t(t.solid)].bounds;
+      const Bounds3& solid = h.solids[std::size_t(t.solid)].bounds;
       const bool outside = ((apex.hi.array() + skip) < solid.lo.array()).any() ||
                            ((apex.lo.array() - skip) > solid.hi.array()).any();
       const Vec3 p = 0.5 * (apex.lo + apex.hi);
@@ -397,7 +268,7 @@ struct ShaftCuller::Impl {
     }
     if (same_side(t, apex, base, corners, light)) return false;
     if (inside && !clip_it) return true;  // within every plane: listed
-    if (!clip_it && meshes[std::size_t(t.mesh)].count > ShaftCuller::kDenseMesh) {
+    if (!clip_it && h.meshes[std::size_t(t.mesh)].count > ShaftCuller::kDenseMesh) {
       // Listed only, of a dense mesh (whose union's outline is taken, not its triangles): kept
       // unless its corners all lie outside one plane (conservative, and much cheaper).
       for (const Plane& pl : planes)
@@ -428,11 +299,11 @@ struct ShaftCuller::Impl {
     int corners = 0;
     if (!shaft(apex, surface, n, light, planes, base, corners))
       return apex.lo == apex.hi ? kNone : kUndecided;
-    if (nodes.empty()) return kDone;
+    if (h.nodes.empty()) return kDone;
     Clip poly, scratch;
     if (among) {
       for (std::uint32_t i : *among)
-        if (in_shaft(tris[i], apex, planes, base, corners, light, poly, scratch, clip_it) &&
+        if (in_shaft(h.tris[i], apex, planes, base, corners, light, poly, scratch, clip_it) &&
             !visit(i, poly))
           return kStopped;
       return kDone;
@@ -441,7 +312,7 @@ struct ShaftCuller::Impl {
     int top = 0;
     stack[top++] = 0;
     while (top > 0) {
-      const Node& node = nodes[std::size_t(stack[--top])];
+      const Node& node = h.nodes[std::size_t(stack[--top])];
       if (planes.misses(node.box.lo, node.box.hi)) continue;
       bool outside = false, inside = true;
       for (const Plane& pl : planes) {
@@ -460,7 +331,7 @@ struct ShaftCuller::Impl {
         // Listing a tile's candidates: all of the node lies within the planes, so only the
         // tests of facing and side remain, triangle by triangle.
         for (int i = node.first; i < node.first + node.size; ++i)
-          if (in_shaft(tris[std::size_t(i)], apex, planes, base, corners, light, poly, scratch,
+          if (in_shaft(h.tris[std::size_t(i)], apex, planes, base, corners, light, poly, scratch,
                        clip_it, /*inside=*/true) &&
               !visit(std::uint32_t(i), poly))
             return kStopped;
@@ -473,7 +344,7 @@ struct ShaftCuller::Impl {
         continue;
       }
       for (int i = node.first; i < node.first + node.count; ++i)
-        if (in_shaft(tris[std::size_t(i)], apex, planes, base, corners, light, poly, scratch,
+        if (in_shaft(h.tris[std::size_t(i)], apex, planes, base, corners, light, poly, scratch,
                      clip_it) &&
             !visit(std::uint32_t(i), poly))
           return kStopped;
@@ -514,74 +385,29 @@ struct ShaftCuller::Impl {
 
 ShaftCuller::ShaftCuller(const std::vector<const Mesh*>& blockers)
     : impl_(std::make_unique<Impl>()) {
-  std::vector<std::array<Vec3, 3>> corners;
-  std::vector<std::size_t> mesh_ends;
-  for (const Mesh* m : blockers) {
-    for (const auto f : m->mesh.faces()) {
-      const Triangle tri = triangle(m->mesh, f);
-      Tri t;
-      t.mesh = int(mesh_ends.size());
-      t.source = int(impl_->tris.size());
-      for (int k = 0; k < 3; ++k) t.v[k] = tri.p[k];
-      const Vec3 cross = (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]);
-      const double len = cross.norm();
-      t.normal = len > 0 ? Vec3(cross / len) : Vec3::Zero();
-      t.lo = t.v[0].cwiseMin(t.v[1]).cwiseMin(t.v[2]);
-      t.hi = t.v[0].cwiseMax(t.v[1]).cwiseMax(t.v[2]);
-      impl_->tris.push_back(t);
-      corners.push_back({t.v[0], t.v[1], t.v[2]});
-    }
-    mesh_ends.push_back(impl_->tris.size());
-  }
-  // The solids and the tree do not depend on each other: found side by side (a dense mesh's
-  // 100,000 triangles take a tenth of a second each), the solids then given to each triangle
-  // by its index in the input.
-  BlockerSolids found;
-  tbb::parallel_invoke([&] { found = find_solids(corners, mesh_ends); },
-                       [&] {
-                         if (impl_->tris.empty()) return;
-                         impl_->nodes.reserve(2 * impl_->tris.size() / kLeafSize + 2);
-                         impl_->build(0, int(impl_->tris.size()));
-                       });
-  for (Tri& t : impl_->tris) t.solid = found.solid_of[std::size_t(t.source)];
-  impl_->solids = std::move(found.solids);
-  // Neighbours across edges, renumbered to where the build put each triangle.
-  std::vector<int> where(impl_->tris.size());
-  for (std::size_t i = 0; i < impl_->tris.size(); ++i)
-    where[std::size_t(impl_->tris[i].source)] = int(i);
-  impl_->of_face.assign(where.begin(), where.end());
-  for (Tri& t : impl_->tris)
-    for (int k = 0; k < 3; ++k) {
-      const int n = found.across[std::size_t(t.source)][std::size_t(k)];
-      t.across[std::size_t(k)] = n < 0 ? -1 : where[std::size_t(n)];
-    }
-  impl_->meshes.resize(mesh_ends.size());
+  impl_->h = BlockerHierarchy(blockers);
+  const BlockerHierarchy& h = impl_->h;
   Bounds3 all;
-  for (const Tri& t : impl_->tris) {
-    Impl::MeshInfo& m = impl_->meshes[std::size_t(t.mesh)];
-    for (const Vec3& v : t.v) m.bounds.extend(v);
-    ++m.count;
-  }
-  for (const Impl::MeshInfo& m : impl_->meshes)
+  for (const BlockerHierarchy::MeshInfo& m : h.meshes)
     if (!m.bounds.empty()) all.extend(m.bounds);
   impl_->skip = surface_offset_for(all);
-  impl_->ball_key.resize(impl_->solids.size());
-  for (std::size_t k = 0; k < impl_->solids.size(); ++k)
+  impl_->ball_key.resize(h.solids.size());
+  for (std::size_t k = 0; k < h.solids.size(); ++k)
     impl_->ball_key[k] = kSolidKey | std::uint32_t(k);
-  for (const Tri& t : impl_->tris) {
-    if (t.solid < 0 || !(impl_->solids[std::size_t(t.solid)].inner_radius > 0)) continue;
-    std::vector<std::uint32_t>& balls = impl_->meshes[std::size_t(t.mesh)].balls;
+  impl_->balls.resize(h.meshes.size());
+  for (const Tri& t : h.tris) {
+    if (t.solid < 0 || !(h.solids[std::size_t(t.solid)].inner_radius > 0)) continue;
+    std::vector<std::uint32_t>& balls = impl_->balls[std::size_t(t.mesh)];
     const std::uint32_t key = kSolidKey | std::uint32_t(t.solid);
     if (std::find(balls.begin(), balls.end(), key) == balls.end()) balls.push_back(key);
   }
-  keys_.reserve(impl_->tris.size());
-  for (std::size_t i = 0; i < impl_->tris.size(); ++i) {
-    const Tri& t = impl_->tris[i];
-    keys_.push_back(t.solid >= 0 && impl_->solids[std::size_t(t.solid)].convex
-                        ? kSolidKey | std::uint32_t(t.solid)
-                    : impl_->meshes[std::size_t(t.mesh)].count > kDenseMesh
-                        ? kMeshKey | std::uint32_t(t.mesh)
-                        : std::uint32_t(i));
+  keys_.reserve(h.tris.size());
+  for (std::size_t i = 0; i < h.tris.size(); ++i) {
+    const Tri& t = h.tris[i];
+    keys_.push_back(
+        t.solid >= 0 && h.solids[std::size_t(t.solid)].convex ? kSolidKey | std::uint32_t(t.solid)
+        : h.meshes[std::size_t(t.mesh)].count > kDenseMesh    ? kMeshKey | std::uint32_t(t.mesh)
+                                                              : std::uint32_t(i));
   }
 }
 
@@ -614,7 +440,7 @@ ShaftCuller::Polygons ShaftCuller::shaft_polygons(const Vec3& origin, const Vec3
                                                      if (out.size() >= max) return false;
                                                      ShaftPolygon& p = out.emplace_back();
                                                      p.triangle = i;
-                                                     p.normal = impl_->tris[i].normal;
+                                                     p.normal = impl_->h.tris[i].normal;
                                                      p.count = poly.n;
                                                      for (int k = 0; k < p.count; ++k)
                                                        p.v[std::size_t(k)] = poly.v[std::size_t(k)];
@@ -649,104 +475,58 @@ bool ShaftCuller::maybe_blocked(const Vec3& origin, const Vec3& surface, const V
 }
 
 const BlockerSolid* ShaftCuller::solid(std::uint32_t triangle) const {
-  const int s = impl_->tris[triangle].solid;
-  return s < 0 ? nullptr : &impl_->solids[std::size_t(s)];
+  const int s = impl_->h.tris[triangle].solid;
+  return s < 0 ? nullptr : &impl_->h.solids[std::size_t(s)];
 }
 
 Bounds3 ShaftCuller::key_bounds(std::uint32_t key) const {
   if (key & kSolidKey) return solid_of_key(key).bounds;
-  if (key & kMeshKey) return impl_->meshes[key & ~kMeshKey].bounds;
+  if (key & kMeshKey) return impl_->h.meshes[key & ~kMeshKey].bounds;
   return triangle_bounds(key);
 }
 
 const BlockerSolid& ShaftCuller::solid_of_key(std::uint32_t key) const {
-  return impl_->solids[key & ~kSolidKey];
+  return impl_->h.solids[key & ~kSolidKey];
 }
 
 std::span<const std::uint32_t> ShaftCuller::solids_with_balls(std::uint32_t key) const {
   if (key & kSolidKey) return {};
-  if (key & kMeshKey) return impl_->meshes[key & ~kMeshKey].balls;
-  const int solid = impl_->tris[key].solid;
-  if (solid < 0 || !(impl_->solids[std::size_t(solid)].inner_radius > 0)) return {};
+  if (key & kMeshKey) return impl_->balls[key & ~kMeshKey];
+  const int solid = impl_->h.tris[key].solid;
+  if (solid < 0 || !(impl_->h.solids[std::size_t(solid)].inner_radius > 0)) return {};
   return {&impl_->ball_key[std::size_t(solid)], 1};
 }
 
-std::size_t ShaftCuller::triangle_count() const { return impl_->tris.size(); }
+std::size_t ShaftCuller::triangle_count() const { return impl_->h.tris.size(); }
 
 void ShaftCuller::triangles_in_box(const Bounds3& box, std::vector<std::uint32_t>& out) const {
-  out.clear();
-  const std::vector<Node>& nodes = impl_->nodes;
-  if (nodes.empty() || box.empty()) return;
-  const auto meets = [&](const Vec3& lo, const Vec3& hi) {
-    return (lo.array() <= box.hi.array()).all() && (box.lo.array() <= hi.array()).all();
-  };
-  thread_local std::vector<int> stack;
-  stack.assign(1, 0);
-  while (!stack.empty()) {
-    const Node& node = nodes[std::size_t(stack.back())];
-    stack.pop_back();
-    if (!meets(node.box.lo, node.box.hi)) continue;
-    if (node.count > 0) {
-      for (int i = node.first; i < node.first + node.count; ++i)
-        if (meets(impl_->tris[std::size_t(i)].lo, impl_->tris[std::size_t(i)].hi))
-          out.push_back(std::uint32_t(i));
-      continue;
-    }
-    stack.push_back(node.left);
-    stack.push_back(node.right);
-  }
-  std::sort(out.begin(), out.end());
+  impl_->h.triangles_in_box(box, out);
 }
 
 std::vector<std::uint32_t> ShaftCuller::triangles_within(const Vec3& centre, double radius) const {
-  std::vector<std::uint32_t> found;
-  const std::vector<Node>& nodes = impl_->nodes;
-  if (nodes.empty()) return found;
-  const auto near = [&](const Vec3& lo, const Vec3& hi) {
-    return (centre.cwiseMax(lo).cwiseMin(hi) - centre).norm() < radius;
-  };
-  std::vector<int> stack = {0};
-  while (!stack.empty()) {
-    const Node& node = nodes[std::size_t(stack.back())];
-    stack.pop_back();
-    if (!near(node.box.lo, node.box.hi)) continue;
-    if (node.count > 0) {
-      for (int i = node.first; i < node.first + node.count; ++i) {
-        const Tri& t = impl_->tris[std::size_t(i)];
-        double bary[3];
-        if (near(t.lo, t.hi) &&
-            nearest_point(t.v[0], t.v[1], t.v[2], centre, bary) < radius * radius)
-          found.push_back(std::uint32_t(i));
-      }
-      continue;
-    }
-    stack.push_back(node.left);
-    stack.push_back(node.right);
-  }
-  std::sort(found.begin(), found.end());
-  return found;
+  return impl_->h.triangles_within(centre, radius);
 }
 
 std::uint32_t ShaftCuller::triangle_of_face(std::int64_t face) const {
-  return impl_->of_face[std::size_t(face)];
+  return impl_->h.of_face[std::size_t(face)];
 }
 
-int ShaftCuller::mesh_of(std::uint32_t triangle) const { return impl_->tris[triangle].mesh; }
+int ShaftCuller::mesh_of(std::uint32_t triangle) const { return impl_->h.tris[triangle].mesh; }
 
 int ShaftCuller::neighbour(std::uint32_t triangle, int edge) const {
-  return impl_->tris[triangle].across[std::size_t(edge)];
+  return impl_->h.tris[triangle].across[std::size_t(edge)];
 }
 
 const Vec3* ShaftCuller::triangle_corners(std::uint32_t triangle) const {
-  return impl_->tris[triangle].v;
+  return impl_->h.tris[triangle].v;
 }
 
 const Vec3& ShaftCuller::triangle_normal(std::uint32_t triangle) const {
-  return impl_->tris[triangle].normal;
+  return impl_->h.tris[triangle].normal;
 }
 
 Bounds3 ShaftCuller::triangle_bounds(std::uint32_t triangle) const {
-  const Tri& t = impl_->tris[triangle];
+  const Tri& t = impl_->h.tris[triangle];
   Bounds3 b;
   b.lo = t.lo;
   b.hi = t.hi;

@@ -84,15 +84,16 @@ TEST(TiledImages, SpilledImagesReadBackAsGiven) {
   ASSERT_EQ(values.size(), 3u * 64 * 3);
   EXPECT_EQ(values[(2 * 64 + 1 * 8 + 1) * 3 + 2], 5.0f);  // tile 5, pixel (1, 1): (17, 9)
   int seen = 0;
-  images.each_pixel(1, [&](int x, int y, const float* v) { seen += x == 9 && y == 4 && v[1] == 7; });
+  images.each_pixel(1,
+                    [&](int x, int y, const float* v) { seen += x == 9 && y == 4 && v[1] == 7; });
   EXPECT_EQ(seen, 1);
   // A parked image is not written in place: at() refuses it.
   EXPECT_THROW(images.at(0, 3, 2), std::logic_error);
   // Images made like these share their scratch file; restored ones spill too.
   TiledImages cropped = images.like(1, 20, 10);
-  ASSERT_TRUE(cropped.restore(0, std::vector<std::uint32_t>(images.tiles(1).begin(),
-                                                           images.tiles(1).end()),
-                              images.values(1)));
+  ASSERT_TRUE(
+      cropped.restore(0, std::vector<std::uint32_t>(images.tiles(1).begin(), images.tiles(1).end()),
+                      images.values(1)));
   EXPECT_EQ(cropped.bytes(), 3 * 4u);
   expect_same(cropped.dense(0), test_image(5.0f));
   // Reserved images are in memory, written in place, until parked.
@@ -113,7 +114,10 @@ TEST(TiledImages, ImagesStayInMemoryWithoutAScratchFolder) {
   ::setenv("TMPDIR", "/nonexistent/shadowbake-test", 1);
   TiledImages images(1, 20, 10, {0.0f, 0.0f, 0.0f}, TiledImages::Spill::to_file);
   images.assign(0, test_image(2.0f));
-  if (before) ::setenv("TMPDIR", kept.c_str(), 1); else ::unsetenv("TMPDIR");
+  if (before)
+    ::setenv("TMPDIR", kept.c_str(), 1);
+  else
+    ::unsetenv("TMPDIR");
   EXPECT_EQ(images.bytes(), 3 * (64 * 3 * sizeof(float) + 4));
   expect_same(images.dense(0), test_image(2.0f));
 }
