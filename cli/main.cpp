@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "commands.h"
-#include "pipeline/output_folder.h"
+#include "formats/output_folder.h"
 
 namespace sbcli {
 

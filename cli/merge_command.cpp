@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "commands.h"
-#include "pipeline/outputs.h"
+#include "formats/outputs.h"
 #include "pipeline/shards.h"
 
 namespace sbcli {

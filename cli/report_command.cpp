@@ -22,7 +22,7 @@
 
 #include "commands.h"
 #include "evaluation/report.h"
-#include "pipeline/manifest.h"
+#include "formats/manifest.h"
 #include "scene/scene.h"
 
 extern char** environ;

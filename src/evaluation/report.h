@@ -6,7 +6,7 @@
 
 #include "core/error.h"
 #include "evaluation/report_data.h"
-#include "pipeline/output_folder.h"
+#include "formats/output_folder.h"
 #include "scene/scene.h"
 
 namespace sb {

@@ -15,8 +15,8 @@
 #include <string_view>
 
 #include "core/image_io.h"
-#include "pipeline/manifest.h"
-#include "pipeline/outputs.h"
+#include "formats/manifest.h"
+#include "formats/outputs.h"
 
 namespace sb {
 

@@ -11,7 +11,7 @@
 
 #include "core/error.h"
 #include "evaluation/image_metrics.h"
-#include "pipeline/output_folder.h"
+#include "formats/output_folder.h"
 #include "scene/scene.h"
 
 namespace sb {

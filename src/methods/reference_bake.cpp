@@ -4,7 +4,7 @@
 // says why), per colour channel with w scaled by the light's texture at the sample, its
 // unoccluded irradiance H0 is exact (for a textured light, see Light::unoccluded_irradiance),
 // and H = H0 · V. A sky is estimated as itself, not as its parts: rays over the whole sky
-// (occluders/sky_rays.h), its H0 and V from the same directions, added as its first part's.
+// (methods/sky_rays.h), its H0 and V from the same directions, added as its first part's.
 // Parallel over texels with
 // oneTBB; each texel has its own random stream, so the result is the same for any thread count.
 #include "methods/reference_bake.h"
@@ -14,8 +14,8 @@
 
 #include <optional>
 
+#include "methods/sky_rays.h"
 #include "occluders/shadow_rays.h"
-#include "occluders/sky_rays.h"
 
 namespace sb {
 

@@ -10,7 +10,7 @@
 
 #include "core/geometry.h"
 #include "methods/baselines.h"
-#include "occluders/virtual_configuration.h"
+#include "occluders/projection_frame.h"
 #include "scene/mesh.h"
 
 namespace sb {

@@ -3,13 +3,13 @@
 // that keeps blocker geometry away from the light's centre before it is projected from there:
 // the blocker image (methods/convolution/blocker_image.cpp) keeps a slab near <= depth <= far,
 // the shadow map (methods/shadow_map.cpp) keeps depth >= near. It sits in occluders beside
-// virtual_configuration.h, whose frame defines the depth, so both methods may include it.
+// projection_frame.h, whose frame defines the depth, so both methods may include it.
 #pragma once
 
 #include <vector>
 
 #include "core/geometry.h"
-#include "occluders/virtual_configuration.h"
+#include "occluders/projection_frame.h"
 
 namespace sb {
 

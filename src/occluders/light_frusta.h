@@ -4,7 +4,7 @@
 // kMaxFrustumHalfAngleDeg of its axis; otherwise (a light beside or among its receiver) the six
 // faces of a cube around the light do, each point going to the face of its dominant direction.
 // The convolution planner (methods/convolution/plan_frames.cpp) and the shadow maps
-// (methods/shadow_map.cpp) split alike. It sits in occluders beside virtual_configuration.h,
+// (methods/shadow_map.cpp) split alike. It sits in occluders beside projection_frame.h,
 // whose frames it makes, so both methods may include it.
 #pragma once
 
@@ -12,7 +12,7 @@
 #include <optional>
 
 #include "core/geometry.h"
-#include "occluders/virtual_configuration.h"
+#include "occluders/projection_frame.h"
 
 namespace sb {
 

@@ -2,14 +2,14 @@
 // coordinates, of points seen from the frame's origin (their central projections onto the plane
 // at unit depth). The convolution planner bounds receiver texels, blocker polygons and convex
 // hulls with it; the shadow map sizes its square frustum by it. It sits in occluders beside
-// virtual_configuration.h, which defines the tangent coordinates, so both methods may include it.
+// projection_frame.h, which defines the tangent coordinates, so both methods may include it.
 #pragma once
 
 #include <limits>
 #include <vector>
 
 #include "core/geometry.h"
-#include "occluders/virtual_configuration.h"
+#include "occluders/projection_frame.h"
 
 namespace sb {
 

@@ -1,6 +1,6 @@
 // Incremental bakes (docs/cli.md, "Incremental bakes"): every bake keeps each receiver's raw
 // result in its output folder's cache (kCacheFolder: the receiver's metadata and key as JSON, its
-// arrays as the shards' binary file, pipeline/shard_files.h), and a later bake into that folder
+// arrays as the shards' binary file, formats/shard_files.h), and a later bake into that folder
 // takes a receiver from there instead of baking it when its key is unchanged.
 //
 // A receiver's key is four hashes (XXH3-128) of what can change its result:
@@ -26,8 +26,8 @@
 #include <vector>
 
 #include "core/error.h"
+#include "formats/output_folder.h"
 #include "pipeline/bake_types.h"
-#include "pipeline/output_folder.h"
 #include "scene/lights.h"
 #include "scene/mesh.h"
 

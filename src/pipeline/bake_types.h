@@ -13,9 +13,9 @@
 
 #include "core/image.h"
 #include "core/tiled_images.h"
+#include "formats/receiver_record.h"
 #include "lightmaps/gltf_export.h"
 #include "methods/method.h"
-#include "pipeline/receiver_record.h"
 #include "texels/atlas_packing.h"
 #include "texels/seams.h"
 #include "texels/texel_space.h"

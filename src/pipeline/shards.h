@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "core/error.h"
+#include "formats/output_folder.h"
 #include "pipeline/bake_types.h"
-#include "pipeline/output_folder.h"
 #include "scene/scene.h"
 
 namespace sb {

@@ -8,7 +8,7 @@
 //    triangle seen from the scene covers its patch's solid angle exactly (to the scene's size
 //    over the sky's distance), so the parts tile the sphere, a uniform sky is exact whatever the
 //    number of parts, and a map is approximated only by its mean over each patch;
-//  - rays over the sky itself (occluders/sky_rays.h): the reference's, sampling the map's own
+//  - rays over the sky itself (methods/sky_rays.h): the reference's, sampling the map's own
 //    pixels by their flux (and the cosine), no patches.
 #pragma once
 

@@ -15,7 +15,7 @@
 
 #include "methods/convolution/pair_report.h"
 #include "pipeline/bake.h"
-#include "pipeline/outputs.h"
+#include "formats/outputs.h"
 
 namespace sb {
 namespace {

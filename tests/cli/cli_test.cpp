@@ -13,7 +13,7 @@
 #include <thread>
 
 #include "core/image_io.h"
-#include "pipeline/manifest.h"
+#include "formats/manifest.h"
 
 namespace fs = std::filesystem;
 

@@ -16,7 +16,7 @@
 
 #include "core/image_io.h"
 #include "evaluation/report.h"
-#include "pipeline/manifest.h"
+#include "formats/manifest.h"
 
 namespace fs = std::filesystem;
 

@@ -23,7 +23,7 @@
 #include <thread>
 #include <vector>
 
-#include "pipeline/manifest.h"
+#include "formats/manifest.h"
 
 namespace {
 

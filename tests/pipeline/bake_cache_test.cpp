@@ -16,8 +16,8 @@
 #include <map>
 #include <sstream>
 
-#include "pipeline/manifest.h"
-#include "pipeline/outputs.h"
+#include "formats/manifest.h"
+#include "formats/outputs.h"
 #include "scene/scene.h"
 
 namespace sb {

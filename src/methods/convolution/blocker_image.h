@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "core/geometry.h"
-#include "occluders/virtual_configuration.h"
+#include "methods/convolution/virtual_configuration.h"
 #include "scene/mesh.h"
 
 namespace sb {

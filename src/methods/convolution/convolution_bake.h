@@ -7,7 +7,7 @@
 
 #include "methods/convolution/convolution_plan.h"
 #include "methods/convolution/pair_report.h"
-#include "occluders/virtual_configuration.h"
+#include "methods/convolution/virtual_configuration.h"
 #include "scene/lights.h"
 #include "scene/mesh.h"
 #include "texels/texel_space.h"

@@ -5,7 +5,7 @@
 #include <array>
 #include <vector>
 
-#include "occluders/virtual_configuration.h"
+#include "methods/convolution/virtual_configuration.h"
 #include "scene/lights.h"
 
 namespace sb {

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "core/geometry.h"
+#include "methods/convolution/virtual_configuration.h"
 #include "occluders/tangent_bounds.h"
-#include "occluders/virtual_configuration.h"
 
 namespace sb {
 

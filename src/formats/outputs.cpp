@@ -1,6 +1,6 @@
 // The bake's files (outputs.h): per sheet — a receiver, or an atlas of receivers — its lightmap,
 // preview, coverage, per-light images and shadow mask, then the glTF and the manifest.
-#include "pipeline/outputs.h"
+#include "formats/outputs.h"
 
 #include <fmt/format.h>
 
@@ -14,12 +14,12 @@
 #include <vector>
 
 #include "core/image_io.h"
+#include "formats/manifest.h"
 #include "lightmaps/atlas_images.h"
 #include "lightmaps/encodings.h"
 #include "lightmaps/gltf_export.h"
 #include "lightmaps/shadowmask.h"
 #include "pipeline/bake_cache.h"
-#include "pipeline/manifest.h"
 
 namespace sb {
 

@@ -6,23 +6,12 @@
 // receiver point at depth r (along D), the penumbra on the receiver is L·(r − d)/d = L·(ρ − 1)
 // with ρ = r/d, so one pair of planes, which fixes one ρ*, gets every penumbra width wrong by
 // L·|ρ − ρ*|; the middle of ρ's range halves the worst case.
-#include "occluders/virtual_configuration.h"
+#include "methods/convolution/virtual_configuration.h"
 
 #include <algorithm>
 #include <cmath>
 
 namespace sb {
-
-ProjectionFrame frame_towards(const Vec3& origin, const Vec3& target) {
-  ProjectionFrame f;
-  f.origin = origin;
-  const Vec3 d = target - origin;
-  f.axis = d.norm() > 0 ? Vec3(d.normalized()) : Vec3(Vec3::UnitZ());
-  const Vec3 helper = std::abs(f.axis.z()) < 0.9 ? Vec3::UnitZ() : Vec3::UnitX();
-  f.e1 = helper.cross(f.axis).normalized();
-  f.e2 = f.axis.cross(f.e1);
-  return f;
-}
 
 VirtualConfiguration choose_configuration(const ProjectionFrame& frame, const DepthRange& blockers,
                                           const DepthRange& receiver, double light_extent) {

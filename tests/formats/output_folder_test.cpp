@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/output_folder.h"
+#include "formats/output_folder.h"
 
 namespace sb {
 namespace {

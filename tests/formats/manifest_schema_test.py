@@ -3,7 +3,7 @@
 valid, every file it names exists, and manifests broken on purpose are refused (so the schema can
 fail). Run by CTest (ManifestSchema.RealBakesValidate) with Debian's python3 and python3-jsonschema:
 
-    /usr/bin/python3 tests/pipeline/manifest_schema_test.py build/shadowbake
+    /usr/bin/python3 tests/formats/manifest_schema_test.py build/shadowbake
 """
 
 import copy

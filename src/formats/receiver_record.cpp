@@ -1,5 +1,5 @@
 // A receiver's record as JSON (receiver_record.h).
-#include "pipeline/receiver_record.h"
+#include "formats/receiver_record.h"
 
 namespace sb {
 

@@ -1,9 +1,9 @@
 // A shard's receivers on disk (shard_files.h).
-#include "pipeline/shard_files.h"
+#include "formats/shard_files.h"
 
+#include "formats/json_fields.h"
+#include "formats/receiver_record.h"
 #include "methods/light_mix.h"
-#include "pipeline/json_fields.h"
-#include "pipeline/receiver_record.h"
 
 #include <fmt/format.h>
 #include <xxhash.h>

@@ -1,7 +1,7 @@
-// manifest.json's schema (pipeline/manifest.h): what is written reads back the same, keys keep
+// manifest.json's schema (formats/manifest.h): what is written reads back the same, keys keep
 // the order the file has always listed them in, and a file that is not a whole manifest is
 // refused with a line naming the file and the key.
-#include "pipeline/manifest.h"
+#include "formats/manifest.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

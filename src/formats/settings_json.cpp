@@ -1,6 +1,8 @@
 // Settings to and from JSON (settings_json.h). Doubles round-trip exactly: nlohmann-json writes
 // the shortest representation that reads back to the same bits.
-#include "pipeline/settings_json.h"
+#include "formats/settings_json.h"
+
+#include "methods/method.h"
 
 #include <initializer_list>
 #include <optional>
@@ -103,7 +105,7 @@ Status settings_from_json(const json& j, const std::string& where, BakeSettings&
   for (const SettingSpec& spec : method_setting_specs()) {
     SettingValue v = spec.fallback;
     std::visit([&](auto& value) { r.read(spec.key.c_str(), value); }, v);
-    if (status) b.set(spec.key, std::move(v));
+    if (status) set_setting(b, spec.key, std::move(v));
   }
   Reader out(j["output"], where, status);
   const std::initializer_list<Encoding> encodings = {Encoding::linear_exr, Encoding::half_exr,

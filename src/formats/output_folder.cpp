@@ -10,7 +10,7 @@
 // - Signals: the handler may run on any thread, so a state word decides between "remove the
 //   staging folder and die" and "publishing: let the renames finish"; the removal uses only
 //   system calls (open, getdents64, unlinkat, rmdir), which are async-signal-safe.
-#include "pipeline/output_folder.h"
+#include "formats/output_folder.h"
 
 #include <dirent.h>
 #include <fcntl.h>

@@ -1,4 +1,4 @@
-// Tests of the files a bake writes for engines (src/pipeline/outputs.h), on the hall of the
+// Tests of the files a bake writes for engines (src/formats/outputs.h), on the hall of the
 // corpus: each light's own file is that light alone; six lights that meet fill a shadow mask's
 // four channels, the same way on every run, and the two left out are named; 26 receivers pack
 // into at most two 2048² atlases where no bilinear filter on one receiver's triangles reads
@@ -16,8 +16,8 @@
 #include "core/image_io.h"
 #include "lightmaps/encodings.h"
 #include "pipeline/bake.h"
-#include "pipeline/manifest.h"
-#include "pipeline/outputs.h"
+#include "formats/manifest.h"
+#include "formats/outputs.h"
 #include "pipeline/receiver_stages.h"
 #include "scene/mesh.h"
 

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "core/error.h"
+#include "formats/receiver_record.h"
 #include "methods/method.h"
-#include "pipeline/receiver_record.h"
 #include "scene/scene.h"
 
 namespace sb {

@@ -1,10 +1,10 @@
 // manifest.json to and from its schema (manifest.h). Reading checks every key's presence and
 // type, so that a reader meets either a whole manifest or a one-line error naming the key.
-#include "pipeline/manifest.h"
+#include "formats/manifest.h"
 
+#include "formats/json_fields.h"
+#include "formats/receiver_record.h"
 #include "lightmaps/shadowmask.h"
-#include "pipeline/json_fields.h"
-#include "pipeline/receiver_record.h"
 
 #include <fstream>
 #include <limits>

@@ -10,7 +10,7 @@
 
 #include <cstdint>
 
-#include "pipeline/json_fields.h"
+#include "formats/json_fields.h"
 #include "texels/seams.h"
 #include "texels/uv_checks.h"
 

@@ -1,7 +1,7 @@
-// Tests of a receiver's record on disk (src/pipeline/receiver_record.h, shard_files.h): the
+// Tests of a receiver's record on disk (src/formats/receiver_record.h, shard_files.h): the
 // manifest and the shard files (and so the cache) write it alike, keep every field through a
 // write and a read, and name a missing field.
-#include "pipeline/receiver_record.h"
+#include "formats/receiver_record.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -10,8 +10,8 @@
 #include <fstream>
 #include <string>
 
-#include "pipeline/manifest.h"
-#include "pipeline/shard_files.h"
+#include "formats/manifest.h"
+#include "formats/shard_files.h"
 
 namespace sb {
 namespace {
