@@ -8,32 +8,13 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/error.h"
+#include "methods/backprojection/backprojection_settings.h"
 #include "methods/backprojection/texel_refinement.h"
 #include "methods/backprojection/texel_routes.h"
 #include "methods/light_mix.h"
-#include "occluders/ray_scene.h"
-#include "occluders/shaft_culling.h"
-#include "scene/lights.h"
 #include "texels/texel_space.h"
 
 namespace sb {
-
-struct BackprojectionInputs {
-  const std::vector<Light>* lights = nullptr;
-  const ShaftCuller* culler = nullptr;
-  const RayScene* rays = nullptr;  // the surface offset; the traced routes' rays
-  Quantity quantity = Quantity::visibility;
-  int light_rows = 32;     // rows of cells across each light (PenumbraEstimator)
-  int max_polygons = 256;  // a shaft with more blocker polygons is traced instead of listed
-  RefinementSettings refinement;
-  // A textured light's traced texels: the reference's estimate, its samples and streams.
-  int samples = 256;
-  std::uint64_t seed = 0, stream = 0;
-  KeepPerLight keep_per_light;
-  // Which lights may reach each block of texels (light_lists.h); null: the bake makes them.
-  const LightLists* lists = nullptr;
-};
 
 // (light, texel) pairs by route (texel_routes.h), and the rays traced.
 struct RouteCounts {

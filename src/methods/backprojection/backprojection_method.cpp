@@ -44,24 +44,31 @@ void summarise_routes(MethodReport& report) {
   report.explain = explain + "\n";
 }
 
+// The method's settings from the [bake] table, read once per bake.
+BackprojectionSettings backprojection_settings(const BakeSettings& bake) {
+  BackprojectionSettings s;
+  s.quantity = bake.quantity;
+  s.light_rows = int(setting_whole(bake, "light_rows"));
+  s.max_polygons = int(setting_whole(bake, "max_polygons"));
+  s.refinement.max_cell = int(setting_whole(bake, "max_cell"));
+  s.refinement.tolerance = setting_number(bake, "interpolation_tolerance");
+  s.refinement.midpoint_cells = setting_number(bake, "midpoint_cells");
+  s.samples = bake.samples;
+  s.seed = bake.seed;
+  return s;
+}
+
 class BackprojectionMethod final : public Method {
  public:
-  explicit BackprojectionMethod(const BakeContext& context) : context_(context) {}
+  explicit BackprojectionMethod(const BakeContext& context)
+      : context_(context), settings_(backprojection_settings(context.scene->bake)) {}
 
   Expected<MethodResult> bake(const ReceiverInput& receiver) override {
-    const BakeSettings& settings = context_.scene->bake;
     BackprojectionInputs in;
+    static_cast<BackprojectionSettings&>(in) = settings_;
     in.lights = context_.lights;
     in.culler = context_.shafts;
     in.rays = context_.rays;
-    in.quantity = settings.quantity;
-    in.light_rows = int(settings.whole("light_rows"));
-    in.max_polygons = int(settings.whole("max_polygons"));
-    in.refinement.max_cell = int(settings.whole("max_cell"));
-    in.refinement.tolerance = settings.number("interpolation_tolerance");
-    in.refinement.midpoint_cells = settings.number("midpoint_cells");
-    in.samples = settings.samples;
-    in.seed = settings.seed;
     in.stream = receiver.stream;
     in.keep_per_light = context_.keep_per_light;
     in.lists = receiver.lists;
@@ -80,12 +87,13 @@ class BackprojectionMethod final : public Method {
 
  private:
   BakeContext context_;
+  BackprojectionSettings settings_;
 };
 
 }  // namespace
 
 MethodEntry backprojection_method() {
-  const BackprojectionInputs defaults;  // the defaults of every key but samples and seed
+  const BackprojectionSettings defaults;  // the defaults of its own keys
   MethodEntry e;
   e.name = "backprojection";
   e.settings = {"samples", "seed"};

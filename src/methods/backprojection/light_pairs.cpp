@@ -14,6 +14,7 @@
 
 #include "methods/backprojection/penumbra_estimator.h"
 #include "methods/backprojection/piercing_blockers.h"
+#include "methods/backprojection/tile_blockers.h"
 #include "methods/backprojection/tile_shafts.h"
 #include "methods/backprojection/umbra_proofs.h"
 #include "occluders/blocker_solids.h"
@@ -23,209 +24,8 @@ namespace sb {
 
 namespace {
 
-// A dense mesh's triangles in a tile's list are taken through their outline from this many on
-// (fewer, each exact interval beats cells).
-constexpr std::size_t kOutlineTriangles = 32;
 // A texel whose patch lists more polygons than this first tries the ray to the light's centre.
 constexpr std::size_t kRayFirst = 8;
-
-// A listed tile's blockers as its texels' evaluations take them: triangles one by one, and the
-// convex solids its texels all lie outside of whole, each with the edges that may be on its
-// silhouette from some point of the tile (between faces that do not face the same way from all
-// of it) and a lower bound on the tile's distance to it.
-struct TileBlockers {
-  std::vector<BlockerPolygon> polygons;
-  std::vector<BlockerOutline> outlines;
-  std::vector<BlockerSolidRef> solids;
-  std::vector<std::vector<int>> edges;             // per solid
-  std::vector<std::vector<BlockerPolygon>> faces;  // per solid: its candidate triangles
-  std::vector<std::vector<int>> cut_faces;         // per solid: faces across the slab's planes
-};
-
-// The solid's edges that may lie on its silhouette from some point of the box `origins`: those
-// between faces that do not face the same way from all of it.
-std::vector<int> edges_on_some_silhouette(const BlockerSolid& solid, const Bounds3& origins) {
-  const Vec3 centre = origins.centre(), half = 0.5 * (origins.hi - origins.lo);
-  // Each face's side of the whole box: 1 facing it from all of it, -1 from none, 0 mixed.
-  std::vector<std::int8_t> side(solid.faces.size());
-  for (std::size_t f = 0; f < solid.faces.size(); ++f) {
-    const Vec3& n = solid.normals[f];
-    const double mid = n.dot(centre - solid.corners[std::size_t(solid.faces[f][0])]);
-    const double spread = half.dot(n.cwiseAbs());
-    side[f] = mid - spread > 0 ? 1 : mid + spread < 0 ? -1 : 0;
-  }
-  std::vector<int> edges;
-  for (std::size_t e = 0; e < solid.edges.size(); ++e) {
-    const std::int8_t a = side[std::size_t(solid.edges[e][2])];
-    const std::int8_t b = side[std::size_t(solid.edges[e][3])];
-    if (a == 0 || b == 0 || a != b) edges.push_back(int(e));
-  }
-  return edges;
-}
-
-// The solid's faces that may cross the light's plane (at the rays' offset) or the height of some
-// origin of the box `origins`: those that cut the outline of the solid's part in a texel's slab.
-std::vector<int> faces_across_slab(const Light& light, const BlockerSolid& solid,
-                                   const Bounds3& origins, double offset) {
-  std::vector<int> cuts;
-  double h_lo = std::numeric_limits<double>::infinity(), h_hi = -h_lo;
-  for (int c = 0; c < 8; ++c) {
-    const Vec3 p = origins.corner(c);
-    const double h = light.normal().dot(p - light.centre());
-    h_lo = std::min(h_lo, h * (1 - 1e-9)), h_hi = std::max(h_hi, h);
-  }
-  for (std::size_t f = 0; f < solid.faces.size(); ++f) {
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (int j = 0; j < 3; ++j) {
-      const double h = light.normal().dot(
-          solid.corners[std::size_t(solid.faces[f][std::size_t(j)])] - light.centre());
-      lo = std::min(lo, h), hi = std::max(hi, h);
-    }
-    if ((lo < offset && hi > offset) || (lo < h_hi && hi > h_lo)) cuts.push_back(int(f));
-  }
-  return cuts;
-}
-
-// The parts of a triangle that pierces the light's ball (piercing_blockers.h) as polygons, each
-// its own umbra (a part alone is convex; the triangle's parts together are not), reported as
-// `key`.
-void add_parts(const PiercingBlockers& piercing, std::uint32_t triangle, std::uint32_t key,
-               const Vec3& normal, std::vector<BlockerPolygon>& out) {
-  const auto parts = piercing.parts_of(triangle);
-  for (const std::array<Vec3, 3>& part : parts)
-    out.push_back({part.data(), 3, normal, key,
-                   PiercingBlockers::kPartUmbra | std::uint32_t(&part - piercing.parts.data())});
-}
-
-TileBlockers tile_blockers(const ShaftCuller& culler, const Light& light,
-                           const std::vector<std::uint32_t>& candidates, const Bounds3& origins,
-                           double offset, const PiercingBlockers& piercing) {
-  TileBlockers out;
-  const Vec3 centre = origins.centre(), half = 0.5 * (origins.hi - origins.lo);
-  // Each convex solid among the candidates once, with how far the whole tile lies in front of
-  // its farthest face plane: a lower bound on its distance to the solid, positive where every
-  // texel lies outside it.
-  std::vector<std::uint32_t> keys;
-  std::vector<double> distances;
-  for (std::uint32_t i : candidates) {
-    const std::uint32_t key = culler.blocker_key(i);
-    if (!(key & ShaftCuller::kSolidKey) || std::find(keys.begin(), keys.end(), key) != keys.end())
-      continue;
-    const BlockerSolid& solid = culler.solid_of_key(key);
-    double distance = -std::numeric_limits<double>::infinity();
-    for (std::size_t k = 0; k < solid.faces.size(); ++k) {
-      const Vec3& n = solid.normals[k];
-      distance = std::max(distance, n.dot(centre - solid.corners[std::size_t(solid.faces[k][0])]) -
-                                        half.dot(n.cwiseAbs()));
-    }
-    keys.push_back(key);
-    distances.push_back(distance);
-  }
-  // A solid the tile's texels lie outside of (by more than the rays' offset) is taken whole;
-  // the texels on or in one (its own surface, a floor under a box) take its triangles one by one.
-  // So do a dense mesh's triangles, but through the outline of their union where the tile holds
-  // enough of them for that to pay.
-  std::vector<std::uint8_t> whole(keys.size());
-  for (std::size_t k = 0; k < keys.size(); ++k) whole[k] = distances[k] > offset;
-  // A triangle through the light's ball goes as its parts outside it, and its solid, if any, as
-  // triangles.
-  for (std::uint32_t i : candidates) {
-    if (!piercing.pierces(i)) continue;
-    const auto at = std::find(keys.begin(), keys.end(), culler.blocker_key(i));
-    if (at != keys.end()) whole[std::size_t(at - keys.begin())] = 0;
-  }
-  std::vector<std::uint32_t> dense;  // dense meshes' keys, in order of first candidate
-  std::vector<std::vector<std::uint32_t>> dense_triangles;
-  for (std::uint32_t i : candidates) {
-    const std::uint32_t key = culler.blocker_key(i);
-    if (piercing.pierces(i)) {
-      add_parts(piercing, i, key, culler.triangle_normal(i), out.polygons);
-      continue;
-    }
-    if (key & ShaftCuller::kMeshKey) {
-      auto at = std::find(dense.begin(), dense.end(), key);
-      if (at == dense.end()) {
-        dense.push_back(key);
-        dense_triangles.emplace_back();
-        at = dense.end() - 1;
-      }
-      dense_triangles[std::size_t(at - dense.begin())].push_back(i);
-      continue;
-    }
-    const auto at = std::find(keys.begin(), keys.end(), key);
-    if (at == keys.end() || !whole[std::size_t(at - keys.begin())])
-      out.polygons.push_back({culler.triangle_corners(i), 3, culler.triangle_normal(i), key});
-  }
-  for (std::size_t k = 0; k < dense.size(); ++k) {
-    std::vector<std::uint32_t>& list = dense_triangles[k];
-    // A sphere light's outline is made anew per texel (penumbra_estimator.h): it pays where the
-    // mesh's triangles are small beside the tile (a knot's), not where they are as large as a
-    // level's walls and floors (OpenArena's oacmpctf3: the evaluations took 11 % longer so).
-    double sizes = 0;
-    if (light.shape() == LightShape::sphere)
-      for (std::uint32_t i : list) sizes += culler.triangle_bounds(i).diagonal();
-    const bool large = sizes > double(list.size()) * origins.diagonal();
-    if (list.size() < kOutlineTriangles || large) {
-      for (std::uint32_t i : list)
-        out.polygons.push_back(
-            {culler.triangle_corners(i), 3, culler.triangle_normal(i), dense[k], i});
-      continue;
-    }
-    out.outlines.push_back(prepare_outline(culler, light, list, dense[k], origins, offset));
-  }
-  // A whole solid that reaches past the light's plane or below the tile's origins (a wall up to
-  // the ceiling a panel hangs from, a ball resting on the floor) has no silhouette every texel
-  // can take: with many faces in the tile, they go through the outline of their union instead.
-  double h_top = std::numeric_limits<double>::infinity();
-  for (int c = 0; c < 8; ++c) {
-    const Vec3 p = origins.corner(c);
-    h_top = std::min(h_top, light.normal().dot(p - light.centre()) * (1 - 1e-9));
-  }
-  const auto within_slab = [&](const Bounds3& b) {
-    if (light.shape() == LightShape::sphere) return true;  // decided per texel
-    for (int c = 0; c < 8; ++c) {
-      const Vec3 p = b.corner(c);
-      const double height = light.normal().dot(p - light.centre());
-      if (height < offset || height > h_top) return false;
-    }
-    return true;
-  };
-  for (std::size_t k = 0; k < keys.size(); ++k) {
-    if (!whole[k]) continue;
-    const BlockerSolid& solid = culler.solid_of_key(keys[k]);
-    if (!within_slab(solid.bounds)) {
-      std::vector<std::uint32_t> faces;
-      for (std::uint32_t i : candidates)
-        if (culler.blocker_key(i) == keys[k]) faces.push_back(i);
-      if (faces.size() >= kOutlineTriangles) {
-        out.outlines.push_back(prepare_outline(culler, light, faces, keys[k], origins, offset));
-        continue;
-      }
-    }
-    out.edges.push_back(edges_on_some_silhouette(solid, origins));
-    out.cut_faces.push_back(light.shape() != LightShape::sphere
-                                ? faces_across_slab(light, solid, origins, offset)
-                                : std::vector<int>());
-    std::vector<BlockerPolygon> faces;
-    for (std::uint32_t i : candidates)
-      if (culler.blocker_key(i) == keys[k])
-        faces.push_back({culler.triangle_corners(i), 3, culler.triangle_normal(i), i});
-    // (A whole solid has no triangle through the ball: see above.)
-    out.faces.push_back(std::move(faces));
-    out.solids.push_back({&solid, keys[k], nullptr, 0, distances[k]});
-  }
-  for (std::size_t k = 0; k < out.solids.size(); ++k) {
-    out.solids[k].edges = out.edges[k].data();
-    out.solids[k].edge_count = int(out.edges[k].size());
-    out.solids[k].faces = out.faces[k].data();
-    out.solids[k].face_count = int(out.faces[k].size());
-    if (light.shape() != LightShape::sphere) {
-      out.solids[k].cut_faces = out.cut_faces[k].data();
-      out.solids[k].cut_count = int(out.cut_faces[k].size());
-    }
-  }
-  return out;
-}
 
 // Stage 2's exact evaluations of one uniform light (texel_refinement.h's PairSource).
 // A light whose form factor at a texel is below this shows it a sliver at its horizon.
@@ -298,36 +98,7 @@ class LightPairs final : public PairSource {
     out = PairSample();
     const double form_factor = light_.form_factor(p, n);
     if (!(form_factor > 0)) return;
-    // A sliver of light at the texel's horizon (F below 1e-8: a texel on an edge, or near a
-    // curved blocker's terminator): whether geometry within a hair of the ray origin hides it
-    // is the rays' call, so the texel takes the reference's own estimate, as a texel whose
-    // visible part is too thin for the estimator's rows does.
-    const auto sliver = [&] {
-      // One batch per thread, grown to the bake's samples (an earlier bake may have had fewer).
-      thread_local ShadowRays batch(0);
-      if (batch.capacity() < in_.samples) batch = ShadowRays(in_.samples);
-      thread_local std::vector<Vec2> strata;
-      Vec3 v;
-      out = PairSample();
-      if (!estimate_visibility(space_, t, light_, *in_.rays, in_.samples, in_.seed, in_.stream,
-                               batch, strata, &v))
-        return;
-      out.route = TexelRoute::traced;
-      out.visibility = float(v.x());
-      // Nothing listed, as nothing hides the sliver, or a blocker at an unknown distance.
-      out.nearest = v.x() == 1 ? std::numeric_limits<float>::infinity() : 0.0f;
-    };
-    if (form_factor < kSliver) return sliver();
-    // The rows' fixed points traced (PenumbraEstimator::visibility_traced).
-    const auto traced = [&] {
-      const PenumbraSample sample =
-          estimator_.visibility_traced(p, n, origin, *in_.rays, form_factor);
-      if (!sample.contributes) return sliver();
-      out.route = TexelRoute::traced;
-      out.listed = false;
-      out.visibility = float(sample.visibility);
-      out.nearest = float(sample.nearest_blocker);
-    };
+    if (form_factor < kSliver) return sliver(t, out);
     // A sphere light seen from a ray origin lifted far from the texel (a coarse mesh's smooth
     // surface): the reference aims its rays from the origin at the sphere's near side as the
     // texel sees it, which the origin sees shifted by parallax, where the rows see the
@@ -347,64 +118,14 @@ class LightPairs final : public PairSource {
         return;
       }
     }
-    // The light's centre first, where the texel's blockers are many (not listed, a dense mesh's
-    // outline, or more polygons than kRayFirst) or are to be traced: where the ray to it meets a
-    // triangle that hides all of the light alone, the texel lies in that triangle's umbra,
-    // exactly, whatever else its shaft holds. (A few polygons or convex solids cost the
-    // estimator less than the ray.)
     const std::int32_t at = prepared_of_[patch_index(tx.x, tx.y)];
-    const bool busy = parallax || at < 0 || !prepared_[std::size_t(at)].outlines.empty() ||
-                      prepared_[std::size_t(at)].polygons.size() > kRayFirst;
     bool centre_hidden = false;
-    if (const RayScene::Hit hit =
-            busy ? in_.rays->first_hit_face(origin, light_.centre() - origin, 1.0)
-                 : RayScene::Hit();
-        hit.face >= 0) {
-      centre_hidden = true;
-      const std::uint32_t triangle = in_.culler->triangle_of_face(hit.face);
-      if (triangle_hides_light(light_, in_.culler->triangle_corners(triangle), origin, offset_)) {
-        out.route = TexelRoute::umbra;
-        out.visibility = 0;
-        out.nearest = 0;  // the shaft is not listed: nearer blockers are unknown
-        const std::uint32_t key = in_.culler->blocker_key(triangle);
-        out.triangles.assign(1, key);
-        // A convex solid's face: the solid's umbra, which holds the face's (and is convex), so
-        // that samples behind different faces of one box lie in one umbra.
-        out.umbra = key & ShaftCuller::kSolidKey ? key : triangle;
-        return;
-      }
-    }
-    if (parallax) return traced();
-    // The blockers: the tile's candidates as they are (the estimator cuts what lies beyond the
-    // light or behind the origin, and ignores what projects outside the light), or, for a tile
-    // without a list, the texel's own shaft's polygons from the whole hierarchy.
-    thread_local std::vector<BlockerPolygon> blockers;
-    thread_local std::vector<ShaftPolygon> polygons;
-    blockers.clear();
+    if (centre_umbra(origin, at, parallax, centre_hidden, out)) return;
+    if (parallax) return traced(t, p, n, origin, form_factor, out);
     PenumbraSample sample;
-    if (at >= 0) {
-      const TileBlockers& prepared = prepared_[std::size_t(at)];
-      sample = estimator_.visibility(
-          p, n, origin,
-          Blockers{&prepared.polygons, &prepared.solids, &prepared.outlines, centre_hidden},
-          form_factor, &out.triangles);
-    } else {
-      const ShaftCuller::Polygons listed = in_.culler->shaft_polygons(
-          origin, p, n, light_, nullptr, std::size_t(in_.max_polygons), polygons);
-      if (listed == ShaftCuller::Polygons::too_many) return traced();
-      // The union of what samples see is kept by key (a solid's triangles as the solid); a
-      // triangle through the light's ball goes as its parts outside it.
-      for (const ShaftPolygon& poly : polygons) {
-        const std::uint32_t key = in_.culler->blocker_key(poly.triangle);
-        if (piercing_.pierces(poly.triangle))
-          add_parts(piercing_, poly.triangle, key, poly.normal, blockers);
-        else
-          blockers.push_back({poly.v.data(), poly.count, poly.normal, key, poly.triangle});
-      }
-      sample = estimator_.visibility(p, n, origin, Blockers{&blockers, nullptr, nullptr},
-                                     form_factor, &out.triangles);
-    }
-    if (!sample.contributes) return sliver();  // no rows above the horizon: a sliver
+    if (!estimate(p, n, origin, at, centre_hidden, form_factor, sample, out))
+      return traced(t, p, n, origin, form_factor, out);
+    if (!sample.contributes) return sliver(t, out);  // no rows above the horizon: a sliver
     // Nothing hid any of the light: exactly 1, as a clear shaft.
     out.route = out.triangles.empty() ? TexelRoute::clear : TexelRoute::exact;
     out.visibility = float(sample.visibility);
@@ -559,6 +280,106 @@ class LightPairs final : public PairSource {
   }
 
  private:
+  // A sliver of light at the texel's horizon (F below 1e-8: a texel on an edge, or near a
+  // curved blocker's terminator): whether geometry within a hair of the ray origin hides it is
+  // the rays' call, so the texel takes the reference's own estimate, as a texel whose visible
+  // part is too thin for the estimator's rows does.
+  void sliver(std::size_t t, PairSample& out) const {
+    // One batch per thread, grown to the bake's samples (an earlier bake may have had fewer).
+    thread_local ShadowRays batch(0);
+    if (batch.capacity() < in_.samples) batch = ShadowRays(in_.samples);
+    thread_local std::vector<Vec2> strata;
+    Vec3 v;
+    out = PairSample();
+    if (!estimate_visibility(space_, t, light_, *in_.rays, in_.samples, in_.seed, in_.stream, batch,
+                             strata, &v))
+      return;
+    out.route = TexelRoute::traced;
+    out.visibility = float(v.x());
+    // Nothing listed, as nothing hides the sliver, or a blocker at an unknown distance.
+    out.nearest = v.x() == 1 ? std::numeric_limits<float>::infinity() : 0.0f;
+  }
+
+  // The rows' fixed points traced (PenumbraEstimator::visibility_traced).
+  void traced(std::size_t t, const Vec3& p, const Vec3& n, const Vec3& origin, double form_factor,
+              PairSample& out) const {
+    const PenumbraSample sample =
+        estimator_.visibility_traced(p, n, origin, *in_.rays, form_factor);
+    if (!sample.contributes) return sliver(t, out);
+    out.route = TexelRoute::traced;
+    out.listed = false;
+    out.visibility = float(sample.visibility);
+    out.nearest = float(sample.nearest_blocker);
+  }
+
+  // Whether the ray to the light's centre settles the texel in one triangle's umbra (then `out`
+  // holds it); `centre_hidden`: whether that ray meets a blocker at all.
+  bool centre_umbra(const Vec3& origin, std::int32_t at, bool parallax, bool& centre_hidden,
+                    PairSample& out) const {
+    // The light's centre first, where the texel's blockers are many (not listed, a dense mesh's
+    // outline, or more polygons than kRayFirst) or are to be traced: where the ray to it meets a
+    // triangle that hides all of the light alone, the texel lies in that triangle's umbra,
+    // exactly, whatever else its shaft holds. (A few polygons or convex solids cost the
+    // estimator less than the ray.)
+    const bool busy = parallax || at < 0 || !prepared_[std::size_t(at)].outlines.empty() ||
+                      prepared_[std::size_t(at)].polygons.size() > kRayFirst;
+    if (const RayScene::Hit hit =
+            busy ? in_.rays->first_hit_face(origin, light_.centre() - origin, 1.0)
+                 : RayScene::Hit();
+        hit.face >= 0) {
+      centre_hidden = true;
+      const std::uint32_t triangle = in_.culler->triangle_of_face(hit.face);
+      if (triangle_hides_light(light_, in_.culler->triangle_corners(triangle), origin, offset_)) {
+        out.route = TexelRoute::umbra;
+        out.visibility = 0;
+        out.nearest = 0;  // the shaft is not listed: nearer blockers are unknown
+        const std::uint32_t key = in_.culler->blocker_key(triangle);
+        out.triangles.assign(1, key);
+        // A convex solid's face: the solid's umbra, which holds the face's (and is convex), so
+        // that samples behind different faces of one box lie in one umbra.
+        out.umbra = key & ShaftCuller::kSolidKey ? key : triangle;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  // The estimator's sample at the texel from its blockers; false where its shaft holds too many
+  // polygons to list (the caller traces instead).
+  bool estimate(const Vec3& p, const Vec3& n, const Vec3& origin, std::int32_t at,
+                bool centre_hidden, double form_factor, PenumbraSample& sample,
+                PairSample& out) const {
+    // The blockers: the tile's candidates as they are (the estimator cuts what lies beyond the
+    // light or behind the origin, and ignores what projects outside the light), or, for a tile
+    // without a list, the texel's own shaft's polygons from the whole hierarchy.
+    thread_local std::vector<BlockerPolygon> blockers;
+    thread_local std::vector<ShaftPolygon> polygons;
+    blockers.clear();
+    if (at >= 0) {
+      const TileBlockers& prepared = prepared_[std::size_t(at)];
+      sample = estimator_.visibility(
+          p, n, origin,
+          Blockers{&prepared.polygons, &prepared.solids, &prepared.outlines, centre_hidden},
+          form_factor, &out.triangles);
+    } else {
+      const ShaftCuller::Polygons listed = in_.culler->shaft_polygons(
+          origin, p, n, light_, nullptr, std::size_t(in_.max_polygons), polygons);
+      if (listed == ShaftCuller::Polygons::too_many) return false;
+      // The union of what samples see is kept by key (a solid's triangles as the solid); a
+      // triangle through the light's ball goes as its parts outside it.
+      for (const ShaftPolygon& poly : polygons) {
+        const std::uint32_t key = in_.culler->blocker_key(poly.triangle);
+        if (piercing_.pierces(poly.triangle))
+          add_parts(piercing_, poly.triangle, key, poly.normal, blockers);
+        else
+          blockers.push_back({poly.v.data(), poly.count, poly.normal, key, poly.triangle});
+      }
+      sample = estimator_.visibility(p, n, origin, Blockers{&blockers, nullptr, nullptr},
+                                     form_factor, &out.triangles);
+    }
+    return true;
+  }
+
   // Whether every one of the texels' ray origins lies on the convex solid `key` (or in it): in
   // front of none of its face planes by more than the rays' offset, four times over, or a
   // five-hundredth of its size (a curved surface's shadow origins lie on the smooth surface,

@@ -1,7 +1,7 @@
-// The back-projection estimator's working types (penumbra_estimator.cpp): a light seen from one
-// texel (its plane and turned frame), and what the blockers hide of each of its rows; and the
-// rasterisers that fill them (blocker_rasteriser.cpp: polygons and convex solids one by one;
-// outline_rasteriser.cpp: many triangles at once through the outline of their union).
+// The back-projection estimator's working types (penumbra_estimator.cpp): rows across a light,
+// a light seen from one texel (its plane and turned frame), and what the blockers hide of each of
+// its rows; and the rasterisers that fill them (blocker_rasteriser.cpp: polygons and convex solids
+// one by one; outline_rasteriser.cpp: many triangles at once through the outline of their union).
 #pragma once
 
 #include <algorithm>
@@ -12,9 +12,21 @@
 #include <vector>
 
 #include "core/geometry.h"
-#include "methods/backprojection/penumbra_estimator.h"
+#include "methods/backprojection/shaft_blockers.h"
 
 namespace sb {
+
+// Rows across (the visible part of) a light, in the light's turned frame (s across rows, t along
+// the frame): row r's centre line is t = first + r·pitch, and it crosses the light from `enter`
+// to `leave` (s). Metres, but for a sphere's own rows, which are those of the unit disk.
+struct LightRows {
+  static constexpr int kMaxRows = 64;
+  static constexpr int kCells = 64;  // a row falls back to cells (one bit each) past a few polygons
+  int count = 0;
+  double pitch = 0, first = 0;
+  bool whole = true;  // across the whole light; false: across the part above a texel's horizon
+  std::array<double, kMaxRows> enter, leave;  // rows [0, count) written
+};
 
 constexpr int kCells = LightRows::kCells;
 constexpr std::uint64_t kAllCells = ~std::uint64_t(0);
