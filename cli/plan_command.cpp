@@ -32,7 +32,7 @@ Runner add_plan_command(CLI::App& app) {
     auto scene = sb::load_scene(o->scene);
     if (!scene) return fail(scene.error());
     if (*resolution_opt) scene->bake.resolution = o->resolution;
-    if (*error_opt) scene->bake.set("error_texels", o->error_texels);
+    if (*error_opt) set_setting(scene->bake, "error_texels", o->error_texels);
     sb::BakeOptions options;
     options.threads = o->threads;
     scene->bake.method = "convolution";  // the plan `plan` shows (docs/cli.md)

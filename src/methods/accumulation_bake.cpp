@@ -95,7 +95,7 @@ MixedImages bake_accumulation(const TexelSpace& space, const BaselineInputs& in,
                               std::int64_t* rays_traced) {
   const auto& lights = *in.lights;
   const RayScene& rays = *in.rays;
-  const BakeSettings& settings = *in.settings;
+  const BaselineSettings& settings = in.settings;
   const int samples = std::max(1, settings.samples);
   const double offset = rays.surface_offset();
 

@@ -17,7 +17,8 @@ class BaselineMethod final : public Method {
  public:
   using Bake = std::function<MixedImages(const TexelSpace&, const BaselineInputs&, MethodStats*,
                                          std::int64_t*)>;
-  BaselineMethod(const BakeContext& context, Bake bake) : context_(context), bake_(bake) {}
+  BaselineMethod(const BakeContext& context, Bake bake)
+      : context_(context), settings_(baseline_settings(context.scene->bake)), bake_(bake) {}
 
   Expected<MethodResult> bake(const ReceiverInput& receiver) override {
     BaselineInputs in;
@@ -25,7 +26,7 @@ class BaselineMethod final : public Method {
     in.rays = context_.rays;
     in.blockers = context_.blockers;
     in.receiver = receiver.mesh;
-    in.settings = &context_.scene->bake;
+    in.settings = settings_;
     in.stream = receiver.stream;
     in.keep_per_light = context_.keep_per_light;
     MethodResult result;
@@ -35,15 +36,32 @@ class BaselineMethod final : public Method {
 
  private:
   BakeContext context_;
+  BaselineSettings settings_;
   Bake bake_;
 };
+
+}  // namespace
+
+BaselineSettings baseline_settings(const BakeSettings& bake) {
+  BaselineSettings s;
+  s.method = bake.method;
+  s.quantity = bake.quantity;
+  s.samples = bake.samples;
+  s.seed = bake.seed;
+  s.shadow_map = int(setting_whole(bake, "shadow_map"));
+  s.pcf_radius = setting_number(bake, "pcf_radius");
+  s.erosion_by_distance = setting_word(bake, "erosion_factor") == "distance";
+  return s;
+}
+
+namespace {
 
 // Shadow-map baselines hold a depth map (float) per light and cube face at shadow_map², and,
 // running light by light, every light's V per texel until the lights are mixed (LightMix).
 std::vector<MemoryItem> shadow_map_memory(const Scene& scene, double texels) {
   const BakeSettings& b = scene.bake;
   const double lights = double(scene.lights.size());
-  const double side = double(b.whole("shadow_map")), map = side * side * 4;
+  const double side = double(setting_whole(b, "shadow_map")), map = side * side * 4;
   return {{"shadow maps", map * lights * 6},
           {"per-light visibility", texels * lights * (sizeof(Vec3f) + 1)}};
 }

@@ -20,6 +20,18 @@
 
 namespace sb {
 
+// The baselines' settings, read once per bake from the [bake] table (baseline_settings).
+struct BaselineSettings {
+  std::string method = "pcf";  // the filter, for the shadow-map baselines
+  Quantity quantity = Quantity::visibility;
+  int samples = 256;  // accumulation's light samples; adaptive PCF's most taps
+  std::uint64_t seed = 0;
+  int shadow_map = 2048;             // texels per side of each shadow map
+  double pcf_radius = 2.0;           // PCF's footprint, shadow-map texels
+  bool erosion_by_distance = false;  // erosion's shadow factor: by distance, else by PCF
+};
+BaselineSettings baseline_settings(const BakeSettings& bake);
+
 struct BaselineInputs {
   const std::vector<Light>* lights = nullptr;
   // Every blocker, for ray-cast hard shadows: accumulation and erosion only (null for the
@@ -27,15 +39,15 @@ struct BaselineInputs {
   const RayScene* rays = nullptr;
   std::vector<const Mesh*> blockers;  // every blocker mesh, the receiver's own if it blocks
   const Mesh* receiver = nullptr;
-  const BakeSettings* settings = nullptr;  // method, quantity, samples, seed, shadow_map, ...
-  std::uint64_t stream = 0;                // the receiver's index, for its own random streams
-  KeepPerLight keep_per_light;             // per-light images wanted (MixedImages)
+  BaselineSettings settings;
+  std::uint64_t stream = 0;     // the receiver's index, for its own random streams
+  KeepPerLight keep_per_light;  // per-light images wanted (MixedImages)
 };
 
 // Each returns width × height RGB images like bake_reference, lights combined by LightMix.
 MixedImages bake_accumulation(const TexelSpace& space, const BaselineInputs& in, MethodStats* stats,
                               std::int64_t* rays_traced);
-// pcf, pcss, adaptive-pcf and chun-oh, by in.settings->method.
+// pcf, pcss, adaptive-pcf and chun-oh, by in.settings.method.
 MixedImages bake_shadow_map_filter(const TexelSpace& space, const BaselineInputs& in,
                                    MethodStats* stats);
 MixedImages bake_erosion(const TexelSpace& space, const BaselineInputs& in, MethodStats* stats,

@@ -467,7 +467,7 @@ class ErosionBake {
   }
 
   void erode(std::size_t l, LightMix& mix, Figures& figures) {
-    const bool by_distance = in_.settings->word("erosion_factor") == "distance";
+    const bool by_distance = in_.settings.erosion_by_distance;
     if (!by_distance) build_tables();
     const EdgeIndex index(edges_, W_, H_);
     std::atomic<std::int64_t> penumbra{0};
@@ -564,7 +564,7 @@ class ErosionBake {
 MixedImages bake_erosion(const TexelSpace& space, const BaselineInputs& in,
                          const ErosionOptions& options, MethodStats* stats,
                          std::int64_t* rays_traced) {
-  LightMix mix(space, *in.lights, in.settings->quantity, LightMix::Order::light_major,
+  LightMix mix(space, *in.lights, in.settings.quantity, LightMix::Order::light_major,
                in.keep_per_light);
   Figures figures;
   if (!space.texels.empty()) {

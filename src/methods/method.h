@@ -9,6 +9,7 @@
 #include <any>
 #include <atomic>
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -165,5 +166,28 @@ SettingSpec word_setting(std::string key, std::string fallback, std::vector<std:
 const std::vector<MethodEntry>& method_registry();
 // The entry named `name`, or null.
 const MethodEntry* find_method(std::string_view name);
+
+// Names of the methods this build knows, in the order docs/methods.md lists them.
+const std::vector<std::string>& known_methods();
+// The method that alone bakes `q` where one does (ambient occlusion's), else empty.
+std::string method_baking_only(Quantity q);
+// Every method's own settings, each key once, in the registry's order.
+const std::vector<SettingSpec>& method_setting_specs();
+// The one for `key`, or null.
+const SettingSpec* find_method_setting(std::string_view key);
+// What the scene reader is told of this build's methods (scene/scene.h).
+const MethodVocabulary& method_vocabulary();
+// The scene file read and checked against this build's methods (scene/scene.h's load_scene).
+Expected<Scene> load_scene(const std::filesystem::path& file, bool need_lights = true);
+
+// A method's own [bake] setting (SettingSpec) in `bake`: the value the scene file or the command
+// line gave, else its registry default. A method reads its settings once per bake with these.
+bool setting_flag(const BakeSettings& bake, std::string_view key);
+std::int64_t setting_whole(const BakeSettings& bake, std::string_view key);
+double setting_number(const BakeSettings& bake, std::string_view key);  // a whole number's too
+std::string setting_word(const BakeSettings& bake, std::string_view key);
+// Sets a method's own setting, a whole number made a number where the key takes one; not checked
+// against its range (the scene reader checks what a file gives).
+void set_setting(BakeSettings& bake, std::string_view key, SettingValue value);
 
 }  // namespace sb

@@ -1,5 +1,6 @@
 // The registry of bake methods: a new method adds its entry here (one line) and its own files.
 #include <algorithm>
+#include <stdexcept>
 
 #include "methods/ambient_occlusion.h"
 #include "methods/backprojection/backprojection_method.h"
@@ -26,8 +27,6 @@ const MethodEntry* find_method(std::string_view name) {
   return nullptr;
 }
 
-// Declared in scene/scene.h, so that the scene reader and the CLI can name the known methods
-// without depending on them.
 const std::vector<std::string>& known_methods() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> out;
@@ -93,9 +92,6 @@ SettingSpec word_setting(std::string key, std::string fallback, std::vector<std:
   return spec;
 }
 
-// The rest are declared in scene/scene.h, for the scene reader.
-std::string default_method() { return method_registry().front().name; }
-
 std::string method_baking_only(Quantity q) {
   for (const MethodEntry& entry : method_registry())
     if (entry.only_quantity == q) return entry.name;
@@ -119,6 +115,56 @@ const SettingSpec* find_method_setting(std::string_view key) {
   for (const SettingSpec& spec : method_setting_specs())
     if (spec.key == key) return &spec;
   return nullptr;
+}
+
+const MethodVocabulary& method_vocabulary() {
+  static const MethodVocabulary vocabulary{
+      known_methods(), method_baking_only(Quantity::ambient_occlusion), method_setting_specs()};
+  return vocabulary;
+}
+
+Expected<Scene> load_scene(const std::filesystem::path& file, bool need_lights) {
+  return load_scene(file, method_vocabulary(), need_lights);
+}
+
+namespace {
+
+const SettingSpec& spec_of(std::string_view key) {
+  const SettingSpec* spec = find_method_setting(key);
+  if (!spec) throw std::logic_error("no method reads the [bake] key " + std::string(key));
+  return *spec;
+}
+
+const SettingValue& value_of(const BakeSettings& bake, std::string_view key) {
+  const auto given = bake.own.find(key);
+  return given != bake.own.end() ? given->second : spec_of(key).fallback;
+}
+
+}  // namespace
+
+bool setting_flag(const BakeSettings& bake, std::string_view key) {
+  return std::get<bool>(value_of(bake, key));
+}
+
+std::int64_t setting_whole(const BakeSettings& bake, std::string_view key) {
+  return std::get<std::int64_t>(value_of(bake, key));
+}
+
+double setting_number(const BakeSettings& bake, std::string_view key) {
+  const SettingValue& v = value_of(bake, key);
+  if (const auto* w = std::get_if<std::int64_t>(&v)) return double(*w);
+  return std::get<double>(v);
+}
+
+std::string setting_word(const BakeSettings& bake, std::string_view key) {
+  return std::get<std::string>(value_of(bake, key));
+}
+
+void set_setting(BakeSettings& bake, std::string_view key, SettingValue value) {
+  const SettingSpec& spec = spec_of(key);
+  if (std::holds_alternative<double>(spec.fallback))
+    if (const auto* w = std::get_if<std::int64_t>(&value)) value = double(*w);
+  bake.own.insert_or_assign(std::string(key), std::move(value));
 }
 
 }  // namespace sb

@@ -47,7 +47,8 @@ Expected<const MethodEntry*> check_request(const Scene& scene, std::vector<std::
   {
     BakeSettings settings = scene.bake;
     if (Status paired =
-            pair_quantity_and_method(settings, true, true, scene.file.string() + ": [bake]");
+            pair_quantity_and_method(settings, method_baking_only(Quantity::ambient_occlusion),
+                                     true, true, scene.file.string() + ": [bake]");
         !paired)
       return paired.error();
   }

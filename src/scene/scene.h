@@ -29,22 +29,13 @@ enum class Quantity { visibility, irradiance, ambient_occlusion };
 bool is_file_name_part(std::string_view name);
 bool is_file_name_char(char c);  // one character of such a name
 
-// Names of the methods this build knows, in the order docs/methods.md lists them.
-const std::vector<std::string>& known_methods();
-
-// What the scene reader asks of the methods' registry without depending on the methods
-// (methods/registry.cpp defines these): the default method, and the method that alone bakes `q`
-// where one does (ambient occlusion's), else empty.
-std::string default_method();
-std::string method_baking_only(Quantity q);
-
 // A method's own [bake] setting's value: a switch, a whole number, a number or a word.
 using SettingValue = std::variant<bool, std::int64_t, double, std::string>;
 
 // One [bake] key that a method reads beyond the keys of every bake, as its registry entry
-// declares it (MethodEntry::own_settings): its default, which also gives the value's type, and
-// how a value is checked. The scene reader, the command line, the manifest and the shard files
-// know a method's settings only through these.
+// declares it (methods/method.h, MethodEntry::own_settings): its default, which also gives the
+// value's type, and how a value is checked. The scene reader, the command line, the manifest and
+// the shard files know a method's settings only through these.
 struct SettingSpec {
   std::string key;
   SettingValue fallback;
@@ -54,17 +45,24 @@ struct SettingSpec {
   std::function<bool(const SettingValue&)> valid;  // beyond the type and range; may be empty
 };
 
-// Every method's own settings, each key once, in the registry's order (methods/registry.cpp).
-const std::vector<SettingSpec>& method_setting_specs();
-// The one for `key`, or null.
-const SettingSpec* find_method_setting(std::string_view key);
+// What the scene reader is told of the bake methods by the layer that knows them
+// (methods/method.h, method_vocabulary()): the scene layer knows no method, and checks a file's
+// [bake] method and method keys against this.
+struct MethodVocabulary {
+  std::vector<std::string> names;  // every method, in the order docs/methods.md lists them
+  // The method that alone bakes ambient occlusion, and bakes nothing else.
+  std::string ambient_occlusion;
+  std::vector<SettingSpec> settings;  // every method's own [bake] keys, each once
+};
 
 struct BakeSettings {
   int resolution = 512;  // texels per side of each receiver's lightmap
   // When > 0, each receiver's lightmap side instead follows from its surface area: this many
   // texels per metre of its surface (texels/lightmap_sizes.h), times its lightmap_scale.
   double texels_per_metre = 0;
-  std::string method = default_method();
+  // The method's name: the registry's first (methods/registry.cpp) unless the scene or the
+  // command line names another; MethodRegistry.DefaultIsTheFirst checks that the two agree.
+  std::string method = "backprojection";
   Quantity quantity = Quantity::visibility;
   int samples = 256;  // light samples per texel, for sampling methods (rays, for ambient occlusion)
   // ambient occlusion: metres along a ray within which a blocker occludes it (Blender's default)
@@ -82,15 +80,9 @@ struct BakeSettings {
   // Bytes the bake may use (memory_budget.h); 0: the default, 3/4 of the physical memory.
   std::uint64_t max_memory = 0;
   // Each method's own [bake] keys (SettingSpec) that the scene file or the command line set; a
-  // key not here has its method's default. Read with the getters below, set with set().
+  // key not here has its method's default. Methods read them with setting_whole() and its
+  // kin, and the command line sets them with set_setting() (methods/method.h).
   std::map<std::string, SettingValue, std::less<>> own;
-  bool flag(std::string_view key) const;
-  std::int64_t whole(std::string_view key) const;
-  double number(std::string_view key) const;  // a whole number's value too
-  std::string word(std::string_view key) const;
-  // Sets a method's own setting, a whole number made a number where the key takes one; not
-  // checked against its range (the scene reader checks what a file gives).
-  void set(std::string_view key, SettingValue value);
 };
 
 struct ObjectDesc {
@@ -235,14 +227,18 @@ struct Scene {
 // (level_file.h), baked alone with the default settings.
 // `need_lights` false: a scene without lights is no error (an ambient-occlusion bake's, which the
 // command line may ask for on a file that says nothing of it).
-Expected<Scene> load_scene(const std::filesystem::path& file, bool need_lights = true);
+// `methods`: the method names and keys a [bake] table may give (methods/method.h has
+// load_scene(file), with this build's).
+Expected<Scene> load_scene(const std::filesystem::path& file, const MethodVocabulary& methods,
+                           bool need_lights = true);
 
 // Quantity "ambient-occlusion" is baked by method "ambient-occlusion" and that method bakes only
 // it: makes the two agree where one of them was left at its default (`quantity_given`,
 // `method_given`: whether the scene or command line set them), else an error "<where>: ..."
 // naming both.
-Status pair_quantity_and_method(BakeSettings& bake, bool quantity_given, bool method_given,
-                                const std::string& where);
+// `ao_method`: the method that alone bakes ambient occlusion (MethodVocabulary).
+Status pair_quantity_and_method(BakeSettings& bake, const std::string& ao_method,
+                                bool quantity_given, bool method_given, const std::string& where);
 
 // "file:line: object 'name'", where messages about an object start; "file: object 'name'" for an
 // object of a level baked alone (line 0: no scene file line stands for it).

@@ -59,47 +59,8 @@ const char* to_string(LightShape s) {
   return "?";
 }
 
-namespace {
-
-const SettingSpec& spec_of(std::string_view key) {
-  const SettingSpec* spec = find_method_setting(key);
-  if (!spec) throw std::logic_error("no method reads the [bake] key " + std::string(key));
-  return *spec;
-}
-
-const SettingValue& value_of(const BakeSettings& bake, std::string_view key) {
-  const auto given = bake.own.find(key);
-  return given != bake.own.end() ? given->second : spec_of(key).fallback;
-}
-
-}  // namespace
-
-bool BakeSettings::flag(std::string_view key) const { return std::get<bool>(value_of(*this, key)); }
-
-std::int64_t BakeSettings::whole(std::string_view key) const {
-  return std::get<std::int64_t>(value_of(*this, key));
-}
-
-double BakeSettings::number(std::string_view key) const {
-  const SettingValue& v = value_of(*this, key);
-  if (const auto* w = std::get_if<std::int64_t>(&v)) return double(*w);
-  return std::get<double>(v);
-}
-
-std::string BakeSettings::word(std::string_view key) const {
-  return std::get<std::string>(value_of(*this, key));
-}
-
-void BakeSettings::set(std::string_view key, SettingValue value) {
-  const SettingSpec& spec = spec_of(key);
-  if (std::holds_alternative<double>(spec.fallback))
-    if (const auto* w = std::get_if<std::int64_t>(&value)) value = double(*w);
-  own.insert_or_assign(std::string(key), std::move(value));
-}
-
-Status pair_quantity_and_method(BakeSettings& bake, bool quantity_given, bool method_given,
-                                const std::string& where) {
-  const std::string ao = method_baking_only(Quantity::ambient_occlusion);
+Status pair_quantity_and_method(BakeSettings& bake, const std::string& ao, bool quantity_given,
+                                bool method_given, const std::string& where) {
   const bool ao_quantity = bake.quantity == Quantity::ambient_occlusion;
   const bool ao_method = bake.method == ao;
   if (ao_quantity == ao_method) return Ok{};
@@ -223,7 +184,8 @@ Status add_unique(const std::filesystem::path& file, const char* kind, std::vect
 
 }  // namespace
 
-Expected<Scene> load_scene(const std::filesystem::path& file, bool need_lights) {
+Expected<Scene> load_scene(const std::filesystem::path& file, const MethodVocabulary& methods,
+                           bool need_lights) {
   if (is_level_file(file)) return load_level_scene(file, need_lights);
   Expected<std::string> text = read_text(file);
   if (!text) return text.error();
@@ -256,7 +218,7 @@ Expected<Scene> load_scene(const std::filesystem::path& file, bool need_lights) 
         return located_error(file, key.source().begin.line, "top level",
                              "'bake' must be a table, written [bake]");
       }
-      Expected<BakeSettings> settings = read_bake(file, *bake);
+      Expected<BakeSettings> settings = read_bake(file, *bake, methods);
       if (!settings) return settings.error();
       scene.bake = *settings;
       for (const auto& [name, value] : *bake)

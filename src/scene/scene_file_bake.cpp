@@ -7,14 +7,27 @@
 
 namespace sb {
 
-Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::table& table) {
+namespace {
+
+// Sets a method's own key to a value the reader checked, a whole number made a number where the
+// key takes one.
+void set_own(BakeSettings& bake, const SettingSpec& spec, SettingValue value) {
+  if (std::holds_alternative<double>(spec.fallback))
+    if (const auto* w = std::get_if<std::int64_t>(&value)) value = double(*w);
+  bake.own.insert_or_assign(spec.key, std::move(value));
+}
+
+}  // namespace
+
+Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::table& table,
+                                 const MethodVocabulary& methods) {
   TableReader r(file, table, "[bake]");
-  // Every bake's keys, then each method's own (SettingSpec, from the registry).
+  // Every bake's keys, then each method's own (SettingSpec, from the methods' vocabulary).
   std::vector<std::string_view> known = {
       "resolution", "texels_per_metre", "method",          "quantity",
       "samples",    "ao_distance",      "margin",          "seams",
       "seed",       "max_memory",       "irradiance_floor"};
-  for (const SettingSpec& spec : method_setting_specs()) known.push_back(spec.key);
+  for (const SettingSpec& spec : methods.settings) known.push_back(spec.key);
   r.check_known_keys(known);
   BakeSettings bake;
   const int int_max = std::numeric_limits<int>::max();
@@ -29,7 +42,7 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
     bake.texels_per_metre = *v;
   }
   if (auto v = r.string("method")) {
-    const auto& known = known_methods();
+    const auto& known = methods.names;
     if (std::find(known.begin(), known.end(), *v) == known.end()) {
       r.fail("method", fmt::format("unknown method {} (known: {})", single_quoted(*v),
                                    fmt::join(known, ", ")));
@@ -73,25 +86,25 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
     }
   }
   // Each method's own keys, by their type, range and check.
-  for (const SettingSpec& spec : method_setting_specs()) {
+  for (const SettingSpec& spec : methods.settings) {
     if (!r.find(spec.key)) continue;
     const auto valid = [&](const SettingValue& v) { return !spec.valid || spec.valid(v); };
     if (std::holds_alternative<bool>(spec.fallback)) {
-      if (auto v = r.boolean(spec.key)) bake.set(spec.key, *v);
+      if (auto v = r.boolean(spec.key)) set_own(bake, spec, *v);
     } else if (std::holds_alternative<std::int64_t>(spec.fallback)) {
       if (auto v = r.integer(spec.key, spec.lo, spec.hi)) {
         if (valid(*v))
-          bake.set(spec.key, *v);
+          set_own(bake, spec, *v);
         else
           r.fail_got(spec.key, spec.requirement);
       }
     } else if (std::holds_alternative<double>(spec.fallback)) {
       if (auto v = r.number(spec.key, spec.requirement,
                             [&](double x) { return std::isfinite(x) && valid(x); }))
-        bake.set(spec.key, *v);
+        set_own(bake, spec, *v);
     } else if (auto v = r.string(spec.key)) {
       if (valid(*v))
-        bake.set(spec.key, *v);
+        set_own(bake, spec, *v);
       else
         r.fail_got(spec.key, spec.requirement);
     }
@@ -101,8 +114,9 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
   if (const toml::node* given = r.find("quantity") ? r.find("quantity") : r.find("method")) {
     const std::string where =
         fmt::format("{}:{}: [bake]", file.string(), given->source().begin.line);
-    if (Status paired = pair_quantity_and_method(bake, r.find("quantity") != nullptr,
-                                                 r.find("method") != nullptr, where);
+    if (Status paired =
+            pair_quantity_and_method(bake, methods.ambient_occlusion, r.find("quantity") != nullptr,
+                                     r.find("method") != nullptr, where);
         !paired)
       return paired.error();
   }

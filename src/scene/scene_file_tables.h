@@ -19,7 +19,8 @@ namespace sb {
 void set_uv(ObjectDesc& obj, int uv_set);
 
 // The [bake] table.
-Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::table& table);
+Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::table& table,
+                                 const MethodVocabulary& methods);
 
 // The [output] table.
 Expected<OutputSettings> read_output(const std::filesystem::path& file, const toml::table& table);

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "methods/method.h"
 #include "occluders/ray_scene.h"
 #include "occluders/shaft_culling.h"
 #include "scene/lights.h"

@@ -124,9 +124,9 @@ TEST(ErosionBake, BothShadowFactorsNearReference) {
   ref_scene.bake.samples = 1024;
   const BakeResult reference = bake_or_fail(ref_scene);
   Scene scene = load("parallel", 256, "erosion");
-  scene.bake.set("erosion_factor", "pcf");
+  set_setting(scene.bake, "erosion_factor", "pcf");
   const BakeResult pcf = bake_or_fail(scene);
-  scene.bake.set("erosion_factor", "distance");
+  set_setting(scene.bake, "erosion_factor", "distance");
   const BakeResult distance = bake_or_fail(scene);
   const Errors e_pcf = errors(pcf, reference), e_distance = errors(distance, reference);
   std::printf("parallel 256²: pcf RMSE %.4f max %.4f; distance RMSE %.4f max %.4f\n", e_pcf.rmse,
@@ -163,7 +163,7 @@ DirectBake bake_direct(const Scene& scene, const ErosionOptions& options) {
   in.lights = &*lights;
   in.rays = &*rays;
   in.receiver = receiver;
-  in.settings = &scene.bake;
+  in.settings = baseline_settings(scene.bake);
   const TexelSpace space =
       rasterise_texels(*receiver, scene.bake.resolution, scene.bake.resolution);
   DirectBake out;
@@ -186,7 +186,7 @@ TEST(ErosionBake, LineFitRemovesStaircaseOnSlantedEdge) {
   const int res = 128;
   const double angle = 30.0 * 3.14159265358979 / 180.0;
   Scene scene = load("parallel", res, "erosion");
-  scene.bake.set("erosion_factor", "distance");
+  set_setting(scene.bake, "erosion_factor", "distance");
   object(scene, "blocker").transform = Affine3(Eigen::AngleAxisd(angle, Vec3::UnitZ()));
   ErosionOptions fit, no_fit;
   no_fit.line_distance = false;
@@ -247,7 +247,7 @@ TEST(ErosionBake, ShowcaseNearReference) {
   }();
   for (const char* name : {"pcf", "distance"}) {
     Scene scene = load("showcase", 64, "erosion");
-    scene.bake.set("erosion_factor", name);
+    set_setting(scene.bake, "erosion_factor", name);
     const BakeResult result = bake_or_fail(scene);
     const Errors e = errors(result, ref);
     std::printf("showcase 64², %s: RMSE %.4f, max %.4f\n", name, e.rmse, e.max);

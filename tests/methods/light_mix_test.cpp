@@ -60,7 +60,7 @@ TEST_P(PerLight, EachLightsImageIsThatLightAlone) {
   Scene scene = load("showcase", 32, GetParam());
   scene.bake.quantity = Quantity::irradiance;
   scene.bake.samples = 8;
-  scene.bake.set("shadow_map", 256);
+  set_setting(scene.bake, "shadow_map", 256);
   ASSERT_EQ(scene.lights.size(), 2u);
   const BakeResult all = bake_or_fail(scene, true);
   for (std::size_t l = 0; l < scene.lights.size(); ++l) {
@@ -87,7 +87,7 @@ TEST_P(PerLight, EachLightsImageIsThatLightAlone) {
 TEST_P(PerLight, EachLightsVisibilityIsTheSceneWithThatLightAlone) {
   Scene scene = load("showcase", 32, GetParam());
   scene.bake.samples = 8;
-  scene.bake.set("shadow_map", 256);
+  set_setting(scene.bake, "shadow_map", 256);
   ASSERT_EQ(scene.lights.size(), 2u);
   const BakeResult all = bake_or_fail(scene, true);
   for (std::size_t l = 0; l < scene.lights.size(); ++l) {
@@ -101,7 +101,7 @@ TEST_P(PerLight, EachLightsVisibilityIsTheSceneWithThatLightAlone) {
 TEST_P(PerLight, KeepingThemLeavesTheMixAlone) {
   Scene scene = load("showcase", 32, GetParam());
   scene.bake.samples = 8;
-  scene.bake.set("shadow_map", 256);
+  set_setting(scene.bake, "shadow_map", 256);
   const BakeResult with = bake_or_fail(scene, true), without = bake_or_fail(scene, false);
   for (std::size_t r = 0; r < with.receivers.size(); ++r) {
     EXPECT_EQ(with.receivers[r].image.pixels, without.receivers[r].image.pixels);

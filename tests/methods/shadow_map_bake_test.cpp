@@ -88,7 +88,7 @@ std::unique_ptr<Prepared> prepare(const Scene& scene, const std::string& receive
   p->space = rasterise_texels(p->meshes[index], scene.bake.resolution, scene.bake.resolution);
   p->in.lights = &p->lights;
   p->in.receiver = &p->meshes[index];
-  p->in.settings = &p->scene.bake;
+  p->in.settings = baseline_settings(p->scene.bake);
   p->in.stream = index;
   return p;
 }
@@ -250,7 +250,7 @@ TEST(ShadowMap, BiasKeepsAThinWallsShadowAtItsBase) {
 // floor in front of the wall stays lit up to the base (the cap at d_r of shadow_map.h).
 TEST(ShadowMap, ConcaveCornerDoesNotDarkenTheFloorAlongAWall) {
   Scene scene = load("parallel", 128, "pcf");
-  scene.bake.set("pcf_radius", 8);
+  set_setting(scene.bake, "pcf_radius", 8);
   object(scene, "floor").blocker = true;
   object(scene, "blocker").transform = Affine3(Eigen::Translation3d(0.5, 0, 0.3)) *
                                        Eigen::AngleAxisd(std::numbers::pi / 2, Vec3::UnitY()) *
@@ -273,7 +273,7 @@ TEST(Pcf, PenumbraWidthIndependentOfBlockerDistance) {
   double widths[2];
   for (int k = 0; k < 2; ++k) {
     Scene scene = load("parallel", 256, "pcf");
-    scene.bake.set("shadow_map", 256);
+    set_setting(scene.bake, "shadow_map", 256);
     object(scene, "blocker").transform =
         Affine3(Eigen::Translation3d(0, 0, (k == 0 ? 0.25 : 0.75) - 0.5));
     widths[k] = edge_width(bake_first(scene), 128);

@@ -11,6 +11,7 @@
 #include <set>
 #include <vector>
 
+#include "methods/method.h"
 #include "occluders/clusters.h"
 #include "scene/mesh.h"
 #include "scene/scene.h"

@@ -192,8 +192,8 @@ TEST(ShaftCullingBake, WithoutConvolutionEqualsTheReference) {
   reference.bake.samples = 16;
   Scene shaft = reference;
   shaft.bake.method = "convolution";
-  shaft.bake.set("trace", true);
-  shaft.bake.set("convolve", false);
+  set_setting(shaft.bake, "trace", true);
+  set_setting(shaft.bake, "convolve", false);
   auto a = bake(reference);
   auto b = bake(shaft);
   ASSERT_TRUE(a) << a.error().message;
@@ -210,7 +210,7 @@ TEST(ShaftCullingBake, WithoutConvolutionEqualsTheReference) {
   }
   EXPECT_LT(b->shadow_rays, a->shadow_rays);  // the clear pairs took none
 
-  shaft.bake.set("trace", false);
+  set_setting(shaft.bake, "trace", false);
   auto neither = bake(shaft);
   ASSERT_FALSE(neither);
   EXPECT_NE(neither.error().message.find("convolve = false needs trace = true"), std::string::npos)

@@ -17,9 +17,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "formats/manifest.h"
+#include "formats/outputs.h"
 #include "pipeline/bake.h"
-#include "pipeline/manifest.h"
-#include "pipeline/outputs.h"
 #include "pipeline/tiles.h"
 
 namespace sb {
@@ -124,7 +124,7 @@ Scene quick(const std::string& file) {
   scene->bake.resolution = 24;
   scene->bake.texels_per_metre = 0;
   scene->bake.samples = 2;
-  scene->bake.set("shadow_map", 256);
+  set_setting(scene->bake, "shadow_map", 256);
   scene->output.per_light = true;
   scene->output.shadowmask = true;
   scene->output.gltf = true;

@@ -10,6 +10,7 @@
 #include <random>
 #include <string>
 
+#include "methods/method.h"
 #include "scene/lights.h"
 #include "scene/scene.h"
 #include "scene/sun_light.h"
@@ -89,6 +90,36 @@ class SceneFile : public ::testing::Test {
 
   std::filesystem::path dir_;
 };
+
+// The scene reader knows the methods only through the vocabulary it is handed: a method and a
+// key this build lacks are read where the vocabulary has them, and refused where this build's
+// is given.
+TEST_F(SceneFile, ChecksTheMethodVocabularyItIsGiven) {
+  const std::string text =
+      "[bake]\nmethod = \"imagined\"\nimagined_rows = 7\n" + object_floor + light_disk;
+  MethodVocabulary imagined;
+  imagined.names = {"imagined"};
+  SettingSpec rows;
+  rows.key = "imagined_rows";
+  rows.fallback = std::int64_t(4);
+  rows.lo = 1, rows.hi = 8;
+  imagined.settings = {rows};
+  Expected<Scene> read = load_scene(write(text), imagined);
+  ASSERT_TRUE(read) << read.error().message;
+  EXPECT_EQ(read->bake.method, "imagined");
+  EXPECT_EQ(std::get<std::int64_t>(read->bake.own.at("imagined_rows")), 7);
+  // This build's vocabulary knows neither.
+  expect_error(text, "imagined_rows =", "[bake]", "unknown key 'imagined_rows'");
+  expect_error("[bake]\nmethod = \"imagined\"\n" + object_floor + light_disk, "method =", "[bake]",
+               "unknown method 'imagined'");
+}
+
+// A scene's default method, which the scene layer names without knowing the methods, is the
+// registry's first.
+TEST(MethodRegistry, DefaultIsTheFirst) {
+  EXPECT_EQ(BakeSettings{}.method, method_registry().front().name);
+  EXPECT_EQ(method_vocabulary().names.front(), method_registry().front().name);
+}
 
 TEST_F(SceneFile, ReadsEveryValue) {
   const std::string text = R"(
@@ -274,18 +305,18 @@ TEST_F(SceneFile, ReadsAndChecksMethodSettings) {
       "blocker_combine = \"product\"\nweighting = \"emission\"\nshadow_map = 1024\npcf_radius = 3\n"
       "erosion_factor = \"distance\"\n" +
       object_floor + light_panel);
-  EXPECT_EQ(scene.bake.number("error_texels"), 0.5);
-  EXPECT_EQ(scene.bake.whole("max_image"), 2048);
-  EXPECT_EQ(scene.bake.whole("max_triples"), 32);
-  EXPECT_EQ(scene.bake.whole("light_parts"), 2);
-  EXPECT_EQ(scene.bake.word("blocker_combine"), "product");
-  EXPECT_EQ(scene.bake.word("weighting"), "emission");
-  EXPECT_EQ(scene.bake.whole("shadow_map"), 1024);
-  EXPECT_EQ(scene.bake.number("pcf_radius"), 3.0);
-  EXPECT_EQ(scene.bake.word("erosion_factor"), "distance");
+  EXPECT_EQ(setting_number(scene.bake, "error_texels"), 0.5);
+  EXPECT_EQ(setting_whole(scene.bake, "max_image"), 2048);
+  EXPECT_EQ(setting_whole(scene.bake, "max_triples"), 32);
+  EXPECT_EQ(setting_whole(scene.bake, "light_parts"), 2);
+  EXPECT_EQ(setting_word(scene.bake, "blocker_combine"), "product");
+  EXPECT_EQ(setting_word(scene.bake, "weighting"), "emission");
+  EXPECT_EQ(setting_whole(scene.bake, "shadow_map"), 1024);
+  EXPECT_EQ(setting_number(scene.bake, "pcf_radius"), 3.0);
+  EXPECT_EQ(setting_word(scene.bake, "erosion_factor"), "distance");
   // Keys not given take their method's default.
-  EXPECT_EQ(scene.bake.whole("light_rows"), 32);
-  EXPECT_TRUE(scene.bake.flag("trace"));
+  EXPECT_EQ(setting_whole(scene.bake, "light_rows"), 32);
+  EXPECT_TRUE(setting_flag(scene.bake, "trace"));
   // The keys given, with their lines, for the bake to report those its method ignores.
   ASSERT_EQ(scene.bake_keys.size(), 9u);
   EXPECT_EQ(scene.bake_keys[0].key, "error_texels");

@@ -16,7 +16,7 @@ inline BakeResult bake_with(Scene scene, const std::string& method, int samples,
                             std::uint64_t seed = 0) {
   scene.bake.method = method;
   scene.bake.samples = samples;
-  scene.bake.set("trace", trace);
+  set_setting(scene.bake, "trace", trace);
   scene.bake.seed = seed;
   scene.bake.margin = 0;
   auto result = bake(scene);

@@ -21,7 +21,7 @@ inline Scene load(const std::string& name, int resolution, const std::string& me
   scene->bake.margin = 0;
   // The convolution itself: without the rays that take over where it cannot vouch for its
   // values (traced_convolution.h), which its own tests are not about.
-  scene->bake.set("trace", false);
+  set_setting(scene->bake, "trace", false);
   return *scene;
 }
 

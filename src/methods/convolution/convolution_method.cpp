@@ -77,18 +77,34 @@ std::string pair_text(const PairReport& p) {
 
 }  // namespace
 
-PlanInputs plan_inputs(const BakeContext& context, const Mesh* receiver,
-                       const ConvolutionBackend* backend) {
-  const BakeSettings& settings = context.scene->bake;
+ConvolutionSettings convolution_settings(const BakeSettings& bake) {
+  ConvolutionSettings s;
+  s.quantity = bake.quantity;
+  s.error_texels = setting_number(bake, "error_texels");
+  s.max_image = int(setting_whole(bake, "max_image"));
+  s.max_triples = int(setting_whole(bake, "max_triples"));
+  s.light_parts = int(setting_whole(bake, "light_parts"));
+  s.combine =
+      setting_word(bake, "blocker_combine") == "sum" ? BlockerCombine::sum : BlockerCombine::product;
+  s.weighted = setting_word(bake, "weighting") == "irradiance";
+  s.convolve = setting_flag(bake, "convolve");
+  s.trace_error_texels = setting_number(bake, "trace_error_texels");
+  s.samples = bake.samples;
+  s.seed = bake.seed;
+  return s;
+}
+
+PlanInputs plan_inputs(const BakeContext& context, const ConvolutionSettings& settings,
+                       const Mesh* receiver, const ConvolutionBackend* backend) {
   PlanInputs in;
   in.lights = context.lights;
   in.receiver = receiver;
   in.blockers = context.blockers;
   in.clusters = context.clusters;
-  in.error_texels = settings.number("error_texels");
-  in.max_image = int(settings.whole("max_image"));
-  in.max_triples = int(settings.whole("max_triples"));
-  in.light_parts = int(settings.whole("light_parts"));
+  in.error_texels = settings.error_texels;
+  in.max_image = settings.max_image;
+  in.max_triples = settings.max_triples;
+  in.light_parts = settings.light_parts;
   in.backend = backend;
   return in;
 }
@@ -97,27 +113,27 @@ namespace {
 
 class ConvolutionMethod final : public Method {
  public:
-  explicit ConvolutionMethod(const BakeContext& context) : context_(context) {
+  explicit ConvolutionMethod(const BakeContext& context)
+      : context_(context), settings_(convolution_settings(context.scene->bake)) {
     fft_.set_threads(std::max(1, context.threads));
   }
 
   Expected<MethodResult> bake(const ReceiverInput& receiver) override {
-    const BakeSettings& settings = context_.scene->bake;
+    const ConvolutionSettings& settings = settings_;
     ConvolutionInputs in;
-    in.plan = plan_inputs(context_, receiver.mesh, &fft_);
+    in.plan = plan_inputs(context_, settings, receiver.mesh, &fft_);
     in.quantity = settings.quantity;
-    in.combine =
-        settings.word("blocker_combine") == "sum" ? BlockerCombine::sum : BlockerCombine::product;
-    in.weighted = settings.word("weighting") == "irradiance";
+    in.combine = settings.combine;
+    in.weighted = settings.weighted;
     in.memory_for_images = context_.memory_for_images;
     in.fft = &fft_;
     TracedConvolutionInputs traced;
     traced.convolution = in;
     traced.culler = context_.shafts;
     traced.rays = context_.rays;
-    traced.convolve = settings.flag("convolve");
+    traced.convolve = settings.convolve;
     traced.samples = settings.samples;
-    traced.trace_error_texels = settings.number("trace_error_texels");
+    traced.trace_error_texels = settings.trace_error_texels;
     traced.seed = settings.seed;
     traced.stream = receiver.stream;
     traced.keep_per_light = context_.keep_per_light;
@@ -162,6 +178,7 @@ class ConvolutionMethod final : public Method {
 
  private:
   BakeContext context_;
+  ConvolutionSettings settings_;
   FftConvolver fft_;  // this bake's transforms: plans made once per size, kernel spectra cached
 };
 
@@ -190,21 +207,21 @@ MethodEntry convolution_method() {
   e.needs = [](const BakeSettings& s) {
     // The planner's clusters serve the convolution (and the buried-texel test); with
     // convolve = false and rays, no leaf is planned.
-    const bool trace = s.flag("trace"), convolve = s.flag("convolve");
+    const bool trace = setting_flag(s, "trace"), convolve = setting_flag(s, "convolve");
     return MethodNeeds{.rays = trace, .clusters = convolve || !trace, .shafts = true};
   };
   e.memory = [](const Scene& scene, double texels) {
     // Parts of a light: at least light_parts; a sphere light's receiver may be seen through up
     // to six cube faces, each a frame of its own.
-    const double parts =
-        double(scene.lights.size()) * std::max<double>(double(scene.bake.whole("light_parts")), 1);
+    const double parts = double(scene.lights.size()) *
+                         std::max<double>(double(setting_whole(scene.bake, "light_parts")), 1);
     return std::vector<MemoryItem>{
         {"convolution texel arrays",
          texels * (kConvolutionBytesPerTexel + kConvolutionBytesPerTexelAndLightPart * parts)}};
   };
   e.make = [](const BakeContext& context) -> Expected<std::unique_ptr<Method>> {
     const BakeSettings& s = context.scene->bake;
-    if (!s.flag("convolve") && !s.flag("trace"))
+    if (!setting_flag(s, "convolve") && !setting_flag(s, "trace"))
       return scene_error(context.scene->file.string() +
                          ": [bake]: convolve = false needs trace = true (with neither, nothing "
                          "would compute the shadows)");
@@ -215,7 +232,8 @@ MethodEntry convolution_method() {
   e.plan = [](const BakeContext& context, const ReceiverInput& receiver) -> Expected<std::string> {
     const FftConvolver fft;
     return describe_plan(
-        plan_convolution(*receiver.space, plan_inputs(context, receiver.mesh, &fft)));
+        plan_convolution(*receiver.space, plan_inputs(context, convolution_settings(context.scene->bake),
+                                                     receiver.mesh, &fft)));
   };
   return e;
 }

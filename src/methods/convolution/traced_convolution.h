@@ -44,9 +44,25 @@ Expected<MixedImages> bake_traced_convolution(const TexelSpace& space,
 // light_parts, trace, convolve, trace_error_texels, blocker_combine, weighting, samples, seed).
 MethodEntry convolution_method();
 
+// The method's settings, read once per bake from the [bake] table (convolution_settings).
+struct ConvolutionSettings {
+  Quantity quantity = Quantity::visibility;
+  // The planner's (PlanInputs).
+  double error_texels = 0;
+  int max_image = 0, max_triples = 0, light_parts = 0;
+  // The convolution's (ConvolutionInputs) and the traced route's (TracedConvolutionInputs).
+  BlockerCombine combine = BlockerCombine::sum;
+  bool weighted = true;
+  bool convolve = true;
+  double trace_error_texels = 0;
+  int samples = 256;
+  std::uint64_t seed = 0;
+};
+ConvolutionSettings convolution_settings(const BakeSettings& bake);
+
 // The planner's inputs for one receiver from the bake's settings (what `shadowbake plan` and the
 // method share).
-PlanInputs plan_inputs(const BakeContext& context, const Mesh* receiver,
-                       const ConvolutionBackend* backend);
+PlanInputs plan_inputs(const BakeContext& context, const ConvolutionSettings& settings,
+                       const Mesh* receiver, const ConvolutionBackend* backend);
 
 }  // namespace sb

@@ -142,7 +142,7 @@ TEST(BackprojectionBake, MidpointCellsIsReadAndHonoured) {
   for (int on = 0; on < 2; ++on) {
     auto scene = write(on ? "4" : "0");
     ASSERT_TRUE(scene) << scene.error().message;
-    EXPECT_EQ(scene->bake.number("midpoint_cells"), on ? 4.0 : 0.0);
+    EXPECT_EQ(setting_number(scene->bake, "midpoint_cells"), on ? 4.0 : 0.0);
     auto result = bake(*scene);
     ASSERT_TRUE(result) << result.error().message;
     const Image& img = result->receivers[0].image;

@@ -53,8 +53,8 @@ std::unique_ptr<Planned> plan_scene(const Scene& scene) {
   in.receiver = &p->meshes[receiver];
   in.blockers = p->blockers;
   in.clusters = &p->clusters;
-  in.error_texels = scene.bake.number("error_texels");
-  in.max_triples = int(scene.bake.whole("max_triples"));
+  in.error_texels = setting_number(scene.bake, "error_texels");
+  in.max_triples = int(setting_whole(scene.bake, "max_triples"));
   const FftConvolver fft;
   in.backend = &fft;
   p->plan = plan_convolution(p->space, in);
@@ -78,7 +78,7 @@ TEST(ConvolutionPlan, WorstErrorFallsAsTheTargetFalls) {
   double previous = std::numeric_limits<double>::infinity();
   std::size_t previous_leaves = 0;
   for (const double target : {32.0, 8.0, 2.0}) {
-    scene.bake.set("error_texels", target);
+    set_setting(scene.bake, "error_texels", target);
     const auto p = plan_scene(scene);
     const double worst = p->plan.worst_error_texels();
     std::printf("posts 128^2, error_texels %.0f: %zu leaves, worst eps %.2f texels\n", target,
@@ -274,7 +274,7 @@ TEST(ConvolutionPlan, PostShadowHardensAtContact) {
   ref.bake.samples = 256;
   // The default, light_parts = 2, and the light whole.
   Scene whole = *scene;
-  whole.bake.set("light_parts", 1);
+  set_setting(whole.bake, "light_parts", 1);
   auto a = bake(whole), b = bake(ref), h = bake(*scene);
   ASSERT_TRUE(a && b && h);
   const Image& ci = a->receivers[0].image;
@@ -330,7 +330,7 @@ TEST(ConvolutionPlan, IslandWindowsChangeNothingButTheWork) {
   in.plan.receiver = &p->meshes[receiver];
   in.plan.blockers = p->blockers;
   in.plan.clusters = &p->clusters;
-  in.plan.max_triples = int(scene.bake.whole("max_triples"));
+  in.plan.max_triples = int(setting_whole(scene.bake, "max_triples"));
   in.plan.backend = &fft;
   in.fft = &fft;
   std::vector<PairReport> with_reports, without_reports;
