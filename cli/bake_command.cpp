@@ -19,9 +19,9 @@
 #include <vector>
 
 #include "commands.h"
+#include "formats/outputs.h"
 #include "pipeline/bake.h"
 #include "pipeline/memory_budget.h"
-#include "pipeline/outputs.h"
 #include "pipeline/shards.h"
 #include "scene/scene.h"
 
@@ -136,6 +136,82 @@ void apply_preset(const std::string& preset, sb::BakeSettings& settings,
   output.shadowmask = false;
 }
 
+// Applies the options given on the command line over the scene file's settings and outputs; the
+// error is a --quantity and --method that do not pair.
+sb::Status apply_options(const BakeArgs& args, sb::Scene& scene) {
+  auto& settings = scene.bake;
+  if (args.preset) apply_preset(*args.preset, settings, scene.output);
+  if (args.method) settings.method = *args.method;
+  if (args.quantity) {
+    settings.quantity = *args.quantity == "irradiance"          ? sb::Quantity::irradiance
+                        : *args.quantity == "ambient-occlusion" ? sb::Quantity::ambient_occlusion
+                                                                : sb::Quantity::visibility;
+  }
+  if (args.quantity || args.method) {
+    if (sb::Status paired = sb::pair_quantity_and_method(
+            settings, sb::method_baking_only(sb::Quantity::ambient_occlusion),
+            args.quantity.has_value(), args.method.has_value(), "--quantity/--method");
+        !paired)
+      return paired.error();
+  }
+  if (args.ao_distance) settings.ao_distance = *args.ao_distance;
+  if (args.irradiance_floor) settings.irradiance_floor = *args.irradiance_floor;
+  if (args.resolution) {
+    settings.resolution = *args.resolution;
+    settings.texels_per_metre = 0;
+  }
+  if (args.texels_per_metre) settings.texels_per_metre = *args.texels_per_metre;
+  sb::OutputSettings& output = scene.output;
+  if (args.encoding) output.encoding = *sb::parse_encoding(*args.encoding);
+  output.per_light |= args.per_light;
+  output.shadowmask |= args.shadowmask;
+  output.gltf |= args.gltf;
+  if (args.atlas_size || args.atlas_padding) {
+    if (!output.atlas) output.atlas = sb::AtlasSettings{};
+    if (args.atlas_size) output.atlas->size = *args.atlas_size;
+    if (args.atlas_padding) output.atlas->padding = *args.atlas_padding;
+  }
+  if (args.no_atlas) output.atlas.reset();
+  if (args.samples) settings.samples = *args.samples;
+  if (args.seed) settings.seed = *args.seed;
+  if (args.error_texels) set_setting(settings, "error_texels", *args.error_texels);
+  if (args.max_memory) settings.max_memory = *args.max_memory;
+  if (args.no_trace) set_setting(settings, "trace", false);
+  if (args.no_convolve) set_setting(settings, "convolve", false);
+  if (args.no_seams) settings.seams = false;
+  return sb::Ok{};
+}
+
+// Prints each receiver baked, then the scene's (or the shard's) line with its steps' times.
+void print_summary(const sb::BakeResult& result, const sb::BakeSettings& settings,
+                   const std::optional<sb::ShardSpec>& shard, const std::string& out_dir,
+                   double write_seconds, double total_seconds) {
+  std::size_t reused = 0;
+  const bool tiles = std::any_of(result.receivers.begin(), result.receivers.end(),
+                                 [](const sb::ReceiverBake& r) { return bool(r.tile); });
+  for (const auto& r : result.receivers) {
+    reused += r.reuse == "reused";
+    const std::string rows =
+        r.tile ? fmt::format(", rows {} to {}", r.tile->begin, r.tile->end - 1) : "";
+    fmt::print("  {:<16} {}²{} ({} texels covered, {})\n", r.name, r.image.width, rows,
+               r.covered_texels,
+               r.reuse == "reused" ? "reused" : fmt::format("{:.2f} s", r.seconds));
+  }
+  const std::string size = settings.texels_per_metre > 0
+                               ? fmt::format("{:.4g} texels per metre", settings.texels_per_metre)
+                               : fmt::format("{}²", settings.resolution);
+  const std::string atlases =
+      result.atlas ? fmt::format(", {} atlas(es)", result.atlas->sizes.size()) : "";
+  const std::string what = shard ? fmt::format("shard {}/{}: ", shard->index, shard->count) : "";
+  fmt::print(
+      "{}baked {} {}{} with '{}' at {}{} into {}/ ({}): load {:.2f} s, bake "
+      "{:.2f} s, write {:.2f} s, total {:.2f} s\n",
+      what, result.receivers.size(), tiles ? "receiver(s) or tile(s)" : "receiver(s)",
+      reused ? fmt::format(" ({} taken unchanged from the earlier bake)", reused) : "",
+      settings.method, size, atlases, out_dir, shard ? sb::kShardFile : "manifest.json",
+      result.load_seconds, result.bake_seconds, write_seconds, total_seconds);
+}
+
 // Bakes one scene into `out_dir` (a shard's part of it, with --shard); the exit code.
 int bake_scene(const BakeArgs& args, const std::string& scene_file, const std::string& out_dir) {
   const auto start = std::chrono::steady_clock::now();
@@ -153,44 +229,7 @@ int bake_scene(const BakeArgs& args, const std::string& scene_file, const std::s
   auto scene = sb::load_scene(scene_file, !ambient_occlusion);
   if (!scene) return fail(scene.error());
   auto& settings = scene->bake;
-  if (args.preset) apply_preset(*args.preset, settings, scene->output);
-  if (args.method) settings.method = *args.method;
-  if (args.quantity) {
-    settings.quantity = *args.quantity == "irradiance"          ? sb::Quantity::irradiance
-                        : *args.quantity == "ambient-occlusion" ? sb::Quantity::ambient_occlusion
-                                                                : sb::Quantity::visibility;
-  }
-  if (args.quantity || args.method) {
-    if (sb::Status paired = sb::pair_quantity_and_method(
-            settings, args.quantity.has_value(), args.method.has_value(), "--quantity/--method");
-        !paired)
-      return fail(paired.error());
-  }
-  if (args.ao_distance) settings.ao_distance = *args.ao_distance;
-  if (args.irradiance_floor) settings.irradiance_floor = *args.irradiance_floor;
-  if (args.resolution) {
-    settings.resolution = *args.resolution;
-    settings.texels_per_metre = 0;
-  }
-  if (args.texels_per_metre) settings.texels_per_metre = *args.texels_per_metre;
-  sb::OutputSettings& output = scene->output;
-  if (args.encoding) output.encoding = *sb::parse_encoding(*args.encoding);
-  output.per_light |= args.per_light;
-  output.shadowmask |= args.shadowmask;
-  output.gltf |= args.gltf;
-  if (args.atlas_size || args.atlas_padding) {
-    if (!output.atlas) output.atlas = sb::AtlasSettings{};
-    if (args.atlas_size) output.atlas->size = *args.atlas_size;
-    if (args.atlas_padding) output.atlas->padding = *args.atlas_padding;
-  }
-  if (args.no_atlas) output.atlas.reset();
-  if (args.samples) settings.samples = *args.samples;
-  if (args.seed) settings.seed = *args.seed;
-  if (args.error_texels) settings.set("error_texels", *args.error_texels);
-  if (args.max_memory) settings.max_memory = *args.max_memory;
-  if (args.no_trace) settings.set("trace", false);
-  if (args.no_convolve) settings.set("convolve", false);
-  if (args.no_seams) settings.seams = false;
+  if (sb::Status applied = apply_options(args, *scene); !applied) return fail(applied.error());
 
   // The output folder is locked and its names checked before the bake, so a bake that could not
   // publish its files fails in a second, not after its work.
@@ -234,32 +273,7 @@ int bake_scene(const BakeArgs& args, const std::string& scene_file, const std::s
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (args.explain) print_explanation(*result);
 
-  if (!args.quiet) {
-    std::size_t reused = 0;
-    const bool tiles = std::any_of(result->receivers.begin(), result->receivers.end(),
-                                   [](const sb::ReceiverBake& r) { return bool(r.tile); });
-    for (const auto& r : result->receivers) {
-      reused += r.reuse == "reused";
-      const std::string rows =
-          r.tile ? fmt::format(", rows {} to {}", r.tile->begin, r.tile->end - 1) : "";
-      fmt::print("  {:<16} {}²{} ({} texels covered, {})\n", r.name, r.image.width, rows,
-                 r.covered_texels,
-                 r.reuse == "reused" ? "reused" : fmt::format("{:.2f} s", r.seconds));
-    }
-    const std::string size = settings.texels_per_metre > 0
-                                 ? fmt::format("{:.4g} texels per metre", settings.texels_per_metre)
-                                 : fmt::format("{}²", settings.resolution);
-    const std::string atlases =
-        result->atlas ? fmt::format(", {} atlas(es)", result->atlas->sizes.size()) : "";
-    const std::string what = shard ? fmt::format("shard {}/{}: ", shard->index, shard->count) : "";
-    fmt::print(
-        "{}baked {} {}{} with '{}' at {}{} into {}/ ({}): load {:.2f} s, bake "
-        "{:.2f} s, write {:.2f} s, total {:.2f} s\n",
-        what, result->receivers.size(), tiles ? "receiver(s) or tile(s)" : "receiver(s)",
-        reused ? fmt::format(" ({} taken unchanged from the earlier bake)", reused) : "",
-        settings.method, size, atlases, out_dir, shard ? sb::kShardFile : "manifest.json",
-        result->load_seconds, result->bake_seconds, write_seconds, total_seconds);
-  }
+  if (!args.quiet) print_summary(*result, settings, shard, out_dir, write_seconds, total_seconds);
   return ok;
 }
 
@@ -381,25 +395,29 @@ int run_bake(const BakeArgs& args) {
   return first_failure;
 }
 
-}  // namespace
+// What `bake`'s options parse into. An option whose absence leaves the scene file's setting is
+// copied into `args` only where given (read_given_options), so each keeps its CLI::Option.
+struct Options {
+  BakeArgs args;
+  std::string method, quantity;
+  int resolution = 0, samples = 0;
+  std::int64_t seed = 0;
+  double error_texels = 1;
+  double ao_distance = 10;
+  double irradiance_floor = 0;
+  std::string max_memory;
+  double texels_per_metre = 0;
+  std::string encoding, shard, balance, preset, shard_tiles;
+  int atlas_size = 0, atlas_padding = 0;
+  CLI::Option *method_opt = nullptr, *quantity_opt = nullptr, *ao_distance_opt = nullptr,
+              *floor_opt = nullptr, *resolution_opt = nullptr, *density_opt = nullptr,
+              *encoding_opt = nullptr, *atlas_opt = nullptr, *padding_opt = nullptr,
+              *samples_opt = nullptr, *seed_opt = nullptr, *memory_opt = nullptr,
+              *error_opt = nullptr;
+};
 
-Runner add_bake_command(CLI::App& app) {
-  struct Options {
-    BakeArgs args;
-    std::string method, quantity;
-    int resolution = 0, samples = 0;
-    std::int64_t seed = 0;
-    double error_texels = 1;
-    double ao_distance = 10;
-    double irradiance_floor = 0;
-    std::string max_memory;
-    double texels_per_metre = 0;
-    std::string encoding, shard, balance, preset, shard_tiles;
-    int atlas_size = 0, atlas_padding = 0;
-  };
-  auto o = std::make_shared<Options>();
-  auto* bake = app.add_subcommand(
-      "bake", "bake every receiver of a scene into OUTDIR (several scenes: each into OUTDIR/...)");
+// The scenes, the output folder and the shard to bake.
+void add_input_options(CLI::App* bake, Options* o) {
   bake->add_option("scene", o->args.scenes, "scene file(s) (TOML, docs/scene-format.md)");
   bake->add_option("--list", o->args.list,
                    "a file naming scene files, one per line (relative to it), baked as a batch");
@@ -415,52 +433,59 @@ Runner add_bake_command(CLI::App& app) {
                    "auto (default): a receiver dearer than a shard's share is split into tiles "
                    "of rows, for methods that allow it; off: receivers stay whole")
       ->check(CLI::IsMember({"auto", "off"}));
-  auto* method_opt =
-      bake->add_option("--method", o->method, "bake method (overrides [bake] method)")
-          ->check(CLI::IsMember(sb::known_methods()));
-  auto* quantity_opt =
+}
+
+// What is baked and written: the method, the quantity and its reach, the lightmaps' size, their
+// encoding, what else is written beside them, the atlases.
+void add_setting_options(CLI::App* bake, Options* o) {
+  o->method_opt = bake->add_option("--method", o->method, "bake method (overrides [bake] method)")
+                      ->check(CLI::IsMember(sb::known_methods()));
+  o->quantity_opt =
       bake->add_option("--quantity", o->quantity,
                        "visibility, irradiance or ambient-occlusion (overrides [bake] quantity)")
           ->check(CLI::IsMember({"visibility", "irradiance", "ambient-occlusion"}));
-  auto* ao_distance_opt =
+  o->ao_distance_opt =
       bake->add_option("--ao-distance", o->ao_distance,
                        "ambient occlusion: metres within which a blocker occludes (overrides "
                        "[bake] ao_distance)")
           ->check(CLI::Range(1e-6, 1e6));
-  auto* floor_opt =
+  o->floor_opt =
       bake->add_option("--irradiance-floor", o->irradiance_floor,
                        "W/m²: a light without a range reaches as far as its irradiance stays "
                        "above this (overrides [bake] irradiance_floor; 0: everywhere)")
           ->check(CLI::Range(0.0, 1e9));
-  auto* resolution_opt = bake->add_option("--resolution", o->resolution, "texels per side")
-                             ->check(CLI::Range(1, 16384));
-  auto* density_opt =
+  o->resolution_opt = bake->add_option("--resolution", o->resolution, "texels per side")
+                          ->check(CLI::Range(1, 16384));
+  o->density_opt =
       bake->add_option("--texels-per-metre", o->texels_per_metre,
                        "size each lightmap by its surface: texels per metre (overrides [bake])")
           ->check(CLI::Range(1e-6, 1e6));
-  resolution_opt->excludes(density_opt);
-  auto* encoding_opt = bake->add_option("--encoding", o->encoding,
-                                        "lightmap files: linear-exr, half-exr, png, rgbm-png")
-                           ->check(CLI::IsMember({"linear-exr", "half-exr", "png", "rgbm-png"}));
+  o->resolution_opt->excludes(o->density_opt);
+  o->encoding_opt = bake->add_option("--encoding", o->encoding,
+                                     "lightmap files: linear-exr, half-exr, png, rgbm-png")
+                        ->check(CLI::IsMember({"linear-exr", "half-exr", "png", "rgbm-png"}));
   bake->add_flag("--per-light", o->args.per_light, "also write each light's own image");
   bake->add_flag("--shadowmask", o->args.shadowmask,
                  "also write shadow masks: up to four lights in R, G, B, A");
   bake->add_flag("--gltf", o->args.gltf, "also write scene.glb with the lightmaps bound");
-  auto* atlas_opt =
+  o->atlas_opt =
       bake->add_option("--atlas", o->atlas_size, "pack the lightmaps into atlases of this size")
           ->check(CLI::Range(64, 16384));
-  auto* padding_opt =
+  o->padding_opt =
       bake->add_option("--atlas-padding", o->atlas_padding, "texels around each atlas rectangle")
           ->check(CLI::Range(1, 256));
   auto* no_atlas_opt = bake->add_flag("--no-atlas", o->args.no_atlas,
                                       "one set of files per receiver, whatever [output] says");
-  no_atlas_opt->excludes(atlas_opt)->excludes(padding_opt);
-  auto* samples_opt = bake->add_option("--samples", o->samples, "light samples per texel")
-                          ->check(CLI::Range(1, 1 << 20));
-  auto* seed_opt =
-      bake->add_option("--seed", o->seed, "sampling seed (0 or more)")
-          ->check(CLI::Range(std::int64_t(0), std::numeric_limits<std::int64_t>::max()));
-  auto* memory_opt =
+  no_atlas_opt->excludes(o->atlas_opt)->excludes(o->padding_opt);
+}
+
+// How the bake samples and runs: its budgets, switches, threads, progress lines and preset.
+void add_run_options(CLI::App* bake, Options* o) {
+  o->samples_opt = bake->add_option("--samples", o->samples, "light samples per texel")
+                       ->check(CLI::Range(1, 1 << 20));
+  o->seed_opt = bake->add_option("--seed", o->seed, "sampling seed (0 or more)")
+                    ->check(CLI::Range(std::int64_t(0), std::numeric_limits<std::int64_t>::max()));
+  o->memory_opt =
       bake->add_option("--max-memory", o->max_memory,
                        "memory the bake may use, e.g. \"8 GiB\" (overrides [bake] max_memory)")
           ->check(CLI::Validator(
@@ -471,7 +496,7 @@ Runner add_bake_command(CLI::App& app) {
                            : "must be a size such as 8GiB or 512MiB, got '" + text + "'";
               },
               "SIZE"));
-  auto* error_opt =
+  o->error_opt =
       bake->add_option("--error-texels", o->error_texels,
                        "convolution: penumbra error allowed, receiver texels (overrides [bake])")
           ->check(CLI::PositiveNumber);
@@ -495,6 +520,11 @@ Runner add_bake_command(CLI::App& app) {
                    "lightmaps alone, no seams pass; final: the scene's settings (options given "
                    "beside it override it)")
       ->check(CLI::IsMember({"preview", "final"}));
+}
+
+// Incremental bakes (pipeline/bake_cache.h): what is baked again, what is taken from the folder's
+// earlier bake, and --watch.
+void add_incremental_options(CLI::App* bake, Options* o) {
   bake->add_flag("--force", o->args.force,
                  "bake every receiver, even those the folder's earlier bake holds unchanged")
       ->excludes("--shard");
@@ -518,31 +548,49 @@ Runner add_bake_command(CLI::App& app) {
       ->excludes("--force")
       ->excludes("--only")
       ->excludes("--lights");
+}
+
+// Copies the options into `args`: those that stand in for a scene file's setting only where
+// given, so that the scene's own setting holds otherwise.
+void read_given_options(Options* o) {
+  if (*o->method_opt) o->args.method = o->method;
+  if (*o->quantity_opt) o->args.quantity = o->quantity;
+  if (*o->ao_distance_opt) o->args.ao_distance = o->ao_distance;
+  if (*o->floor_opt) o->args.irradiance_floor = o->irradiance_floor;
+  if (*o->resolution_opt) o->args.resolution = o->resolution;
+  if (*o->density_opt) o->args.texels_per_metre = o->texels_per_metre;
+  if (!o->shard.empty()) o->args.shard = o->shard;
+  if (!o->preset.empty()) o->args.preset = o->preset;
+  if (o->balance == "count") o->args.balance = sb::ShardBalance::count;
+  o->args.shard_tiles = o->shard_tiles != "off";
+  if (*o->encoding_opt) o->args.encoding = o->encoding;
+  if (*o->atlas_opt) o->args.atlas_size = o->atlas_size;
+  if (*o->padding_opt) o->args.atlas_padding = o->atlas_padding;
+  if (*o->samples_opt) o->args.samples = o->samples;
+  if (*o->seed_opt) o->args.seed = std::uint64_t(o->seed);
+  if (*o->memory_opt) {
+    std::uint64_t bytes = 0;
+    sb::parse_memory_size(o->max_memory, bytes);
+    o->args.max_memory = bytes;
+  }
+  if (*o->error_opt) o->args.error_texels = o->error_texels;
+}
+
+}  // namespace
+
+Runner add_bake_command(CLI::App& app) {
+  auto o = std::make_shared<Options>();
+  auto* bake = app.add_subcommand(
+      "bake", "bake every receiver of a scene into OUTDIR (several scenes: each into OUTDIR/...)");
+  add_input_options(bake, o.get());
+  add_setting_options(bake, o.get());
+  add_run_options(bake, o.get());
+  add_incremental_options(bake, o.get());
   bake->add_flag("--explain", o->args.explain,
                  "print, per light and receiver, the convolution's direction, planes, error "
                  "metric, image sizes and stage times");
-  return [=]() {
-    if (*method_opt) o->args.method = o->method;
-    if (*quantity_opt) o->args.quantity = o->quantity;
-    if (*ao_distance_opt) o->args.ao_distance = o->ao_distance;
-    if (*floor_opt) o->args.irradiance_floor = o->irradiance_floor;
-    if (*resolution_opt) o->args.resolution = o->resolution;
-    if (*density_opt) o->args.texels_per_metre = o->texels_per_metre;
-    if (!o->shard.empty()) o->args.shard = o->shard;
-    if (!o->preset.empty()) o->args.preset = o->preset;
-    if (o->balance == "count") o->args.balance = sb::ShardBalance::count;
-    o->args.shard_tiles = o->shard_tiles != "off";
-    if (*encoding_opt) o->args.encoding = o->encoding;
-    if (*atlas_opt) o->args.atlas_size = o->atlas_size;
-    if (*padding_opt) o->args.atlas_padding = o->atlas_padding;
-    if (*samples_opt) o->args.samples = o->samples;
-    if (*seed_opt) o->args.seed = std::uint64_t(o->seed);
-    if (*memory_opt) {
-      std::uint64_t bytes = 0;
-      sb::parse_memory_size(o->max_memory, bytes);
-      o->args.max_memory = bytes;
-    }
-    if (*error_opt) o->args.error_texels = o->error_texels;
+  return [o]() {
+    read_given_options(o.get());
     return run_bake(o->args);
   };
 }

@@ -17,7 +17,7 @@
 #include "core/image_io.h"
 #include "evaluation/image_metrics.h"
 #include "evaluation/metrics_json.h"
-#include "pipeline/output_folder.h"
+#include "formats/output_folder.h"
 
 namespace sbcli {
 
@@ -123,8 +123,10 @@ void warn_non_finite(const std::string& file, std::int64_t texels) {
       file.c_str(), static_cast<long long>(texels), texels == 1 ? "texel holds" : "texels hold");
 }
 
-int run_compare(const CompareArgs& args) {
-  std::vector<Gate> gates;
+// Reads the --fail-above gates, --peak and --penumbra into `gates` and `options`; `ok`, or the
+// usage error's exit code.
+int read_gates_and_options(const CompareArgs& args, std::vector<Gate>& gates,
+                           sb::CompareOptions& options) {
   for (const auto& text : args.gates) {
     auto gate = parse_gate(text);
     if (!gate) {
@@ -137,7 +139,6 @@ int run_compare(const CompareArgs& args) {
     return usage_error(
         fmt::format("--peak {}: expected a value ≥ 0 (0: the reference's largest)", args.peak));
   }
-  sb::CompareOptions options;
   options.peak = args.peak;
   if (!args.penumbra.empty()) {
     double lo = 0, hi = 0;
@@ -148,13 +149,17 @@ int run_compare(const CompareArgs& args) {
     options.penumbra_lo = lo;
     options.penumbra_hi = hi;
   }
+  return ok;
+}
 
-  auto a = sb::read_image(args.a);
-  if (!a) return fail(a.error());
-  auto reference = sb::read_image(args.reference);
-  if (!reference) return fail(reference.error());
+// Which mask counts texels, and where it came from ("option", "beside reference" or "none").
+struct MaskChoice {
+  fs::path path;
+  std::string source;
+};
 
-  // The mask: given, or the bake's coverage beside the reference, or none (every texel).
+// The mask: given, or the bake's coverage beside the reference, or none (every texel).
+MaskChoice choose_mask(const CompareArgs& args) {
   fs::path mask_path = args.mask;
   std::string mask_source = "option";
   if (mask_path.empty()) {
@@ -170,6 +175,91 @@ int run_compare(const CompareArgs& args) {
       mask_source = "none";
     }
   }
+  return {mask_path, mask_source};
+}
+
+// Judges each gate on the comparison, appending its result to `gate_results`; the failures, one
+// line each.
+std::vector<std::string> check_gates(const std::vector<Gate>& gates, const sb::Comparison& c,
+                                     const std::string& a_file,
+                                     nlohmann::ordered_json& gate_results) {
+  std::vector<std::string> failures;
+  for (const auto& gate : gates) {
+    const double value = gate_value(gate, c);
+    // A gate that has nothing to judge, or an image with texels that are not numbers, fails:
+    // a pipeline must not pass a bake it could not measure.
+    const bool unmeasured = std::isnan(value);
+    const bool broken = c.non_finite_a > 0;
+    const bool failed =
+        unmeasured || broken || (gate.fail_below ? value < gate.threshold : value > gate.threshold);
+    if (unmeasured) {
+      failures.push_back(
+          fmt::format("{}: no texels to judge (none covered, or none finite)", gate.metric));
+    } else if (broken) {
+      failures.push_back(fmt::format("{}: {} has {} non-finite texel value(s)", gate.metric, a_file,
+                                     c.non_finite_a));
+    } else if (failed) {
+      failures.push_back(fmt::format("{} = {} {} {}", gate.metric, number(value),
+                                     gate.fail_below ? "<" : ">", number(gate.threshold)));
+    }
+    gate_results.push_back({{"metric", gate.metric},
+                            {"threshold", gate.threshold},
+                            {"fails", gate.fail_below ? "below" : "above"},
+                            {"value", sb::json_number(value)},
+                            {"passed", !failed}});
+  }
+  return failures;
+}
+
+// Writes difference.png and compare.json into --output; `ok`, or the error's exit code.
+int write_compare_outputs(const CompareArgs& args, const sb::Image& a, const sb::Image& reference,
+                          const sb::CompareOptions& options, const MaskChoice& mask,
+                          const sb::Comparison& c, const nlohmann::ordered_json& gate_results) {
+  const fs::path& mask_path = mask.path;
+  auto folder = sb::OutputFolder::open(args.out_dir);
+  if (!folder) return fail(folder.error());
+  const double scale = sb::heat_map_scale(a, reference, options.mask);
+  const sb::Image heat = sb::difference_heat_map(a, reference, options.mask, scale, true);
+
+  nlohmann::ordered_json j;
+  j["a"] = {{"path", args.a}, {"width", a.width}, {"height", a.height}, {"channels", a.channels}};
+  j["reference"] = {{"path", args.reference},
+                    {"width", reference.width},
+                    {"height", reference.height},
+                    {"channels", reference.channels}};
+  j["mask"] = {{"source", mask.source},
+               {"path", mask_path.empty() ? nlohmann::ordered_json(nullptr)
+                                          : nlohmann::ordered_json(mask_path.string())}};
+  j["peak"] = c.peak;
+  j["penumbra_range"] = {options.penumbra_lo, options.penumbra_hi};
+  j["non_finite"] = {{"a", c.non_finite_a}, {"reference", c.non_finite_reference}};
+  j["covered"] = sb::to_json(c.covered);
+  j["penumbra"] = sb::to_json(c.penumbra);
+  j["heat_map"] = {{"file", "difference.png"}, {"scale", scale}};
+  j["gates"] = gate_results;
+
+  if (auto s = sb::write_image(folder->staged("difference.png"), heat, sb::PixelFormat::uint8); !s)
+    return fail(s.error());
+  if (auto s = sb::write_text_file(folder->staged("compare.json"), j.dump(2) + "\n"); !s)
+    return fail(s.error());
+  auto published = folder->publish({"difference.png", "compare.json"});
+  reraise_pending_interrupt();
+  if (!published) return fail(published.error());
+  return ok;
+}
+
+int run_compare(const CompareArgs& args) {
+  std::vector<Gate> gates;
+  sb::CompareOptions options;
+  if (int code = read_gates_and_options(args, gates, options); code != ok) return code;
+
+  auto a = sb::read_image(args.a);
+  if (!a) return fail(a.error());
+  auto reference = sb::read_image(args.reference);
+  if (!reference) return fail(reference.error());
+
+  const MaskChoice mask = choose_mask(args);
+  const fs::path& mask_path = mask.path;
   if (!mask_path.empty()) {
     auto mask_image = sb::read_image(mask_path);
     if (!mask_image) return fail(mask_image.error());
@@ -193,64 +283,11 @@ int run_compare(const CompareArgs& args) {
 
   // Gates, checked after the outputs are written so that a failing run can be inspected.
   nlohmann::ordered_json gate_results = nlohmann::ordered_json::array();
-  std::vector<std::string> failures;
-  for (const auto& gate : gates) {
-    const double value = gate_value(gate, c);
-    // A gate that has nothing to judge, or an image with texels that are not numbers, fails:
-    // a pipeline must not pass a bake it could not measure.
-    const bool unmeasured = std::isnan(value);
-    const bool broken = c.non_finite_a > 0;
-    const bool failed =
-        unmeasured || broken || (gate.fail_below ? value < gate.threshold : value > gate.threshold);
-    if (unmeasured) {
-      failures.push_back(
-          fmt::format("{}: no texels to judge (none covered, or none finite)", gate.metric));
-    } else if (broken) {
-      failures.push_back(fmt::format("{}: {} has {} non-finite texel value(s)", gate.metric, args.a,
-                                     c.non_finite_a));
-    } else if (failed) {
-      failures.push_back(fmt::format("{} = {} {} {}", gate.metric, number(value),
-                                     gate.fail_below ? "<" : ">", number(gate.threshold)));
-    }
-    gate_results.push_back({{"metric", gate.metric},
-                            {"threshold", gate.threshold},
-                            {"fails", gate.fail_below ? "below" : "above"},
-                            {"value", sb::json_number(value)},
-                            {"passed", !failed}});
-  }
+  const std::vector<std::string> failures = check_gates(gates, c, args.a, gate_results);
 
   if (!args.out_dir.empty()) {
-    auto folder = sb::OutputFolder::open(args.out_dir);
-    if (!folder) return fail(folder.error());
-    const double scale = sb::heat_map_scale(*a, *reference, options.mask);
-    const sb::Image heat = sb::difference_heat_map(*a, *reference, options.mask, scale, true);
-
-    nlohmann::ordered_json j;
-    j["a"] = {
-        {"path", args.a}, {"width", a->width}, {"height", a->height}, {"channels", a->channels}};
-    j["reference"] = {{"path", args.reference},
-                      {"width", reference->width},
-                      {"height", reference->height},
-                      {"channels", reference->channels}};
-    j["mask"] = {{"source", mask_source},
-                 {"path", mask_path.empty() ? nlohmann::ordered_json(nullptr)
-                                            : nlohmann::ordered_json(mask_path.string())}};
-    j["peak"] = c.peak;
-    j["penumbra_range"] = {options.penumbra_lo, options.penumbra_hi};
-    j["non_finite"] = {{"a", c.non_finite_a}, {"reference", c.non_finite_reference}};
-    j["covered"] = sb::to_json(c.covered);
-    j["penumbra"] = sb::to_json(c.penumbra);
-    j["heat_map"] = {{"file", "difference.png"}, {"scale", scale}};
-    j["gates"] = gate_results;
-
-    if (auto s = sb::write_image(folder->staged("difference.png"), heat, sb::PixelFormat::uint8);
-        !s)
-      return fail(s.error());
-    if (auto s = sb::write_text_file(folder->staged("compare.json"), j.dump(2) + "\n"); !s)
-      return fail(s.error());
-    auto published = folder->publish({"difference.png", "compare.json"});
-    reraise_pending_interrupt();
-    if (!published) return fail(published.error());
+    const int written = write_compare_outputs(args, *a, *reference, options, mask, c, gate_results);
+    if (written != ok) return written;
   }
 
   for (const auto& f : failures) std::fprintf(stderr, "shadowbake: gate failed: %s\n", f.c_str());

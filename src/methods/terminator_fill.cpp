@@ -85,6 +85,109 @@ bool square_reaches(const TexelSpace& space, const Texel& texel, const H0& h0) {
   return false;
 }
 
+// A texel's fill: its pixel's index and the values it takes. Each texel's fill is found first and
+// written after (fill_terminators).
+struct Fill {
+  std::size_t pixel;
+  float v[3];
+};
+
+// The covered texels of the blocks `blocks` (LightLists::kSide² texels each), block by block.
+std::vector<std::size_t> texels_of_blocks(const TexelSpace& space,
+                                          std::span<const std::uint32_t> blocks) {
+  std::vector<std::size_t> visited;
+  const int blocks_x = (space.width + LightLists::kSide - 1) / LightLists::kSide;
+  for (const std::uint32_t b : blocks) {
+    const int x0 = int(b % std::uint32_t(blocks_x)) * LightLists::kSide;
+    const int y0 = int(b / std::uint32_t(blocks_x)) * LightLists::kSide;
+    for (int y = y0; y < std::min(y0 + LightLists::kSide, space.height); ++y)
+      for (int x = x0; x < std::min(x0 + LightLists::kSide, space.width); ++x)
+        if (space.covered[std::size_t(y) * std::size_t(space.width) + std::size_t(x)])
+          visited.push_back(texel_at(space, x, y));
+  }
+  return visited;
+}
+
+// Whether a light counts at the texel or at one of its 8 neighbours in the lightmap.
+bool counted_around(const TexelSpace& space, const Image& image, const Texel& texel,
+                    UncountedMark mark) {
+  bool any_counted = false;
+  for (int dy = -1; dy <= 1 && !any_counted; ++dy) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int x = texel.x + dx, y = texel.y + dy;
+      if (x >= 0 && y >= 0 && x < space.width && y < space.height &&
+          space.covered[std::size_t(y) * space.width + x] && counted(image.at(x, y), mark))
+        any_counted = true;
+    }
+  }
+  return any_counted;
+}
+
+// The texel's 8 neighbours on the same piece of surface as it (at `p`) into `around`, by offset
+// (dy + 1, dx + 1); null where there is none.
+void same_surface_neighbours(const TexelSpace& space, const Texel& texel, const Vec3& p,
+                             const Texel* (&around)[3][3]) {
+  // The 8 neighbours on the same piece of surface: no farther apart than their faces'
+  // texel steps allow (a neighbour in the lightmap across a chart's border lies
+  // elsewhere).
+  const double step = space.face_texel_sizes[std::size_t(texel.face)];
+  for (int dy = -1; dy <= 1; ++dy) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int x = texel.x + dx, y = texel.y + dy;
+      if ((dx == 0 && dy == 0) || x < 0 || y < 0 || x >= space.width || y >= space.height ||
+          !space.covered[std::size_t(y) * space.width + x])
+        continue;
+      const Texel& other = space.texels[texel_at(space, x, y)];
+      const double reach = 1.5 * std::hypot(dx, dy) *
+                           std::max(step, double(space.face_texel_sizes[std::size_t(other.face)]));
+      if ((other.position.cast<double>() - p).norm() <= reach) around[dy + 1][dx + 1] = &other;
+    }
+  }
+}
+
+// Sums the lit neighbours' first `values` values into `v`, each weighted by the lights' H0 under
+// the normal on the border between them and the texel (normal `n`); the weights' sum.
+template <class H0>
+double weigh_lit_neighbours(const Image& image, UncountedMark mark, int values,
+                            const Texel* const (&around)[3][3], const Vec3& n, const H0& h0,
+                            double (&v)[3]) {
+  // The lit neighbours' values, each weighted by the lights' H0 under the normal on the
+  // two texels' border (their mean where none is lit there: only a corner reaches).
+  double weight = 0;
+  for (const bool by_border : {true, false}) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const Texel* other = around[dy + 1][dx + 1];
+        if (!other) continue;
+        const float* px = image.at(other->x, other->y);
+        if (!counted(px, mark)) continue;
+        const double w = by_border ? h0(n + other->normal.cast<double>()) : 1.0;
+        if (!(w > 0)) continue;
+        weight += w;
+        for (int c = 0; c < values; ++c) v[c] += w * double(px[c]);
+      }
+    }
+    if (weight > 0) break;
+  }
+  return weight;
+}
+
+// Writes the fills into the image: the values, and with a coverage mark the mark set.
+void write_fills(const tbb::enumerable_thread_specific<std::vector<Fill>>& fills,
+                 UncountedMark mark, Image& image) {
+  for (const std::vector<Fill>& mine : fills) {
+    for (const Fill& fill : mine) {
+      float* px = &image.pixels[fill.pixel * std::size_t(image.channels)];
+      if (mark == UncountedMark::value) {
+        for (int c = 0; c < 3; ++c) px[c] = fill.v[c];
+      } else {
+        px[0] = fill.v[0];
+        px[1] = 1.0f;
+      }
+    }
+  }
+}
+
 }  // namespace
 
 void fill_terminators(const TexelSpace& space, const std::vector<Light>& all,
@@ -96,26 +199,12 @@ void fill_terminators(const TexelSpace& space, const std::vector<Light>& all,
     if (mark == UncountedMark::value) clear_uncounted(image);
     return;
   }
-  // Each texel's fill is found first and written after, so that no texel reads a neighbour
-  // filled in the same pass: the result does not depend on the order texels are visited in.
-  struct Fill {
-    std::size_t pixel;
-    float v[3];
-  };
   // The texels visited: all, or those of `blocks`.
   std::vector<std::size_t> visited;
-  if (blocks) {
-    const int blocks_x = (space.width + LightLists::kSide - 1) / LightLists::kSide;
-    for (const std::uint32_t b : *blocks) {
-      const int x0 = int(b % std::uint32_t(blocks_x)) * LightLists::kSide;
-      const int y0 = int(b / std::uint32_t(blocks_x)) * LightLists::kSide;
-      for (int y = y0; y < std::min(y0 + LightLists::kSide, space.height); ++y)
-        for (int x = x0; x < std::min(x0 + LightLists::kSide, space.width); ++x)
-          if (space.covered[std::size_t(y) * std::size_t(space.width) + std::size_t(x)])
-            visited.push_back(texel_at(space, x, y));
-    }
-  }
+  if (blocks) visited = texels_of_blocks(space, *blocks);
   const std::size_t count = blocks ? visited.size() : space.texels.size();
+  // Each texel's fill is found first and written after, so that no texel reads a neighbour
+  // filled in the same pass: the result does not depend on the order texels are visited in.
   tbb::enumerable_thread_specific<std::vector<Fill>> fills;
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, count, 1024),
@@ -142,71 +231,19 @@ void fill_terminators(const TexelSpace& space, const std::vector<Light>& all,
           };
           // Most texels where no light counts lie among others (a sphere's dark side): their
           // pixels alone say so.
-          bool any_counted = false;
-          for (int dy = -1; dy <= 1 && !any_counted; ++dy) {
-            for (int dx = -1; dx <= 1; ++dx) {
-              const int x = texel.x + dx, y = texel.y + dy;
-              if (x >= 0 && y >= 0 && x < space.width && y < space.height &&
-                  space.covered[std::size_t(y) * space.width + x] && counted(image.at(x, y), mark))
-                any_counted = true;
-            }
-          }
-          if (!any_counted) continue;
-          // The 8 neighbours on the same piece of surface: no farther apart than their faces'
-          // texel steps allow (a neighbour in the lightmap across a chart's border lies
-          // elsewhere).
+          if (!counted_around(space, image, texel, mark)) continue;
           const Texel* around[3][3] = {};
-          const double step = space.face_texel_sizes[std::size_t(texel.face)];
-          for (int dy = -1; dy <= 1; ++dy) {
-            for (int dx = -1; dx <= 1; ++dx) {
-              const int x = texel.x + dx, y = texel.y + dy;
-              if ((dx == 0 && dy == 0) || x < 0 || y < 0 || x >= space.width || y >= space.height ||
-                  !space.covered[std::size_t(y) * space.width + x])
-                continue;
-              const Texel& other = space.texels[texel_at(space, x, y)];
-              const double reach =
-                  1.5 * std::hypot(dx, dy) *
-                  std::max(step, double(space.face_texel_sizes[std::size_t(other.face)]));
-              if ((other.position.cast<double>() - p).norm() <= reach)
-                around[dy + 1][dx + 1] = &other;
-            }
-          }
+          same_surface_neighbours(space, texel, p, around);
           if (!square_reaches(space, texel, h0)) continue;
-          // The lit neighbours' values, each weighted by the lights' H0 under the normal on the
-          // two texels' border (their mean where none is lit there: only a corner reaches).
-          double weight = 0, v[3] = {0, 0, 0};
-          for (const bool by_border : {true, false}) {
-            for (int dy = -1; dy <= 1; ++dy) {
-              for (int dx = -1; dx <= 1; ++dx) {
-                const Texel* other = around[dy + 1][dx + 1];
-                if (!other) continue;
-                const float* px = image.at(other->x, other->y);
-                if (!counted(px, mark)) continue;
-                const double w = by_border ? h0(n + other->normal.cast<double>()) : 1.0;
-                if (!(w > 0)) continue;
-                weight += w;
-                for (int c = 0; c < values; ++c) v[c] += w * double(px[c]);
-              }
-            }
-            if (weight > 0) break;
-          }
+          double v[3] = {0, 0, 0};
+          const double weight = weigh_lit_neighbours(image, mark, values, around, n, h0, v);
           if (!(weight > 0)) continue;  // its lit neighbours lie on other pieces of surface
           Fill fill{std::size_t(texel.y) * std::size_t(space.width) + texel.x, {0, 0, 0}};
           for (int c = 0; c < values; ++c) fill.v[c] = float(v[c] / weight);
           mine.push_back(fill);
         }
       });
-  for (const std::vector<Fill>& mine : fills) {
-    for (const Fill& fill : mine) {
-      float* px = &image.pixels[fill.pixel * std::size_t(image.channels)];
-      if (mark == UncountedMark::value) {
-        for (int c = 0; c < 3; ++c) px[c] = fill.v[c];
-      } else {
-        px[0] = fill.v[0];
-        px[1] = 1.0f;
-      }
-    }
-  }
+  write_fills(fills, mark, image);
   if (mark == UncountedMark::value) clear_uncounted(image);
 }
 

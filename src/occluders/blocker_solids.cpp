@@ -93,17 +93,26 @@ void find_inner_ball(const std::vector<std::array<Vec3, 3>>& triangles, std::siz
   if (!(solid.inner_radius > 0)) solid.inner_radius = 0;
 }
 
-}  // namespace
+// One mesh's part of the search, as steps over what they share: its triangles from `first` on,
+// their corners welded on the mesh's grid, each triangle's three, and its directed edges.
+struct MeshSolids {
+  MeshSolids(const std::vector<std::array<Vec3, 3>>& triangles, std::size_t first,
+             std::size_t count, BlockerSolids& out)
+      : triangles(triangles), first(first), count(count), out(out), position(count, -1) {}
 
-BlockerSolids find_solids(const std::vector<std::array<Vec3, 3>>& triangles,
-                          const std::vector<std::size_t>& mesh_ends) {
-  BlockerSolids out;
-  out.solid_of.assign(triangles.size(), -1);
-  out.across.assign(triangles.size(), {-1, -1, -1});
-  std::size_t first = 0;
-  for (const std::size_t end : mesh_ends) {
-    const std::size_t count = end - first;
-    if (count == 0) continue;
+  const std::vector<std::array<Vec3, 3>>& triangles;
+  const std::size_t first, count;
+  BlockerSolids& out;
+  std::vector<Vec3> corners;
+  std::vector<std::array<int, 3>> tri;
+  std::vector<std::uint8_t> usable;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> directed;
+  std::vector<std::uint8_t> repeated;  // a directed edge held twice: not closed
+  std::vector<int> position;           // a triangle's place in its component's list
+
+  // Welds the corners, gives each triangle its three, and marks the triangles with area.
+  void weld_corners() {
+    const std::size_t end = first + count;
     // Corners welded on the mesh's grid, and each triangle's three.
     Bounds3 box;
     for (std::size_t i = first; i < end; ++i)
@@ -111,9 +120,8 @@ BlockerSolids find_solids(const std::vector<std::array<Vec3, 3>>& triangles,
     const double cell = std::max(box.diagonal(), 1e-300) * 1e-6;
     std::unordered_map<Key, int, KeyHash> index;
     index.reserve(3 * count);
-    std::vector<Vec3> corners;
-    std::vector<std::array<int, 3>> tri(count);
-    std::vector<std::uint8_t> usable(count, 1);
+    tri.resize(count);
+    usable.assign(count, 1);
     for (std::size_t i = 0; i < count; ++i) {
       for (int k = 0; k < 3; ++k) {
         const Vec3 q = (triangles[first + i][std::size_t(k)] - box.lo) / cell;
@@ -126,9 +134,14 @@ BlockerSolids find_solids(const std::vector<std::array<Vec3, 3>>& triangles,
       usable[i] = tri[i][0] != tri[i][1] && tri[i][1] != tri[i][2] && tri[i][0] != tri[i][2] &&
                   (t[1] - t[0]).cross(t[2] - t[0]).squaredNorm() > 0;
     }
+  }
+
+  // Sorts the directed edges, sets each triangle's neighbours across its edges in `out.across`,
+  // and marks the triangles that hold a repeated directed edge.
+  void link_edges() {
     // Directed edges (a, b) sorted, each with its triangle and side: an edge's neighbour is the
     // one triangle holding it the other way round, where neither direction is repeated.
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> directed(3 * count);
+    directed.resize(3 * count);
     for (std::size_t i = 0; i < count; ++i)
       for (int k = 0; k < 3; ++k)
         directed[3 * i + std::size_t(k)] = {
@@ -142,7 +155,7 @@ BlockerSolids find_solids(const std::vector<std::array<Vec3, 3>>& triangles,
       if (std::next(it) != directed.end() && std::next(it)->first == key) return -2;
       return int(it->second);
     };
-    std::vector<std::uint8_t> repeated(count, 0);  // a directed edge held twice: not closed
+    repeated.assign(count, 0);
     for (std::size_t i = 0; i < count; ++i)
       for (int k = 0; k < 3; ++k) {
         const int a = tri[i][std::size_t(k)], b = tri[i][std::size_t((k + 1) % 3)];
@@ -150,6 +163,10 @@ BlockerSolids find_solids(const std::vector<std::array<Vec3, 3>>& triangles,
         if (own == -2) repeated[i] = 1;
         if (own >= 0 && other >= 0) out.across[first + i][std::size_t(k)] = int(first) + other / 3;
       }
+  }
+
+  // Each component's triangles, listed under its root (the component's smallest triangle).
+  std::vector<std::vector<std::size_t>> components() const {
     // Components: triangles joined through shared edges (not corners alone: boxes that touch
     // at a corner are two solids, and only a surface joined edge to edge is convex where it is
     // convex at every edge), whichever way the edge runs in each.
@@ -170,77 +187,110 @@ BlockerSolids find_solids(const std::vector<std::array<Vec3, 3>>& triangles,
       }
     }
     std::vector<std::vector<std::size_t>> members(count);
-    std::vector<int> position(count, -1);  // a triangle's place in its component's list
     for (std::size_t i = 0; i < count; ++i) members[std::size_t(find(parent, int(i)))].push_back(i);
-    for (std::size_t root = 0; root < count; ++root) {  // in a fixed order
-      const std::vector<std::size_t>& list = members[root];
-      if (list.size() < 4) continue;
-      // Closed and consistently oriented: each directed edge once, its reverse present (then
-      // in the same component).
-      bool closed = true;
-      double volume = 0;
-      for (std::size_t j = 0; j < list.size() && closed; ++j) {
+    return members;
+  }
+
+  // Whether the component `list` is convex at every edge within `tolerance`; its edges, each
+  // once as (a, b, face, face across), in `edges` as far as the test went.
+  bool convex_edges(const std::vector<std::size_t>& list, const std::vector<Vec3>& normals,
+                    double tolerance, std::vector<std::array<int, 4>>& edges) const {
+    bool convex = true;
+    for (std::size_t j = 0; j < list.size() && convex; ++j)
+      for (int k = 0; k < 3; ++k) {
         const std::size_t i = list[j];
-        closed = usable[i] && !repeated[i];
-        for (int k = 0; k < 3 && closed; ++k) closed = out.across[first + i][std::size_t(k)] >= 0;
-        const auto& t = triangles[first + i];
-        volume += t[0].dot(t[1].cross(t[2]));
-        position[i] = int(j);
-      }
-      if (!closed || !(volume > 0)) continue;
-      BlockerSolid solid;
-      for (std::size_t i : list)
-        for (const Vec3& v : triangles[first + i]) solid.bounds.extend(v);
-      // Convex: the far corner across each edge on or behind this side's plane, within 0.1 % of
-      // the solid's size (bevelled boxes as Blender exports them dent by about 0.3 mm in 0.4 m:
-      // taken whole, such a solid hides what its convex hull does, at most that much more).
-      const double tolerance = 1e-3 * std::max(solid.bounds.diagonal(), 1e-300);
-      std::vector<Vec3> normals(list.size());
-      for (std::size_t j = 0; j < list.size(); ++j) {
-        const auto& t = triangles[first + list[j]];
-        normals[j] = (t[1] - t[0]).cross(t[2] - t[0]).normalized();
-      }
-      bool convex = true;
-      std::vector<std::array<int, 4>> edges;
-      for (std::size_t j = 0; j < list.size() && convex; ++j)
-        for (int k = 0; k < 3; ++k) {
-          const std::size_t i = list[j];
-          const int a = tri[i][std::size_t(k)], b = tri[i][std::size_t((k + 1) % 3)];
-          if (a > b) continue;  // each undirected edge once, from its (a < b) direction
-          const std::size_t across = std::size_t(out.across[first + i][std::size_t(k)]) - first;
-          const int other = position[across];
-          const auto& far = tri[across];
-          const int c = far[0] != a && far[0] != b   ? far[0]
-                        : far[1] != a && far[1] != b ? far[1]
-                                                     : far[2];
-          if (normals[j].dot(corners[std::size_t(c)] - corners[std::size_t(a)]) > tolerance) {
-            convex = false;
-            break;
-          }
-          edges.push_back({a, b, int(j), other});
+        const int a = tri[i][std::size_t(k)], b = tri[i][std::size_t((k + 1) % 3)];
+        if (a > b) continue;  // each undirected edge once, from its (a < b) direction
+        const std::size_t across = std::size_t(out.across[first + i][std::size_t(k)]) - first;
+        const int other = position[across];
+        const auto& far = tri[across];
+        const int c = far[0] != a && far[0] != b   ? far[0]
+                      : far[1] != a && far[1] != b ? far[1]
+                                                   : far[2];
+        if (normals[j].dot(corners[std::size_t(c)] - corners[std::size_t(a)]) > tolerance) {
+          convex = false;
+          break;
         }
-      const int id = int(out.solids.size());
-      for (std::size_t i : list) out.solid_of[first + i] = id;
-      find_inner_ball(triangles, first, list, solid);
-      if (convex) {
-        solid.convex = true;
-        // The solid's own corners, renumbered from 0, with its faces and edges.
-        std::unordered_map<int, int> local;
-        const auto corner = [&](int c) {
-          const auto [it, added] = local.try_emplace(c, int(solid.corners.size()));
-          if (added) solid.corners.push_back(corners[std::size_t(c)]);
-          return it->second;
-        };
-        for (std::size_t j = 0; j < list.size(); ++j) {
-          const auto& t = tri[list[j]];
-          solid.faces.push_back({corner(t[0]), corner(t[1]), corner(t[2])});
-          solid.normals.push_back(normals[j]);
-        }
-        std::sort(edges.begin(), edges.end());
-        for (const auto& e : edges) solid.edges.push_back({corner(e[0]), corner(e[1]), e[2], e[3]});
+        edges.push_back({a, b, int(j), other});
       }
-      out.solids.push_back(std::move(solid));
+    return convex;
+  }
+
+  // Gives a convex solid its own corners, renumbered from 0, with its faces, normals and edges.
+  void describe_convex(const std::vector<std::size_t>& list, const std::vector<Vec3>& normals,
+                       std::vector<std::array<int, 4>>& edges, BlockerSolid& solid) const {
+    solid.convex = true;
+    // The solid's own corners, renumbered from 0, with its faces and edges.
+    std::unordered_map<int, int> local;
+    const auto corner = [&](int c) {
+      const auto [it, added] = local.try_emplace(c, int(solid.corners.size()));
+      if (added) solid.corners.push_back(corners[std::size_t(c)]);
+      return it->second;
+    };
+    for (std::size_t j = 0; j < list.size(); ++j) {
+      const auto& t = tri[list[j]];
+      solid.faces.push_back({corner(t[0]), corner(t[1]), corner(t[2])});
+      solid.normals.push_back(normals[j]);
     }
+    std::sort(edges.begin(), edges.end());
+    for (const auto& e : edges) solid.edges.push_back({corner(e[0]), corner(e[1]), e[2], e[3]});
+  }
+
+  // Adds the component `list` to `out.solids` when it is a closed solid whose normals point out.
+  void add_solid(const std::vector<std::size_t>& list) {
+    if (list.size() < 4) return;
+    // Closed and consistently oriented: each directed edge once, its reverse present (then
+    // in the same component).
+    bool closed = true;
+    double volume = 0;
+    for (std::size_t j = 0; j < list.size() && closed; ++j) {
+      const std::size_t i = list[j];
+      closed = usable[i] && !repeated[i];
+      for (int k = 0; k < 3 && closed; ++k) closed = out.across[first + i][std::size_t(k)] >= 0;
+      const auto& t = triangles[first + i];
+      volume += t[0].dot(t[1].cross(t[2]));
+      position[i] = int(j);
+    }
+    if (!closed || !(volume > 0)) return;
+    BlockerSolid solid;
+    for (std::size_t i : list)
+      for (const Vec3& v : triangles[first + i]) solid.bounds.extend(v);
+    // Convex: the far corner across each edge on or behind this side's plane, within 0.1 % of
+    // the solid's size (bevelled boxes as Blender exports them dent by about 0.3 mm in 0.4 m:
+    // taken whole, such a solid hides what its convex hull does, at most that much more).
+    const double tolerance = 1e-3 * std::max(solid.bounds.diagonal(), 1e-300);
+    std::vector<Vec3> normals(list.size());
+    for (std::size_t j = 0; j < list.size(); ++j) {
+      const auto& t = triangles[first + list[j]];
+      normals[j] = (t[1] - t[0]).cross(t[2] - t[0]).normalized();
+    }
+    std::vector<std::array<int, 4>> edges;
+    const bool convex = convex_edges(list, normals, tolerance, edges);
+    const int id = int(out.solids.size());
+    for (std::size_t i : list) out.solid_of[first + i] = id;
+    find_inner_ball(triangles, first, list, solid);
+    if (convex) describe_convex(list, normals, edges, solid);
+    out.solids.push_back(std::move(solid));
+  }
+};
+
+}  // namespace
+
+BlockerSolids find_solids(const std::vector<std::array<Vec3, 3>>& triangles,
+                          const std::vector<std::size_t>& mesh_ends) {
+  BlockerSolids out;
+  out.solid_of.assign(triangles.size(), -1);
+  out.across.assign(triangles.size(), {-1, -1, -1});
+  std::size_t first = 0;
+  for (const std::size_t end : mesh_ends) {
+    const std::size_t count = end - first;
+    if (count == 0) continue;
+    MeshSolids mesh(triangles, first, count, out);
+    mesh.weld_corners();
+    mesh.link_edges();
+    const std::vector<std::vector<std::size_t>> members = mesh.components();
+    for (std::size_t root = 0; root < count; ++root)  // in a fixed order
+      mesh.add_solid(members[root]);
     first = end;
   }
   return out;

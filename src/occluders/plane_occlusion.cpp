@@ -142,29 +142,39 @@ void light_corners(const Light& light, std::vector<Vec3>& corners) {
   }
 }
 
-// Whether the triangles lying in the plane of triangle `seed` cover every crossing of the plane
-// by a segment from the box's corners `box` to the light's `ends`.
-bool plane_covers(const ShaftCuller& culler, std::uint32_t seed, const std::array<Vec3, 8>& box,
-                  const std::vector<Vec3>& ends, double offset) {
-  const Vec3 n = culler.triangle_normal(seed);
-  const double d = n.dot(culler.triangle_corners(seed)[0]);
+// A plane n·x = d, with a frame (u, v) in it.
+struct PlaneFrame {
+  Vec3 n;
+  double d;
+  Vec3 u, v;
+  // A point's coordinates in the plane's frame.
+  Vec2 in_plane(const Vec3& p) const { return Vec2(u.dot(p), v.dot(p)); }
+};
+
+// Whether the box lies wholly on one side of the plane n·x = d and the light's ends wholly on the
+// other, each clear of it by more than `offset`; the heights above it into `h_box` and `h_end`.
+bool box_and_light_apart(const Vec3& n, double d, const std::array<Vec3, 8>& box,
+                         const std::vector<Vec3>& ends, double offset, std::array<double, 8>& h_box,
+                         std::vector<double>& h_end) {
   // The box wholly on one side, the light wholly on the other, each clear of the plane by more
   // than a shadow ray skips.
-  std::array<double, 8> h_box;
   for (std::size_t k = 0; k < 8; ++k) h_box[k] = n.dot(box[k]) - d;
   const double sign = h_box[0] > 0 ? 1.0 : -1.0;
   for (const double h : h_box)
     if (!(sign * h > offset)) return false;
-  thread_local std::vector<double> h_end;
   h_end.resize(ends.size());
   for (std::size_t k = 0; k < ends.size(); ++k) {
     h_end[k] = n.dot(ends[k]) - d;
     if (!(-sign * h_end[k] > offset)) return false;
   }
-  // The plane's frame, and the crossings' polygon in it.
-  const Vec3 u = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
-  const Vec3 v = n.cross(u);
-  const auto in_plane = [&](const Vec3& p) { return Vec2(u.dot(p), v.dot(p)); };
+  return true;
+}
+
+// The convex hull, in the plane's frame, of the points where the segments from the box's corners
+// to the light's ends cross the plane (their heights above it `h_box` and `h_end`).
+void crossings_hull(const PlaneFrame& plane, const std::array<Vec3, 8>& box,
+                    const std::vector<Vec3>& ends, const std::array<double, 8>& h_box,
+                    const std::vector<double>& h_end, Polygon& hull) {
   thread_local std::vector<Vec2> crossings;
   crossings.clear();
   for (std::size_t a = 0; a < 8; ++a) {
@@ -175,24 +185,27 @@ bool plane_covers(const ShaftCuller& culler, std::uint32_t seed, const std::arra
       continue;
     for (std::size_t b = 0; b < ends.size(); ++b)
       crossings.push_back(
-          in_plane((-h_end[b] * box[a] + h_box[a] * ends[b]) / (h_box[a] - h_end[b])));
+          plane.in_plane((-h_end[b] * box[a] + h_box[a] * ends[b]) / (h_box[a] - h_end[b])));
   }
-  thread_local Polygon hull;
   convex_hull(crossings, hull);
-  const double hull_area = hull.empty() ? 0.0 : area(hull);
-  if (!(hull_area > 0)) return false;
-  Vec2 lo = hull[0], hi = hull[0];
-  for (const Vec2& p : hull) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+}
+
+// The blocker triangles lying in the plane whose boxes meet the box (lo, hi) of the polygon
+// `hull`, counter-clockwise in the plane's frame, into `triangles`.
+void triangles_in_plane(const ShaftCuller& culler, const PlaneFrame& plane, const Polygon& hull,
+                        const Vec2& lo, const Vec2& hi,
+                        std::vector<std::array<Vec2, 3>>& triangles) {
+  const Vec3& n = plane.n;
+  const double d = plane.d;
   // The blocker triangles whose boxes meet the polygon's (in space, as thick as a triangle may
   // stand off the plane and count as in it), then those in the plane over the polygon's box,
   // counter-clockwise in its frame.
   Bounds3 slab;
-  for (const Vec2& p : hull) slab.extend(Vec3(d * n + p.x() * u + p.y() * v));
+  for (const Vec2& p : hull) slab.extend(Vec3(d * n + p.x() * plane.u + p.y() * plane.v));
   const double thick = kInPlane + kInPlaneRelative * std::max(slab.lo.norm(), slab.hi.norm());
   slab.lo -= Vec3::Constant(thick), slab.hi += Vec3::Constant(thick);
   thread_local std::vector<std::uint32_t> near;
   culler.triangles_in_box(slab, near);
-  thread_local std::vector<std::array<Vec2, 3>> triangles;
   triangles.clear();
   for (const std::uint32_t i : near) {
     const Vec3* c = culler.triangle_corners(i);
@@ -200,7 +213,7 @@ bool plane_covers(const ShaftCuller& culler, std::uint32_t seed, const std::arra
     for (int k = 0; k < 3 && in; ++k)
       in = std::abs(n.dot(c[k]) - d) <= kInPlane + kInPlaneRelative * c[k].norm();
     if (!in) continue;
-    std::array<Vec2, 3> t = {in_plane(c[0]), in_plane(c[1]), in_plane(c[2])};
+    std::array<Vec2, 3> t = {plane.in_plane(c[0]), plane.in_plane(c[1]), plane.in_plane(c[2])};
     const Vec2 t_lo = t[0].cwiseMin(t[1]).cwiseMin(t[2]), t_hi = t[0].cwiseMax(t[1]).cwiseMax(t[2]);
     if ((t_hi.array() < lo.array()).any() || (t_lo.array() > hi.array()).any()) continue;
     const double twice = side(t[0], t[1], t[2]);
@@ -208,26 +221,32 @@ bool plane_covers(const ShaftCuller& culler, std::uint32_t seed, const std::arra
     if (twice < 0) std::swap(t[1], t[2]);
     triangles.push_back(t);
   }
-  // Whether they can cover it at all: its area is what they cover of it, what is left, and the
-  // slivers dropped (each under `negligible`, at most 4 per piece and triangle, below), and a
-  // triangle covers no more of it than of its box. Most polygons a plane fails to cover (a
-  // pillar's face, a floor's edge) fail here, before the subtraction.
-  const double negligible = kUncovered * hull_area;
-  {
-    const std::array<Vec2, 4> frame = {lo, Vec2(hi.x(), lo.y()), hi, Vec2(lo.x(), hi.y())};
-    thread_local Polygon part, cut;
-    double reach = 0;
-    for (const auto& t : triangles) {
-      part.assign(t.begin(), t.end());
-      for (std::size_t e = 0; e < 4 && part.size() >= 3; ++e) {
-        clip(part, frame[e], frame[(e + 1) % 4], true, cut);
-        part.swap(cut);
-      }
-      if (part.size() >= 3) reach += area(part);
+}
+
+// Whether the triangles can cover a polygon of area `hull_area` and box (lo, hi) at all, from
+// what each covers of the box and the slivers the subtraction may drop.
+bool may_cover(const std::vector<std::array<Vec2, 3>>& triangles, const Vec2& lo, const Vec2& hi,
+               double hull_area, double negligible) {
+  const std::array<Vec2, 4> frame = {lo, Vec2(hi.x(), lo.y()), hi, Vec2(lo.x(), hi.y())};
+  thread_local Polygon part, cut;
+  double reach = 0;
+  for (const auto& t : triangles) {
+    part.assign(t.begin(), t.end());
+    for (std::size_t e = 0; e < 4 && part.size() >= 3; ++e) {
+      clip(part, frame[e], frame[(e + 1) % 4], true, cut);
+      part.swap(cut);
     }
-    const double dropped = 4.0 * double(kMaxPieces) * double(triangles.size()) * negligible;
-    if (reach + dropped < hull_area * (1 - 1e-9)) return false;
+    if (part.size() >= 3) reach += area(part);
   }
+  const double dropped = 4.0 * double(kMaxPieces) * double(triangles.size()) * negligible;
+  if (reach + dropped < hull_area * (1 - 1e-9)) return false;
+  return true;
+}
+
+// Whether subtracting the triangles (sorted here, the largest first) from the polygon `hull`
+// leaves nothing but pieces under `negligible`; false too where the pieces grow too many.
+bool subtract_covers(std::vector<std::array<Vec2, 3>>& triangles, const Polygon& hull,
+                     double negligible) {
   // The largest first: a wall's big triangles leave the fewest pieces.
   std::sort(triangles.begin(), triangles.end(), [](const auto& a, const auto& b) {
     return side(a[0], a[1], a[2]) > side(b[0], b[1], b[2]);
@@ -271,6 +290,36 @@ bool plane_covers(const ShaftCuller& culler, std::uint32_t seed, const std::arra
     if (pieces.size() > kMaxPieces) return false;
   }
   return false;
+}
+
+// Whether the triangles lying in the plane of triangle `seed` cover every crossing of the plane
+// by a segment from the box's corners `box` to the light's `ends`.
+bool plane_covers(const ShaftCuller& culler, std::uint32_t seed, const std::array<Vec3, 8>& box,
+                  const std::vector<Vec3>& ends, double offset) {
+  const Vec3 n = culler.triangle_normal(seed);
+  const double d = n.dot(culler.triangle_corners(seed)[0]);
+  std::array<double, 8> h_box;
+  thread_local std::vector<double> h_end;
+  if (!box_and_light_apart(n, d, box, ends, offset, h_box, h_end)) return false;
+  // The plane's frame, and the crossings' polygon in it.
+  const Vec3 u = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
+  const Vec3 v = n.cross(u);
+  const PlaneFrame plane{n, d, u, v};
+  thread_local Polygon hull;
+  crossings_hull(plane, box, ends, h_box, h_end, hull);
+  const double hull_area = hull.empty() ? 0.0 : area(hull);
+  if (!(hull_area > 0)) return false;
+  Vec2 lo = hull[0], hi = hull[0];
+  for (const Vec2& p : hull) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  thread_local std::vector<std::array<Vec2, 3>> triangles;
+  triangles_in_plane(culler, plane, hull, lo, hi, triangles);
+  // Whether they can cover it at all: its area is what they cover of it, what is left, and the
+  // slivers dropped (each under `negligible`, at most 4 per piece and triangle, below), and a
+  // triangle covers no more of it than of its box. Most polygons a plane fails to cover (a
+  // pillar's face, a floor's edge) fail here, before the subtraction.
+  const double negligible = kUncovered * hull_area;
+  if (!may_cover(triangles, lo, hi, hull_area, negligible)) return false;
+  return subtract_covers(triangles, hull, negligible);
 }
 
 }  // namespace

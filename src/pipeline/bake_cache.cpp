@@ -11,10 +11,10 @@
 #include <map>
 #include <set>
 
+#include "formats/settings_json.h"
+#include "formats/shard_files.h"
 #include "occluders/shaft_culling.h"
 #include "pipeline/bake_stages.h"
-#include "pipeline/settings_json.h"
-#include "pipeline/shard_files.h"
 #include "source_hash.h"  // generated at build time (CMakeLists.txt, script mode)
 
 namespace sb {
@@ -123,31 +123,22 @@ json key_json(const ReceiverKey& k) {
           {"blockers", k.blockers}};
 }
 
-}  // namespace
-
-Expected<std::vector<ReceiverKey>> receiver_keys(const KeyInputs& in,
-                                                 const std::vector<std::size_t>& objects,
-                                                 const std::vector<int>& sides,
-                                                 std::vector<std::vector<int>>* reaching) {
+// The hash that every receiver's key shares: the build, the settings and what is kept per light.
+std::string settings_hash(const KeyInputs& in) {
   const Scene& scene = *in.scene;
-  const std::vector<Light>& lights = *in.lights;
-  const std::vector<const Mesh*>& blockers = *in.blockers;
-  const bool ambient_occlusion = scene.bake.quantity == Quantity::ambient_occlusion;
-  const bool local = in.local;
+  Hash h;
+  h.text(SHADOWBAKE_VERSION);
+  h.text(SHADOWBAKE_SOURCE_HASH);  // another build's code may give other values
+  h.text(settings_to_json(scene.bake, scene.output).dump());
+  h.number(in.keep_per_light.values ? 1 : 0);
+  h.number(in.keep_per_light.visibility ? 1 : 0);
+  h.number(double(scene.lights.size()));
+  return h.hex();
+}
 
-  std::string settings;
-  {
-    Hash h;
-    h.text(SHADOWBAKE_VERSION);
-    h.text(SHADOWBAKE_SOURCE_HASH);  // another build's code may give other values
-    h.text(settings_to_json(scene.bake, scene.output).dump());
-    h.number(in.keep_per_light.values ? 1 : 0);
-    h.number(in.keep_per_light.visibility ? 1 : 0);
-    h.number(double(scene.lights.size()));
-    settings = h.hex();
-  }
-  // Each light's and blocker's own hash, once.
-  std::vector<std::string> light_hashes(lights.size());
+// Each light's own hash, from its description and its texture's bytes; each texture is read once.
+Expected<std::vector<std::string>> light_hashes(const std::vector<Light>& lights) {
+  std::vector<std::string> hashes(lights.size());
   std::map<fs::path, std::string> textures;
   for (std::size_t l = 0; l < lights.size(); ++l) {
     const LightDesc& d = lights[l].desc();
@@ -177,13 +168,123 @@ Expected<std::vector<ReceiverKey>> receiver_keys(const KeyInputs& in,
       }
       h.text(found->second);
     }
-    light_hashes[l] = h.hex();
+    hashes[l] = h.hex();
   }
-  std::vector<std::string> blocker_hashes(blockers.size());
-  std::vector<Bounds3> blocker_boxes(blockers.size());
+  return hashes;
+}
+
+// The hashes of the lights and blockers, and the blockers' boxes, which all receivers share.
+struct SharedHashes {
+  std::vector<std::string> lights, blockers;
+  std::vector<Bounds3> blocker_boxes;
+};
+
+// A receiver's own hash: its name, lightmap side, UV choice and mesh.
+std::string receiver_hash(const ObjectDesc& obj, int side, const Mesh& mesh) {
+  Hash h;
+  h.text(obj.name);  // its sampling stream's key, too
+  h.number(double(side));
+  h.number(double(obj.uv_channel));
+  h.number(obj.auto_uv ? 1 : 0);
+  h.text(mesh_hash(mesh));
+  return h.hex();
+}
+
+// A receiver's box, and the boxes of its parts from which its shafts are tested.
+struct ReceiverBoxes {
+  Bounds3 box;
+  std::vector<Bounds3> parts;
+};
+
+// Its box, grown for the shadow origins lifted off the surface (texel_space.h), and the
+// boxes of its triangles in each cell of a kCells³ grid over it (by centroid), grown alike:
+// a floor's far end has shafts of its own.
+ReceiverBoxes receiver_boxes(const Mesh& mesh) {
+  Bounds3 box = mesh_bounds(mesh);
+  const Vec3 grow = Vec3::Constant(1e-3 + 1e-2 * box.diagonal());
+  std::vector<Bounds3> parts(std::size_t(kCells * kCells * kCells));
+  const Vec3 extent = (box.hi - box.lo).cwiseMax(Vec3::Constant(1e-12));
+  for (const auto f : mesh.mesh.faces()) {
+    Bounds3 tri;
+    for (const auto v : mesh.mesh.fv_range(f)) {
+      const auto& p = mesh.mesh.point(v);
+      tri.extend(Vec3(p[0], p[1], p[2]));
+    }
+    const Vec3 at = ((tri.centre() - box.lo).cwiseQuotient(extent) * kCells).cwiseMax(0.0);
+    const auto cell = [&](int k) { return std::min(int(at[k]), kCells - 1); };
+    parts[std::size_t((cell(2) * kCells + cell(1)) * kCells + cell(0))].extend(tri);
+  }
+  parts.erase(
+      std::remove_if(parts.begin(), parts.end(), [](const Bounds3& b) { return b.empty(); }),
+      parts.end());
+  for (Bounds3& b : parts) b.lo -= grow, b.hi += grow;
+  box.lo -= grow, box.hi += grow;
+  return {box, std::move(parts)};
+}
+
+// Sets the key's hashes of the lights that may reach the receiver and of the blockers that may
+// lie in its shafts; lists the reaching lights (Light::output) in `reaching` when it is given.
+void hash_reach(const KeyInputs& in, const SharedHashes& shared, const ReceiverBoxes& boxes,
+                ReceiverKey& key, std::vector<int>* reaching) {
+  const Scene& scene = *in.scene;
+  const std::vector<Light>& lights = *in.lights;
+  const std::vector<const Mesh*>& blockers = *in.blockers;
+  const bool ambient_occlusion = scene.bake.quantity == Quantity::ambient_occlusion;
+  const bool local = in.local;
+  const Bounds3& box = boxes.box;
+  std::vector<std::uint8_t> blocker_in(blockers.size(), local ? 0 : 1);
+  Hash lights_hash;
+  if (!ambient_occlusion) {
+    std::vector<std::uint32_t> candidates;
+    for (std::size_t l = 0; l < lights.size(); ++l) {
+      if (!lights[l].may_reach(box)) continue;
+      lights_hash.text(shared.lights[l]);
+      if (reaching) reaching->push_back(lights[l].output());
+      if (!local) continue;
+      for (const Bounds3& part : boxes.parts) {
+        // Too many to list (or no culler): every blocker may be in the shafts.
+        if (in.culler == nullptr ||
+            (in.culler->tile_candidates(part, lights[l], std::size_t(1) << 22, candidates) &&
+             candidates.empty())) {
+          std::fill(blocker_in.begin(), blocker_in.end(), 1);
+          break;
+        }
+        for (std::uint32_t t : candidates) blocker_in[std::size_t(in.culler->mesh_of(t))] = 1;
+      }
+    }
+  } else if (local) {
+    Bounds3 reach = box;
+    reach.lo -= Vec3::Constant(scene.bake.ao_distance);
+    reach.hi += Vec3::Constant(scene.bake.ao_distance);
+    for (std::size_t b = 0; b < blockers.size(); ++b)
+      blocker_in[b] = overlap(reach, shared.blocker_boxes[b]);
+  }
+  key.lights = lights_hash.hex();
+  Hash blockers_hash;
+  for (std::size_t b = 0; b < blockers.size(); ++b)
+    if (blocker_in[b]) blockers_hash.text(shared.blockers[b]);
+  key.blockers = blockers_hash.hex();
+}
+
+}  // namespace
+
+Expected<std::vector<ReceiverKey>> receiver_keys(const KeyInputs& in,
+                                                 const std::vector<std::size_t>& objects,
+                                                 const std::vector<int>& sides,
+                                                 std::vector<std::vector<int>>* reaching) {
+  const Scene& scene = *in.scene;
+  const std::vector<const Mesh*>& blockers = *in.blockers;
+  const std::string settings = settings_hash(in);
+  // Each light's and blocker's own hash, once.
+  SharedHashes shared;
+  auto lights = light_hashes(*in.lights);
+  if (!lights) return lights.error();
+  shared.lights = std::move(*lights);
+  shared.blockers.resize(blockers.size());
+  shared.blocker_boxes.resize(blockers.size());
   tbb::parallel_for(std::size_t(0), blockers.size(), [&](std::size_t b) {
-    blocker_hashes[b] = mesh_hash(*blockers[b]);
-    blocker_boxes[b] = mesh_bounds(*blockers[b]);
+    shared.blockers[b] = mesh_hash(*blockers[b]);
+    shared.blocker_boxes[b] = mesh_bounds(*blockers[b]);
   });
 
   std::vector<ReceiverKey> keys(objects.size());
@@ -192,72 +293,10 @@ Expected<std::vector<ReceiverKey>> receiver_keys(const KeyInputs& in,
   tbb::parallel_for(std::size_t(0), objects.size(), [&](std::size_t r) {
     const std::size_t object = objects[r];
     const Mesh& mesh = (*in.meshes)[object];
-    const ObjectDesc& obj = scene.objects[object];
     ReceiverKey& key = keys[r];
     key.settings = settings;
-    {
-      Hash h;
-      h.text(obj.name);  // its sampling stream's key, too
-      h.number(double(sides[r]));
-      h.number(double(obj.uv_channel));
-      h.number(obj.auto_uv ? 1 : 0);
-      h.text(mesh_hash(mesh));
-      key.receiver = h.hex();
-    }
-    // Its box, grown for the shadow origins lifted off the surface (texel_space.h), and the
-    // boxes of its triangles in each cell of a kCells³ grid over it (by centroid), grown alike:
-    // a floor's far end has shafts of its own.
-    Bounds3 box = mesh_bounds(mesh);
-    const Vec3 grow = Vec3::Constant(1e-3 + 1e-2 * box.diagonal());
-    std::vector<Bounds3> parts(std::size_t(kCells * kCells * kCells));
-    const Vec3 extent = (box.hi - box.lo).cwiseMax(Vec3::Constant(1e-12));
-    for (const auto f : mesh.mesh.faces()) {
-      Bounds3 tri;
-      for (const auto v : mesh.mesh.fv_range(f)) {
-        const auto& p = mesh.mesh.point(v);
-        tri.extend(Vec3(p[0], p[1], p[2]));
-      }
-      const Vec3 at = ((tri.centre() - box.lo).cwiseQuotient(extent) * kCells).cwiseMax(0.0);
-      const auto cell = [&](int k) { return std::min(int(at[k]), kCells - 1); };
-      parts[std::size_t((cell(2) * kCells + cell(1)) * kCells + cell(0))].extend(tri);
-    }
-    parts.erase(
-        std::remove_if(parts.begin(), parts.end(), [](const Bounds3& b) { return b.empty(); }),
-        parts.end());
-    for (Bounds3& b : parts) b.lo -= grow, b.hi += grow;
-    box.lo -= grow, box.hi += grow;
-    std::vector<std::uint8_t> blocker_in(blockers.size(), local ? 0 : 1);
-    Hash lights_hash;
-    if (!ambient_occlusion) {
-      std::vector<std::uint32_t> candidates;
-      for (std::size_t l = 0; l < lights.size(); ++l) {
-        if (!lights[l].may_reach(box)) continue;
-        lights_hash.text(light_hashes[l]);
-        if (reaching) (*reaching)[r].push_back(lights[l].output());
-        if (!local) continue;
-        for (const Bounds3& part : parts) {
-          // Too many to list (or no culler): every blocker may be in the shafts.
-          if (in.culler == nullptr ||
-              (in.culler->tile_candidates(part, lights[l], std::size_t(1) << 22, candidates) &&
-               candidates.empty())) {
-            std::fill(blocker_in.begin(), blocker_in.end(), 1);
-            break;
-          }
-          for (std::uint32_t t : candidates) blocker_in[std::size_t(in.culler->mesh_of(t))] = 1;
-        }
-      }
-    } else if (local) {
-      Bounds3 reach = box;
-      reach.lo -= Vec3::Constant(scene.bake.ao_distance);
-      reach.hi += Vec3::Constant(scene.bake.ao_distance);
-      for (std::size_t b = 0; b < blockers.size(); ++b)
-        blocker_in[b] = overlap(reach, blocker_boxes[b]);
-    }
-    key.lights = lights_hash.hex();
-    Hash blockers_hash;
-    for (std::size_t b = 0; b < blockers.size(); ++b)
-      if (blocker_in[b]) blockers_hash.text(blocker_hashes[b]);
-    key.blockers = blockers_hash.hex();
+    key.receiver = receiver_hash(scene.objects[object], sides[r], mesh);
+    hash_reach(in, shared, receiver_boxes(mesh), key, reaching ? &(*reaching)[r] : nullptr);
   });
   return keys;
 }

@@ -14,9 +14,9 @@
 #include <set>
 #include <sstream>
 
+#include "formats/settings_json.h"
+#include "formats/shard_files.h"
 #include "pipeline/bake_stages.h"
-#include "pipeline/settings_json.h"
-#include "pipeline/shard_files.h"
 #include "pipeline/tiles.h"
 #include "texels/atlas_packing.h"
 
@@ -193,9 +193,13 @@ Status write_shard(OutputFolder& folder, const Scene& scene, const ShardSpec& sp
   return folder.publish(names);
 }
 
-Expected<MergedBake> merge_shards(const std::vector<fs::path>& folders,
-                                  const fs::path& scene_file) {
-  if (folders.empty()) return scene_error("merge: no shard folders given");
+namespace {
+
+using ReceiversByObject = std::map<std::size_t, ReceiverBake>;
+using TilesByObject = std::map<std::size_t, std::vector<ReceiverBake>>;
+
+// Reads each folder's shard description, with the shard's index and the split's count.
+Expected<std::vector<ShardRead>> read_shards(const std::vector<fs::path>& folders) {
   std::vector<ShardRead> shards;
   for (const fs::path& folder : folders) {
     const fs::path file = folder / kShardFile;
@@ -214,7 +218,11 @@ Expected<MergedBake> merge_shards(const std::vector<fs::path>& folders,
     }
     shards.push_back(std::move(s));
   }
+  return shards;
+}
 
+// Checks that every shard comes from the first one's version, scene, settings and split.
+Status check_shards_match(const std::vector<ShardRead>& shards) {
   // One scene, one set of settings, one split, each shard once.
   const ShardRead& first = shards[0];
   const auto same = [&](const ShardRead& s, const char* key) {
@@ -238,7 +246,14 @@ Expected<MergedBake> merge_shards(const std::vector<fs::path>& folders,
                                      s.description.value("hash", "?"),
                                      first.description.value("hash", "?")));
   }
-  const int count = first.count;
+  return Ok{};
+}
+
+// Orders the shards by index, checking that each shard of the split is given exactly once;
+// `folder_count` is how many folders were given, for the message on a missing shard.
+Expected<std::vector<const ShardRead*>> shards_by_index(const std::vector<ShardRead>& shards,
+                                                        std::size_t folder_count) {
+  const int count = shards[0].count;
   std::vector<const ShardRead*> by_index(std::size_t(std::max(count, 0)), nullptr);
   for (const ShardRead& s : shards) {
     if (s.index < 0 || s.index >= count)
@@ -255,18 +270,20 @@ Expected<MergedBake> merge_shards(const std::vector<fs::path>& folders,
       return input_error(
           fmt::format("shard {}/{} is missing: none of the {} folder(s) given holds "
                       "it (bake it with --shard {}/{})",
-                      k, count, folders.size(), k, count));
+                      k, count, folder_count, k, count));
+  return by_index;
+}
 
-  // The scene, as the shards baked it.
-  const json& d = by_index[0]->description;
-  MergedBake merged;
-  const std::string as_given = d.value("scene", "");
-  const std::string path = scene_file.empty() ? d.value("scene_path", "") : scene_file.string();
+// Loads the scene from `path` with the shards' settings, naming it `as_given` as the shards did,
+// and checks that its content still hashes to the shards' hash.
+Status load_baked_scene(const ShardRead& first, const std::string& path,
+                        const std::string& as_given, MergedBake& merged) {
+  const json& d = first.description;
   auto scene = load_scene(path);
   if (!scene) return scene.error();
   merged.scene = std::move(*scene);
   merged.scene.file = as_given;
-  if (Status s = settings_from_json(d.at("settings"), (by_index[0]->folder / kShardFile).string(),
+  if (Status s = settings_from_json(d.at("settings"), (first.folder / kShardFile).string(),
                                     merged.scene.bake, merged.scene.output);
       !s)
     return s.error();
@@ -282,66 +299,115 @@ Expected<MergedBake> merge_shards(const std::vector<fs::path>& folders,
                       "the shards again",
                       path, *hash, d.value("hash", "")));
   }
+  return Ok{};
+}
+
+// Reads one shard's receivers with their timings into `receivers`, or into `tiled` for those
+// baked in tiles, and adds the shard's load and bake times to `result`.
+Status read_shard_receivers(const ShardRead& shard, const Scene& scene, BakeResult& result,
+                            ReceiversByObject& receivers, TilesByObject& tiled) {
+  const std::string where = (shard.folder / kShardFile).string();
+  // Timings are not checked: a shard's time is what it is, and the merged manifest sums them.
+  const auto timings = read_json(shard.folder / kShardTimingsFile, "the shard's timings");
+  if (timings) {
+    result.load_seconds = std::max(result.load_seconds, timings->value("load_seconds", 0.0));
+    result.bake_seconds += timings->value("bake_seconds", 0.0);
+  }
+  for (const json& meta : shard.description.at("receivers")) {
+    std::optional<RowRange> tile;
+    if (const json rows = meta.value("tile", json());
+        rows.is_array() && rows.size() == 2 && rows[0].is_number_integer())
+      tile = RowRange{rows[0].get<int>(), rows[1].get<int>()};
+    const std::string file = receiver_data_file(meta.value("object", 0), tile);
+    auto r = read_receiver(meta, shard.folder / file, where);
+    if (!r) return r.error();
+    if (timings && timings->contains("receivers") && (*timings)["receivers"].contains(file)) {
+      const json& t = (*timings)["receivers"][file];
+      r->seconds = t.value("seconds", 0.0);
+      r->seconds_texels = t.value("texels", 0.0);
+      r->seconds_method = t.value("method", 0.0);
+      r->seconds_dilate = t.value("dilate", 0.0);
+      r->seconds_seams = t.value("seams", 0.0);
+    }
+    const std::size_t object = r->object;
+    if (object >= scene.objects.size() || !scene.objects[object].receiver ||
+        scene.objects[object].name != r->name)
+      return input_error(where + ": receiver '" + r->name + "' is not in the scene");
+    if (r->tile) {
+      tiled[object].push_back(std::move(*r));
+    } else if (!receivers.emplace(object, std::move(*r)).second) {
+      return input_error(where + ": receiver '" + r->name + "' is in two shards");
+    }
+  }
+  return Ok{};
+}
+
+// Joins each tiled receiver's tiles into one receiver and adds it to `receivers`; the scene is
+// read from `path` but its warnings name it `as_given`, as the shards did.
+Status join_tiled_receivers(const Scene& scene, const std::string& path,
+                            const std::string& as_given, TilesByObject& tiled,
+                            ReceiversByObject& receivers) {
+  std::vector<std::vector<ReceiverBake>> lists;
+  for (auto& [object, tiles] : tiled) {
+    if (receivers.count(object))
+      return input_error(fmt::format("receiver '{}' is both whole and in tiles in the shards",
+                                     tiles.front().name));
+    lists.push_back(std::move(tiles));
+  }
+  Scene as_read = scene;
+  as_read.file = path;  // where its meshes lie
+  auto joined = join_tiles(as_read, std::move(lists), "merge");
+  if (!joined) return joined.error();
+  for (ReceiverBake& r : *joined) {
+    // Its warnings name the scene as the shards did.
+    for (std::string& w : r.uv_warnings)
+      if (w.rfind(path, 0) == 0) w = as_given + w.substr(path.size());
+    const std::size_t object = r.object;
+    receivers.emplace(object, std::move(r));
+  }
+  return Ok{};
+}
+
+// Reads the glTF blocker meshes that the first shard wrote.
+Status read_gltf_blockers(const ShardRead& first, BakeResult& result) {
+  for (const json& blocker : first.description.at("gltf_blockers")) {
+    auto mesh =
+        read_gltf_mesh(first.folder / blocker.value("file", ""), blocker.value("checksum", ""));
+    if (!mesh) return mesh.error();
+    result.gltf_blockers.emplace_back(blocker.value("name", ""),
+                                      std::make_shared<const GltfMesh>(std::move(*mesh)));
+  }
+  return Ok{};
+}
+
+}  // namespace
+
+Expected<MergedBake> merge_shards(const std::vector<fs::path>& folders,
+                                  const fs::path& scene_file) {
+  if (folders.empty()) return scene_error("merge: no shard folders given");
+  auto shards = read_shards(folders);
+  if (!shards) return shards.error();
+  if (Status s = check_shards_match(*shards); !s) return s.error();
+  auto by_index = shards_by_index(*shards, folders.size());
+  if (!by_index) return by_index.error();
+
+  // The scene, as the shards baked it.
+  const ShardRead& first = *(*by_index)[0];
+  const json& d = first.description;
+  MergedBake merged;
+  const std::string as_given = d.value("scene", "");
+  const std::string path = scene_file.empty() ? d.value("scene_path", "") : scene_file.string();
+  if (Status s = load_baked_scene(first, path, as_given, merged); !s) return s.error();
 
   // Every receiver once, in scene order; a receiver baked in tiles once its tiles are joined.
   BakeResult& result = merged.result;
-  std::map<std::size_t, ReceiverBake> receivers;
-  std::map<std::size_t, std::vector<ReceiverBake>> tiled;
-  for (const ShardRead* s : by_index) {
-    const std::string where = (s->folder / kShardFile).string();
-    // Timings are not checked: a shard's time is what it is, and the merged manifest sums them.
-    const auto timings = read_json(s->folder / kShardTimingsFile, "the shard's timings");
-    if (timings) {
-      result.load_seconds = std::max(result.load_seconds, timings->value("load_seconds", 0.0));
-      result.bake_seconds += timings->value("bake_seconds", 0.0);
-    }
-    for (const json& meta : s->description.at("receivers")) {
-      std::optional<RowRange> tile;
-      if (const json rows = meta.value("tile", json());
-          rows.is_array() && rows.size() == 2 && rows[0].is_number_integer())
-        tile = RowRange{rows[0].get<int>(), rows[1].get<int>()};
-      const std::string file = receiver_data_file(meta.value("object", 0), tile);
-      auto r = read_receiver(meta, s->folder / file, where);
-      if (!r) return r.error();
-      if (timings && timings->contains("receivers") && (*timings)["receivers"].contains(file)) {
-        const json& t = (*timings)["receivers"][file];
-        r->seconds = t.value("seconds", 0.0);
-        r->seconds_texels = t.value("texels", 0.0);
-        r->seconds_method = t.value("method", 0.0);
-        r->seconds_dilate = t.value("dilate", 0.0);
-        r->seconds_seams = t.value("seams", 0.0);
-      }
-      const std::size_t object = r->object;
-      if (object >= merged.scene.objects.size() || !merged.scene.objects[object].receiver ||
-          merged.scene.objects[object].name != r->name)
-        return input_error(where + ": receiver '" + r->name + "' is not in the scene");
-      if (r->tile) {
-        tiled[object].push_back(std::move(*r));
-      } else if (!receivers.emplace(object, std::move(*r)).second) {
-        return input_error(where + ": receiver '" + r->name + "' is in two shards");
-      }
-    }
-  }
-  {
-    std::vector<std::vector<ReceiverBake>> lists;
-    for (auto& [object, tiles] : tiled) {
-      if (receivers.count(object))
-        return input_error(fmt::format("receiver '{}' is both whole and in tiles in the shards",
-                                       tiles.front().name));
-      lists.push_back(std::move(tiles));
-    }
-    Scene as_read = merged.scene;
-    as_read.file = path;  // where its meshes lie
-    auto joined = join_tiles(as_read, std::move(lists), "merge");
-    if (!joined) return joined.error();
-    for (ReceiverBake& r : *joined) {
-      // Its warnings name the scene as the shards did.
-      for (std::string& w : r.uv_warnings)
-        if (w.rfind(path, 0) == 0) w = as_given + w.substr(path.size());
-      const std::size_t object = r.object;
-      receivers.emplace(object, std::move(r));
-    }
-  }
+  ReceiversByObject receivers;
+  TilesByObject tiled;
+  for (const ShardRead* s : *by_index)
+    if (Status status = read_shard_receivers(*s, merged.scene, result, receivers, tiled); !status)
+      return status.error();
+  if (Status s = join_tiled_receivers(merged.scene, path, as_given, tiled, receivers); !s)
+    return s.error();
   for (std::size_t i = 0; i < merged.scene.objects.size(); ++i) {
     const ObjectDesc& obj = merged.scene.objects[i];
     if (obj.receiver && !receivers.count(i))
@@ -355,13 +421,7 @@ Expected<MergedBake> merge_shards(const std::vector<fs::path>& folders,
     result.receivers.push_back(std::move(r));
   }
   result.setup_warnings = d.at("setup_warnings").get<std::vector<std::string>>();
-  for (const json& blocker : d.at("gltf_blockers")) {
-    auto mesh = read_gltf_mesh(by_index[0]->folder / blocker.value("file", ""),
-                               blocker.value("checksum", ""));
-    if (!mesh) return mesh.error();
-    result.gltf_blockers.emplace_back(blocker.value("name", ""),
-                                      std::make_shared<const GltfMesh>(std::move(*mesh)));
-  }
+  if (Status s = read_gltf_blockers(first, result); !s) return s.error();
   if (merged.scene.output.atlas) result.atlas = pack_atlases(sides, *merged.scene.output.atlas);
   finish_bake(merged.scene, result, true);
   return merged;

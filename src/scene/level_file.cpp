@@ -252,43 +252,61 @@ std::optional<LightDesc> mesh_light(std::vector<Vec3> corners) {
 // bake's own memory check, which counts its lightmaps, is what refuses real levels).
 constexpr double kBytesPerPlacedTriangle = 400;
 
-}  // namespace
-
-bool is_level_file(const fs::path& file) { return lower_extension(file) != ".toml"; }
-
-Expected<LevelContents> import_level(const fs::path& file, const Affine3& placement, int line,
-                                     const ImportLimits& limits) {
-  const std::string where = file.string();
-  auto raw = read_checked_mesh_file(file, limits);
-  if (!raw) return raw.error();
-  LevelContents level;
-  const std::vector<Affine3> world = node_world_transforms(*raw);
-  const nlohmann::json gltf = gltf_document(file);
-  const std::vector<double> strength = emissive_strengths(gltf, raw->materials.size());
-  const std::map<std::string, double> ranges = gltf_light_ranges(gltf);
-  const auto fail = [&](const std::string& node, const std::string& problem) {
-    return scene_error(fmt::format("{}: node '{}': {}", where, node, problem));
-  };
-
-  // Emission per material (radiance, W/(m²·sr), per channel); a negative or non-finite one is an
-  // error naming the first node that uses it.
-  std::vector<Vec3> emission(raw->materials.size(), Vec3::Zero());
-  for (std::size_t m = 0; m < raw->materials.size(); ++m) {
-    const auto& e = raw->materials[m].emissive;
+// Emission per material (radiance, W/(m²·sr), per channel): its emissive colour times its
+// KHR_materials_emissive_strength factor.
+std::vector<Vec3> material_emission(const RawMeshFile& raw, const std::vector<double>& strength) {
+  std::vector<Vec3> emission(raw.materials.size(), Vec3::Zero());
+  for (std::size_t m = 0; m < raw.materials.size(); ++m) {
+    const auto& e = raw.materials[m].emissive;
     emission[m] = Vec3(e[0], e[1], e[2]) * strength[m];
   }
+  return emission;
+}
 
-  std::vector<std::size_t> object_nodes;
+// The steps of import_level, sharing the file's contents, its placement and what it makes.
+struct LevelImport {
+  const fs::path& file;
+  const std::string& where;
+  const Affine3& placement;
+  int line;
+  const RawMeshFile& raw;
+  const std::vector<Affine3>& world;            // per node, its transform in the file
+  const nlohmann::json& gltf;                   // the glTF document, or null for another format
+  const std::map<std::string, double>& ranges;  // per node name, its light's range
+  const std::vector<Vec3>& emission;            // per material
+  LevelContents level;
+  std::set<std::string> light_names;  // those given so far
+
+  Error fail(const std::string& node, const std::string& problem) const {
+    return scene_error(fmt::format("{}: node '{}': {}", where, node, problem));
+  }
+  Status find_object_nodes(const ImportLimits& limits, std::vector<std::size_t>& object_nodes);
+  void add_objects(const std::vector<std::size_t>& object_nodes);
+  Bounds3 level_bounds(const std::vector<std::size_t>& object_nodes) const;
+  std::string light_name(const std::string& node);
+  void add_emissive_lights();
+  Status add_punctual_light(const RawLight& raw_light, const Bounds3& scene_bounds);
+  Status add_sun(const RawLight& raw_light, const Affine3& transform, const Vec3& color,
+                 const Bounds3& scene_bounds);
+  Status add_point_light(const RawLight& raw_light, const Affine3& transform, const Vec3& color,
+                         const Vec3& position);
+};
+
+// The nodes with some non-emissive part, which become objects. A negative or non-finite emission
+// is an error naming the first node that uses it; so are more placed triangles than the bake's
+// memory allows.
+Status LevelImport::find_object_nodes(const ImportLimits& limits,
+                                      std::vector<std::size_t>& object_nodes) {
   double placed_triangles = 0;
-  for (std::size_t n = 0; n < raw->nodes.size(); ++n) {
+  for (std::size_t n = 0; n < raw.nodes.size(); ++n) {
     bool surface = false;
-    for (std::uint32_t p : raw->nodes[n].parts) {
-      const RawMeshPart& part = raw->parts[p];
+    for (std::uint32_t p : raw.nodes[n].parts) {
+      const RawMeshPart& part = raw.parts[p];
       const Vec3 e = part.material < emission.size() ? emission[part.material] : Vec3::Zero();
       if (!e.allFinite() || (e.array() < 0).any()) {
-        return fail(raw->nodes[n].name,
+        return fail(raw.nodes[n].name,
                     fmt::format("material '{}' has a negative or non-finite emission ({}, {}, {})",
-                                raw->materials[part.material].name, e.x(), e.y(), e.z()));
+                                raw.materials[part.material].name, e.x(), e.y(), e.z()));
       }
       surface = surface || !(e.maxCoeff() > 0);
       placed_triangles += double(part.triangles.size() / 3);
@@ -302,12 +320,15 @@ Expected<LevelContents> import_level(const fs::path& file, const Affine3& placem
     return scene_error(fmt::format(
         "{}: its {} nodes place {:.0f} triangles, about {:.1f} GiB once built, more than the "
         "{:.1f} GiB the bake may use; bake fewer instances or raise max_memory (--max-memory)",
-        where, raw->nodes.size(), placed_triangles, bytes / double(1ull << 30),
+        where, raw.nodes.size(), placed_triangles, bytes / double(1ull << 30),
         double(limits.max_memory) / double(1ull << 30)));
   }
+  return Ok{};
+}
 
-  // Objects: a node's non-emissive parts.
-  const auto names = unique_names(*raw, object_nodes, where, level.warnings);
+// Objects: a node's non-emissive parts.
+void LevelImport::add_objects(const std::vector<std::size_t>& object_nodes) {
+  const auto names = unique_names(raw, object_nodes, where, level.warnings);
   for (std::size_t n : object_nodes) {
     ObjectDesc obj;
     obj.name = names.at(n);
@@ -316,53 +337,59 @@ Expected<LevelContents> import_level(const fs::path& file, const Affine3& placem
     obj.transform = placement;
     obj.line = line;
     int channels = kMaxUvChannels;
-    for (std::uint32_t p : raw->nodes[n].parts) {
-      const RawMeshPart& part = raw->parts[p];
+    for (std::uint32_t p : raw.nodes[n].parts) {
+      const RawMeshPart& part = raw.parts[p];
       if (part.material < emission.size() && emission[part.material].maxCoeff() > 0) continue;
       obj.parts.push_back(p);
       channels = std::min(channels, part.uv_channel_count());
     }
-    if (obj.parts.size() == raw->nodes[n].parts.size()) obj.parts.clear();
+    if (obj.parts.size() == raw.nodes[n].parts.size()) obj.parts.clear();
     // The second UV set is the lightmap's by every engine's convention; without one, the bake
     // makes lightmap UVs (channel 0, if any, stays the texture UVs a glTF of the bake carries).
     obj.auto_uv = channels < 2;
     obj.uv_channel = obj.auto_uv ? 0 : 1;
     level.objects.push_back(std::move(obj));
   }
+}
 
-  // The level's extent, for where a sun is put.
+// The level's extent, for where a sun is put.
+Bounds3 LevelImport::level_bounds(const std::vector<std::size_t>& object_nodes) const {
   Bounds3 scene_bounds;
   for (std::size_t n : object_nodes) {
     const Affine3 node_transform = placement * world[n];
-    for (std::uint32_t p : raw->nodes[n].parts) {
-      const std::vector<float>& positions = raw->parts[p].positions;
+    for (std::uint32_t p : raw.nodes[n].parts) {
+      const std::vector<float>& positions = raw.parts[p].positions;
       for (std::size_t i = 0; i + 2 < positions.size(); i += 3)
         scene_bounds.extend(node_transform *
                             Vec3(positions[i], positions[i + 1], positions[i + 2]));
     }
   }
   if (scene_bounds.empty()) scene_bounds.extend(Vec3::Zero());
+  return scene_bounds;
+}
 
-  // Lights: emissive rectangles, discs and other meshes, then the file's punctual lights.
-  std::set<std::string> light_names;
-  const auto light_name = [&](const std::string& node) {
-    std::string name = safe_name(node);
-    for (int k = 2; !light_names.insert(name).second; ++k)
-      name = fmt::format("{}-{}", safe_name(node), k);
-    return name;
-  };
-  for (std::size_t n = 0; n < raw->nodes.size(); ++n) {
-    for (std::uint32_t p : raw->nodes[n].parts) {
-      const RawMeshPart& part = raw->parts[p];
+// A light's name from its node's: file-name-safe, and numbered where an earlier light has it.
+std::string LevelImport::light_name(const std::string& node) {
+  std::string name = safe_name(node);
+  for (int k = 2; !light_names.insert(name).second; ++k)
+    name = fmt::format("{}-{}", safe_name(node), k);
+  return name;
+}
+
+// Lights of the emissive parts: rectangles, discs and other meshes (a warning for each left out).
+void LevelImport::add_emissive_lights() {
+  for (std::size_t n = 0; n < raw.nodes.size(); ++n) {
+    for (std::uint32_t p : raw.nodes[n].parts) {
+      const RawMeshPart& part = raw.parts[p];
       if (part.material >= emission.size() || !(emission[part.material].maxCoeff() > 0)) continue;
-      const std::string& node = raw->nodes[n].name;
+      const std::string& node = raw.nodes[n].name;
       std::vector<Vec3> triangles = world_triangles(part, placement * world[n]);
       std::optional<LightDesc> shape = planar_light(triangles);
       if (!shape) shape = mesh_light(std::move(triangles));
       if (!shape) {
         level.warnings.push_back(fmt::format(
             "{}: node '{}': its emissive material '{}' is on a mesh of no area; it is left out",
-            where, node, raw->materials[part.material].name));
+            where, node, raw.materials[part.material].name));
         continue;
       }
       if (shape->corners.size() / 3 > kMaxMeshLightTriangles) {
@@ -370,7 +397,7 @@ Expected<LevelContents> import_level(const fs::path& file, const Affine3& placem
             "{}: node '{}': its emissive material '{}' is on a mesh of {} triangles, more than "
             "the {} a mesh light may have (each of its triangles or quads is baked as a light); it "
             "is left out",
-            where, node, raw->materials[part.material].name, shape->corners.size() / 3,
+            where, node, raw.materials[part.material].name, shape->corners.size() / 3,
             kMaxMeshLightTriangles));
         continue;
       }
@@ -383,80 +410,120 @@ Expected<LevelContents> import_level(const fs::path& file, const Affine3& placem
       level.lights.push_back(std::move(light));
     }
   }
-  for (const RawLight& raw_light : raw->lights) {
-    const auto node = std::find_if(raw->nodes.begin(), raw->nodes.end(),
-                                   [&](const RawNode& n) { return n.name == raw_light.name; });
-    const Affine3 transform =
-        placement * (node == raw->nodes.end() ? Affine3::Identity()
-                                              : world[std::size_t(node - raw->nodes.begin())]);
-    const Vec3 color(raw_light.color[0], raw_light.color[1], raw_light.color[2]);
-    const Vec3 position =
-        transform * Vec3(raw_light.position[0], raw_light.position[1], raw_light.position[2]);
-    if (!color.allFinite() || (color.array() < 0).any() || !position.allFinite())
-      return fail(raw_light.name, "the light has a negative or non-finite intensity or position");
-    if (raw_light.type != RawLight::point && raw_light.type != RawLight::spot &&
-        raw_light.type != RawLight::directional) {
-      level.warnings.push_back(
-          fmt::format("{}: node '{}': area and ambient lights are not read yet; it is left out",
-                      where, raw_light.name));
-      continue;
-    }
-    if (!(color.maxCoeff() > 0)) continue;  // a light switched off
-    if (raw_light.type == RawLight::directional) {
-      const Vec3 direction =
-          transform.linear() *
-          Vec3(raw_light.direction[0], raw_light.direction[1], raw_light.direction[2]);
-      if (!direction.allFinite() || !(direction.norm() > 0))
-        return fail(raw_light.name, "the sun has a zero or non-finite direction");
-      // glTF's sun is lux; FBX's (as Blender writes it) W/m².
-      const double irradiance =
-          gltf.is_object() ? color.maxCoeff() / kLumensPerWatt : color.maxCoeff();
-      LightDesc sun = sun_light(direction.normalized(), kSunAngleDeg, irradiance, scene_bounds);
-      sun.name = light_name(raw_light.name);
-      sun.color = color / color.maxCoeff();
-      sun.line = line;
-      level.lights.push_back(std::move(sun));
-      continue;
-    }
-    LightDesc light;
-    if (raw_light.type == RawLight::spot) {
-      const Vec3 axis = transform.linear() * Vec3(raw_light.direction[0], raw_light.direction[1],
-                                                  raw_light.direction[2]);
-      // glTF's cone angles are half-angles; Assimp gives FBX's as the whole cone.
-      const double half = gltf.is_object() ? 1.0 : 0.5;
-      light.spot_inner = half * raw_light.inner_cone;
-      light.spot_outer = half * raw_light.outer_cone;
-      if (!axis.allFinite() || !(axis.norm() > 0) || !std::isfinite(light.spot_inner) ||
-          !(light.spot_outer > 0) || !(light.spot_outer < std::numbers::pi))
-        return fail(raw_light.name, "the spot light has a zero or non-finite direction or cone");
-      light.spot_axis = axis.normalized();
-      light.spot_inner = std::clamp(light.spot_inner, 0.0, light.spot_outer);
-    }
-    light.name = light_name(raw_light.name);
-    light.shape = LightShape::sphere;
-    light.position = position;
-    light.radius = kPointLightRadius;  // a point, as glTF's are
-    light.color = color / color.maxCoeff();
-    // glTF's intensity is candela; other formats' (FBX as Blender writes it) is the light's
-    // watts.
-    light.power = gltf.is_object() ? 4 * std::numbers::pi * color.maxCoeff() / kLumensPerWatt
-                                   : color.maxCoeff();
-    light.line = line;
-    if (const auto range = ranges.find(raw_light.name); range != ranges.end()) {
-      // glTF's "range": metres in the file's frame, scaled as the placement scales the level
-      // (its largest axis scale, so that a light reaches at least as far as the file says).
-      const double scale = transform.linear().colwise().norm().maxCoeff();
-      if (!std::isfinite(range->second) || !(range->second > 0))
-        return fail(raw_light.name,
-                    fmt::format("the light's KHR_lights_punctual range is {}; it must be a "
-                                "finite number > 0 (metres), or left out to reach everywhere",
-                                range->second));
-      light.range = range->second * scale;
-      light.shadowmask_range = light.range;
-    }
-    level.lights.push_back(std::move(light));
+}
+
+// One of the file's punctual lights, placed by its node: a sun, a point or spot light, or a
+// warning where it is of a kind not read; none where it is switched off.
+Status LevelImport::add_punctual_light(const RawLight& raw_light, const Bounds3& scene_bounds) {
+  const auto node = std::find_if(raw.nodes.begin(), raw.nodes.end(),
+                                 [&](const RawNode& n) { return n.name == raw_light.name; });
+  const Affine3 transform =
+      placement * (node == raw.nodes.end() ? Affine3::Identity()
+                                           : world[std::size_t(node - raw.nodes.begin())]);
+  const Vec3 color(raw_light.color[0], raw_light.color[1], raw_light.color[2]);
+  const Vec3 position =
+      transform * Vec3(raw_light.position[0], raw_light.position[1], raw_light.position[2]);
+  if (!color.allFinite() || (color.array() < 0).any() || !position.allFinite())
+    return fail(raw_light.name, "the light has a negative or non-finite intensity or position");
+  if (raw_light.type != RawLight::point && raw_light.type != RawLight::spot &&
+      raw_light.type != RawLight::directional) {
+    level.warnings.push_back(
+        fmt::format("{}: node '{}': area and ambient lights are not read yet; it is left out",
+                    where, raw_light.name));
+    return Ok{};
   }
-  return level;
+  if (!(color.maxCoeff() > 0)) return Ok{};  // a light switched off
+  if (raw_light.type == RawLight::directional)
+    return add_sun(raw_light, transform, color, scene_bounds);
+  return add_point_light(raw_light, transform, color, position);
+}
+
+// A directional light as a sun over the level's extent.
+Status LevelImport::add_sun(const RawLight& raw_light, const Affine3& transform, const Vec3& color,
+                            const Bounds3& scene_bounds) {
+  const Vec3 direction = transform.linear() * Vec3(raw_light.direction[0], raw_light.direction[1],
+                                                   raw_light.direction[2]);
+  if (!direction.allFinite() || !(direction.norm() > 0))
+    return fail(raw_light.name, "the sun has a zero or non-finite direction");
+  // glTF's sun is lux; FBX's (as Blender writes it) W/m².
+  const double irradiance = gltf.is_object() ? color.maxCoeff() / kLumensPerWatt : color.maxCoeff();
+  LightDesc sun = sun_light(direction.normalized(), kSunAngleDeg, irradiance, scene_bounds);
+  sun.name = light_name(raw_light.name);
+  sun.color = color / color.maxCoeff();
+  sun.line = line;
+  level.lights.push_back(std::move(sun));
+  return Ok{};
+}
+
+// A point or spot light as a point light (a spot keeping its cone), with its glTF range if any.
+Status LevelImport::add_point_light(const RawLight& raw_light, const Affine3& transform,
+                                    const Vec3& color, const Vec3& position) {
+  LightDesc light;
+  if (raw_light.type == RawLight::spot) {
+    const Vec3 axis = transform.linear() *
+                      Vec3(raw_light.direction[0], raw_light.direction[1], raw_light.direction[2]);
+    // glTF's cone angles are half-angles; Assimp gives FBX's as the whole cone.
+    const double half = gltf.is_object() ? 1.0 : 0.5;
+    light.spot_inner = half * raw_light.inner_cone;
+    light.spot_outer = half * raw_light.outer_cone;
+    if (!axis.allFinite() || !(axis.norm() > 0) || !std::isfinite(light.spot_inner) ||
+        !(light.spot_outer > 0) || !(light.spot_outer < std::numbers::pi))
+      return fail(raw_light.name, "the spot light has a zero or non-finite direction or cone");
+    light.spot_axis = axis.normalized();
+    light.spot_inner = std::clamp(light.spot_inner, 0.0, light.spot_outer);
+  }
+  light.name = light_name(raw_light.name);
+  light.shape = LightShape::sphere;
+  light.position = position;
+  light.radius = kPointLightRadius;  // a point, as glTF's are
+  light.color = color / color.maxCoeff();
+  // glTF's intensity is candela; other formats' (FBX as Blender writes it) is the light's
+  // watts.
+  light.power = gltf.is_object() ? 4 * std::numbers::pi * color.maxCoeff() / kLumensPerWatt
+                                 : color.maxCoeff();
+  light.line = line;
+  if (const auto range = ranges.find(raw_light.name); range != ranges.end()) {
+    // glTF's "range": metres in the file's frame, scaled as the placement scales the level
+    // (its largest axis scale, so that a light reaches at least as far as the file says).
+    const double scale = transform.linear().colwise().norm().maxCoeff();
+    if (!std::isfinite(range->second) || !(range->second > 0))
+      return fail(raw_light.name,
+                  fmt::format("the light's KHR_lights_punctual range is {}; it must be a "
+                              "finite number > 0 (metres), or left out to reach everywhere",
+                              range->second));
+    light.range = range->second * scale;
+    light.shadowmask_range = light.range;
+  }
+  level.lights.push_back(std::move(light));
+  return Ok{};
+}
+
+}  // namespace
+
+bool is_level_file(const fs::path& file) { return lower_extension(file) != ".toml"; }
+
+Expected<LevelContents> import_level(const fs::path& file, const Affine3& placement, int line,
+                                     const ImportLimits& limits) {
+  const std::string where = file.string();
+  auto raw = read_checked_mesh_file(file, limits);
+  if (!raw) return raw.error();
+  const std::vector<Affine3> world = node_world_transforms(*raw);
+  const nlohmann::json gltf = gltf_document(file);
+  const std::vector<double> strength = emissive_strengths(gltf, raw->materials.size());
+  const std::map<std::string, double> ranges = gltf_light_ranges(gltf);
+  const std::vector<Vec3> emission = material_emission(*raw, strength);
+  LevelImport importer{file, where, placement, line, *raw, world, gltf, ranges, emission, {}, {}};
+
+  std::vector<std::size_t> object_nodes;
+  if (Status found = importer.find_object_nodes(limits, object_nodes); !found) return found.error();
+  importer.add_objects(object_nodes);
+  const Bounds3 scene_bounds = importer.level_bounds(object_nodes);
+  // Lights: emissive rectangles, discs and other meshes, then the file's punctual lights.
+  importer.add_emissive_lights();
+  for (const RawLight& raw_light : raw->lights)
+    if (Status added = importer.add_punctual_light(raw_light, scene_bounds); !added)
+      return added.error();
+  return std::move(importer.level);
 }
 
 Expected<Scene> load_level_scene(const fs::path& file, bool need_lights) {

@@ -219,21 +219,33 @@ std::vector<std::size_t> weld_vertices(const std::vector<ImportedVertex>& vertic
   return representative;
 }
 
-Expected<Mesh> build_mesh(const RawMeshFile& file, const std::vector<PartInstance>& instances,
-                          const ObjectDesc& obj, const std::string& path,
-                          const ErrorPrefix& error) {
-  Mesh result;
-  result.name = obj.name;
+// The steps of build_mesh, sharing the object, its parts' instances and the vertices read.
+struct MeshBuild {
+  const RawMeshFile& file;
+  const std::vector<PartInstance>& instances;
+  const ObjectDesc& obj;
+  const std::string& path;
+  const ErrorPrefix& error;
+  Mesh& result;
+  std::vector<ImportedVertex> vertices;   // in world space, all instances concatenated
+  std::vector<std::size_t> first_vertex;  // per instance, the index of its first vertex
+  bool keep_texture_uv = false;
 
-  std::size_t triangle_count = 0;
-  for (const PartInstance& instance : instances)
-    triangle_count += file.parts[instance.part].triangles.size() / 3;
-  if (triangle_count == 0) {
-    return error("'" + path + "' has no triangles (an object needs a surface)");
-  }
+  const RawMeshPart* choose_uv_channel();
+  void choose_texture_uv();
+  Status read_vertices();
+  Status read_vertex(const RawMeshPart& part, std::size_t i, const Affine3& transform,
+                     const Mat3& normal_matrix, bool& uvs_finite);
+  Status check_receiver_uv(const RawMeshPart* part_without_uv) const;
+  double degenerate_area() const;
+  TriMesh::VertexHandle vertex(std::size_t index, std::vector<TriMesh::VertexHandle>& handle);
+  void add_triangles(double min_area);
+};
 
-  // UV channel: every part must carry it for the object to have lightmap UVs. Generated ones
-  // (uv = "auto") are made after import (texels/auto_uv.h): none are read.
+// UV channel: every part must carry it for the object to have lightmap UVs. Generated ones
+// (uv = "auto") are made after import (texels/auto_uv.h): none are read. Returns the first part
+// without it, if any.
+const RawMeshPart* MeshBuild::choose_uv_channel() {
   const bool channel_in_range =
       !obj.auto_uv && obj.uv_channel >= 0 && obj.uv_channel < kMaxUvChannels;
   result.has_uv = channel_in_range;
@@ -245,74 +257,91 @@ Expected<Mesh> build_mesh(const RawMeshFile& file, const std::vector<PartInstanc
       if (!part_without_uv) part_without_uv = &part;
     }
   }
+  return part_without_uv;
+}
 
-  // A receiver's texture UVs (channel 0), when its lightmap UVs are another channel and every
-  // part has them: a glTF of the bake carries them as TEXCOORD_0.
-  bool keep_texture_uv = obj.receiver && (obj.auto_uv || obj.uv_channel != 0);
+// A receiver's texture UVs (channel 0), when its lightmap UVs are another channel and every
+// part has them: a glTF of the bake carries them as TEXCOORD_0.
+void MeshBuild::choose_texture_uv() {
+  keep_texture_uv = obj.receiver && (obj.auto_uv || obj.uv_channel != 0);
   for (const PartInstance& instance : instances)
     keep_texture_uv = keep_texture_uv && !file.parts[instance.part].uvs[0].empty();
+}
 
-  // Vertices in world space, all instances concatenated. UVs are copied only when every part has
-  // the channel, so has_uv says what the texcoords hold.
-  std::vector<ImportedVertex> vertices;
-  std::vector<std::size_t> first_vertex(instances.size());
+// Vertices in world space, all instances concatenated. UVs are copied only when every part has
+// the channel, so has_uv says what the texcoords hold.
+Status MeshBuild::read_vertices() {
+  first_vertex.resize(instances.size());
   bool uvs_finite = true;
   for (std::size_t m = 0; m < instances.size(); ++m) {
     const RawMeshPart& part = file.parts[instances[m].part];
     const Affine3& transform = instances[m].transform;
     const Mat3 normal_matrix = transform.linear().inverse().transpose();
     first_vertex[m] = vertices.size();
-    for (std::size_t i = 0; i < part.vertex_count(); ++i) {
-      ImportedVertex v;
-      const float* p = &part.positions[3 * i];
-      const Vec3 file_position(p[0], p[1], p[2]);
-      if (!file_position.allFinite()) {
-        return error("'" + path + "': vertex " + std::to_string(vertices.size()) +
-                     " (as Assimp numbers them) has a non-finite position " +
-                     format_vec(file_position) + "; fix the mesh file");
-      }
-      v.position = transform * file_position;
-      // Finite but beyond any level (1e30 in a file, or a scale of 1e25): the ray tracer's
-      // float arithmetic overflows on such coordinates, and a float there is coarser than a
-      // texel anyway.
-      if (!(v.position.cwiseAbs().maxCoeff() <= kMaxCoordinate)) {
-        return error(fmt::format(
-            "'{}': vertex {} (as Assimp numbers them) at {} lies beyond {:g} m of the origin{}; "
-            "fix the mesh file or the object's transform",
-            path, vertices.size(), format_vec(v.position), kMaxCoordinate,
-            file_position.cwiseAbs().maxCoeff() <= kMaxCoordinate ? " after its transform" : ""));
-      }
-      v.normal = Vec3::Zero();
-      if (!part.normals.empty()) {
-        const float* n = &part.normals[3 * i];
-        const Vec3 world_normal = normal_matrix * Vec3(n[0], n[1], n[2]);
-        const double length = world_normal.norm();
-        if (std::isfinite(length) && length > 0) v.normal = world_normal / length;
-      }
-      if (result.has_uv) {
-        const float* t = &part.uvs[std::size_t(obj.uv_channel)][3 * i];
-        v.uv = Vec2(t[0], t[1]);
-        if (!v.uv.allFinite()) {
-          if (obj.receiver) {
-            return error("'" + path + "': vertex " + std::to_string(vertices.size()) +
-                         " (as Assimp numbers them) has a non-finite UV in channel " +
-                         std::to_string(obj.uv_channel) + "; fix the mesh file");
-          }
-          uvs_finite = false;
-        }
-      }
-      if (keep_texture_uv) {
-        const float* t = &part.uvs[0][3 * i];
-        v.texture_uv = Vec2(t[0], t[1]);
-        keep_texture_uv = v.texture_uv.allFinite();
-      }
-      vertices.push_back(v);
-    }
+    for (std::size_t i = 0; i < part.vertex_count(); ++i)
+      if (Status read = read_vertex(part, i, transform, normal_matrix, uvs_finite); !read)
+        return read.error();
   }
   if (!uvs_finite) {  // a blocker's unusable UVs are dropped: it needs none
     result.has_uv = false;
     for (ImportedVertex& v : vertices) v.uv = Vec2::Zero();
   }
+  return Ok{};
+}
+
+// Vertex i of `part`, placed by `transform`, appended to the vertices; an error where its
+// position is unusable, or a receiver's UV is. A blocker's non-finite UV clears `uvs_finite`.
+Status MeshBuild::read_vertex(const RawMeshPart& part, std::size_t i, const Affine3& transform,
+                              const Mat3& normal_matrix, bool& uvs_finite) {
+  ImportedVertex v;
+  const float* p = &part.positions[3 * i];
+  const Vec3 file_position(p[0], p[1], p[2]);
+  if (!file_position.allFinite()) {
+    return error("'" + path + "': vertex " + std::to_string(vertices.size()) +
+                 " (as Assimp numbers them) has a non-finite position " +
+                 format_vec(file_position) + "; fix the mesh file");
+  }
+  v.position = transform * file_position;
+  // Finite but beyond any level (1e30 in a file, or a scale of 1e25): the ray tracer's
+  // float arithmetic overflows on such coordinates, and a float there is coarser than a
+  // texel anyway.
+  if (!(v.position.cwiseAbs().maxCoeff() <= kMaxCoordinate)) {
+    return error(fmt::format(
+        "'{}': vertex {} (as Assimp numbers them) at {} lies beyond {:g} m of the origin{}; "
+        "fix the mesh file or the object's transform",
+        path, vertices.size(), format_vec(v.position), kMaxCoordinate,
+        file_position.cwiseAbs().maxCoeff() <= kMaxCoordinate ? " after its transform" : ""));
+  }
+  v.normal = Vec3::Zero();
+  if (!part.normals.empty()) {
+    const float* n = &part.normals[3 * i];
+    const Vec3 world_normal = normal_matrix * Vec3(n[0], n[1], n[2]);
+    const double length = world_normal.norm();
+    if (std::isfinite(length) && length > 0) v.normal = world_normal / length;
+  }
+  if (result.has_uv) {
+    const float* t = &part.uvs[std::size_t(obj.uv_channel)][3 * i];
+    v.uv = Vec2(t[0], t[1]);
+    if (!v.uv.allFinite()) {
+      if (obj.receiver) {
+        return error("'" + path + "': vertex " + std::to_string(vertices.size()) +
+                     " (as Assimp numbers them) has a non-finite UV in channel " +
+                     std::to_string(obj.uv_channel) + "; fix the mesh file");
+      }
+      uvs_finite = false;
+    }
+  }
+  if (keep_texture_uv) {
+    const float* t = &part.uvs[0][3 * i];
+    v.texture_uv = Vec2(t[0], t[1]);
+    keep_texture_uv = v.texture_uv.allFinite();
+  }
+  vertices.push_back(v);
+  return Ok{};
+}
+
+// A receiver without lightmap UVs, read or made, is an error naming the channel it asked for.
+Status MeshBuild::check_receiver_uv(const RawMeshPart* part_without_uv) const {
   if (obj.receiver && !result.has_uv && !obj.auto_uv) {
     const int channels = part_without_uv ? part_without_uv->uv_channel_count() : 0;
     const std::string channel = std::to_string(obj.uv_channel);
@@ -322,29 +351,39 @@ Expected<Mesh> build_mesh(const RawMeshFile& file, const std::vector<PartInstanc
                                 : "only " + std::to_string(channels) + " UV channel(s)") +
                  "; add a lightmap UV set or set 'uv' to an existing channel");
   }
+  return Ok{};
+}
 
-  // Degenerate threshold relative to the object's size, from the vertices faces use.
+// Degenerate threshold relative to the object's size, from the vertices faces use.
+double MeshBuild::degenerate_area() const {
   Bounds3 bounds;
   for (std::size_t m = 0; m < instances.size(); ++m)
     for (const std::uint32_t index : file.parts[instances[m].part].triangles)
       bounds.extend(vertices[first_vertex[m] + index].position);
   const double diagonal = bounds.diagonal();
-  const double min_area = kDegenerateAreaFraction * diagonal * diagonal;
+  return kDegenerateAreaFraction * diagonal * diagonal;
+}
 
+// The mesh vertex of vertex `index`, added on first use (`handle` holds those made so far).
+TriMesh::VertexHandle MeshBuild::vertex(std::size_t index,
+                                        std::vector<TriMesh::VertexHandle>& handle) {
+  TriMesh& mesh = result.mesh;
+  if (!handle[index].is_valid()) {
+    const ImportedVertex& v = vertices[index];
+    handle[index] = mesh.add_vertex(TriMesh::Point(v.position.x(), v.position.y(), v.position.z()));
+    mesh.set_normal(handle[index], TriMesh::Normal(v.normal.x(), v.normal.y(), v.normal.z()));
+    mesh.set_texcoord2D(handle[index], TriMesh::TexCoord2D(v.uv.x(), v.uv.y()));
+    if (keep_texture_uv) result.texture_uv.push_back(v.texture_uv);
+  }
+  return handle[index];
+}
+
+// The triangles of every instance on the welded vertices, wound as their vertex normals say;
+// those of no more than `min_area` are skipped and counted, as are non-manifold ones split off.
+void MeshBuild::add_triangles(double min_area) {
   TriMesh& mesh = result.mesh;
   const std::vector<std::size_t> welded = weld_vertices(vertices, file, instances);
   std::vector<TriMesh::VertexHandle> handle(vertices.size());  // made on first use
-  auto vertex = [&](std::size_t index) {
-    if (!handle[index].is_valid()) {
-      const ImportedVertex& v = vertices[index];
-      handle[index] =
-          mesh.add_vertex(TriMesh::Point(v.position.x(), v.position.y(), v.position.z()));
-      mesh.set_normal(handle[index], TriMesh::Normal(v.normal.x(), v.normal.y(), v.normal.z()));
-      mesh.set_texcoord2D(handle[index], TriMesh::TexCoord2D(v.uv.x(), v.uv.y()));
-      if (keep_texture_uv) result.texture_uv.push_back(v.texture_uv);
-    }
-    return handle[index];
-  };
   for (std::size_t m = 0; m < instances.size(); ++m) {
     const std::vector<std::uint32_t>& triangles = file.parts[instances[m].part].triangles;
     const bool mirrors = instances[m].transform.linear().determinant() < 0;
@@ -366,18 +405,15 @@ Expected<Mesh> build_mesh(const RawMeshFile& file, const std::vector<PartInstanc
         ++result.skipped_degenerate;
         continue;
       }
-      if (!add_triangle(mesh, vertex(index[0]), vertex(index[1]), vertex(index[2]),
-                        result.texture_uv))
+      if (!add_triangle(mesh, vertex(index[0], handle), vertex(index[1], handle),
+                        vertex(index[2], handle), result.texture_uv))
         ++result.split_nonmanifold;
     }
   }
-  if (mesh.n_faces() == 0) {
-    return error("every one of the " + std::to_string(triangle_count) + " triangles of '" + path +
-                 "' has zero area; fix the mesh file or its scale");
-  }
-  mesh.update_face_normals();
+}
 
-  // A vertex whose file normal was missing or unusable takes the area-weighted mean of its faces'.
+// A vertex whose file normal was missing or unusable takes the area-weighted mean of its faces'.
+void fill_missing_normals(TriMesh& mesh) {
   for (auto v : mesh.vertices()) {
     if (mesh.normal(v).sqrnorm() > 0) continue;
     TriMesh::Normal sum(0, 0, 0);
@@ -385,6 +421,34 @@ Expected<Mesh> build_mesh(const RawMeshFile& file, const std::vector<PartInstanc
     const double length = sum.norm();
     mesh.set_normal(v, length > 0 ? sum / length : TriMesh::Normal(0, 0, 1));
   }
+}
+
+Expected<Mesh> build_mesh(const RawMeshFile& file, const std::vector<PartInstance>& instances,
+                          const ObjectDesc& obj, const std::string& path,
+                          const ErrorPrefix& error) {
+  Mesh result;
+  result.name = obj.name;
+
+  std::size_t triangle_count = 0;
+  for (const PartInstance& instance : instances)
+    triangle_count += file.parts[instance.part].triangles.size() / 3;
+  if (triangle_count == 0) {
+    return error("'" + path + "' has no triangles (an object needs a surface)");
+  }
+
+  MeshBuild build{file, instances, obj, path, error, result, {}, {}, false};
+  const RawMeshPart* part_without_uv = build.choose_uv_channel();
+  build.choose_texture_uv();
+  if (Status read = build.read_vertices(); !read) return read.error();
+  if (Status checked = build.check_receiver_uv(part_without_uv); !checked) return checked.error();
+  build.add_triangles(build.degenerate_area());
+  TriMesh& mesh = result.mesh;
+  if (mesh.n_faces() == 0) {
+    return error("every one of the " + std::to_string(triangle_count) + " triangles of '" + path +
+                 "' has zero area; fix the mesh file or its scale");
+  }
+  mesh.update_face_normals();
+  fill_missing_normals(mesh);
   return result;
 }
 

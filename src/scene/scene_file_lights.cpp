@@ -159,6 +159,188 @@ Expected<LightDesc> read_sky(TableReader& r, const std::filesystem::path& file, 
   return light;
 }
 
+// A light's `name`, required and not empty; the table's later errors name the light by it.
+void read_light_name(TableReader& r, LightDesc& light) {
+  if (r.require("name")) {
+    if (auto name = r.string("name")) {
+      if (name->empty()) {
+        r.fail("name", "'name' must not be empty");
+      } else {
+        light.name = *name;
+        r.set_item(item_name("light", light.name));
+      }
+    }
+  }
+}
+
+// Refuses keys no [[light]] table has.
+void check_light_keys(TableReader& r) {
+  r.check_known_keys({"name",
+                      "shape",
+                      "position",
+                      "normal",
+                      "up",
+                      "size",
+                      "radius",
+                      "color",
+                      "power",
+                      "texture",
+                      "shadowmask_range",
+                      "range",
+                      "direction",
+                      "angle_deg",
+                      "irradiance",
+                      "cone_deg",
+                      "blend",
+                      "strength",
+                      "map",
+                      "rotation_deg",
+                      "parts",
+                      "model",
+                      "turbidity",
+                      "sun",
+                      "sun_direction"});
+}
+
+// Refuses a sun's and a sky's keys on a local light (`shape_name`), and reads a spot's cone or
+// refuses its keys on any other.
+void read_spot_or_forbid(TableReader& r, LightDesc& light, bool spot,
+                         const std::string& shape_name) {
+  for (const char* key : {"angle_deg", "irradiance"})
+    r.forbid(key, fmt::format("applies only to sun lights, not {}", shape_name));
+  for (const char* key :
+       {"strength", "map", "rotation_deg", "parts", "model", "turbidity", "sun", "sun_direction"})
+    r.forbid(key, fmt::format("applies only to sky lights, not {}", shape_name));
+  if (spot) {
+    read_cone(r, light);
+  } else {
+    for (const char* key : {"direction", "cone_deg", "blend"})
+      r.forbid(key, fmt::format("applies only to spot lights, not {}", shape_name));
+  }
+}
+
+// A rectangle's or disk's `normal`, and a rectangle's `up` made perpendicular to it (a default
+// height axis where it has none); both refused where they do not apply.
+void read_orientation(TableReader& r, LightDesc& light, const std::string& shape_name) {
+  const bool is_rectangle = light.shape == LightShape::rectangle;
+  const bool is_sphere = light.shape == LightShape::sphere;
+  if (is_sphere) {
+    r.forbid("normal",
+             fmt::format("applies only to rectangle and disk lights, not {}", shape_name));
+  } else if (r.require("normal")) {
+    if (auto v = r.vec3("normal", "3 finite numbers, not all zero", is_finite)) {
+      if (v->isZero(0)) r.fail_got("normal", "3 finite numbers, not all zero");
+      light.normal = v->normalized();
+    }
+  }
+
+  if (!is_rectangle) {
+    r.forbid("up", fmt::format("applies only to rectangle lights, not {}", shape_name));
+    if (!is_sphere) light.up = default_up(light.normal);
+  } else if (r.find("up")) {
+    if (auto v = r.vec3("up", "3 finite numbers, not all zero", is_finite)) {
+      // Gram-Schmidt: keep only the part of up across the normal.
+      const Vec3 across = *v - v->dot(light.normal) * light.normal;
+      if (v->isZero(0)) {
+        r.fail_got("up", "3 finite numbers, not all zero");
+      } else if (across.norm() < parallel_sine * v->norm()) {
+        r.fail("up", fmt::format("'up' must not be parallel to 'normal', got {} with normal {}",
+                                 describe(*r.find("up")), describe(*r.find("normal"))));
+      } else {
+        light.up = across.normalized();
+      }
+    }
+  } else {
+    light.up = default_up(light.normal);
+  }
+}
+
+// A rectangle's `size` or a disk's, sphere's or spot's `radius`, each refused where it does not
+// apply; a sphere's radius is at least kPointLightRadius.
+void read_extent(TableReader& r, LightDesc& light, bool spot, const std::string& shape_name) {
+  const bool is_rectangle = light.shape == LightShape::rectangle;
+  const bool is_sphere = light.shape == LightShape::sphere;
+  if (!is_rectangle) {
+    r.forbid("size", fmt::format("applies only to rectangle lights, not {}", shape_name));
+  } else if (r.require("size")) {
+    if (auto v =
+            r.numbers("size", 2, "2 positive numbers (width, height in metres)", is_positive)) {
+      light.width = (*v)[0];
+      light.height = (*v)[1];
+    }
+  }
+
+  if (is_rectangle) {
+    r.forbid("radius", "applies only to disk and sphere lights, not rectangle");
+  } else if (spot && !r.find("radius")) {
+    light.radius = kPointLightRadius;  // a spot is a point unless given a radius
+  } else if (r.require("radius")) {
+    // Both `radius = 0.1` and `radius = [0.1]` are accepted; a sphere's may be 0, a point light.
+    const std::string_view requirement = is_sphere
+                                             ? "a number >= 0 or [r] (metres; 0: a point light)"
+                                             : "a positive number or [r] (metres)";
+    const auto valid = [&](double x) {
+      return is_sphere ? std::isfinite(x) && x >= 0 : is_positive(x);
+    };
+    if (r.find("radius")->is_array()) {
+      if (auto v = r.numbers("radius", 1, requirement, valid)) light.radius = (*v)[0];
+    } else if (auto v = r.number("radius", requirement, valid)) {
+      light.radius = *v;
+    }
+    if (is_sphere && light.radius < kPointLightRadius) light.radius = kPointLightRadius;
+  }
+}
+
+// A local light's `color` and `power`, refused where their exitance is outside what a lightmap
+// holds.
+void read_emission(TableReader& r, LightDesc& light) {
+  const bool is_rectangle = light.shape == LightShape::rectangle;
+  const bool is_sphere = light.shape == LightShape::sphere;
+  const std::string_view color_requirement = "3 finite numbers >= 0, not all zero";
+  if (auto v =
+          r.vec3("color", color_requirement, [](double x) { return std::isfinite(x) && x >= 0; })) {
+    if (v->isZero(0)) r.fail_got("color", color_requirement);
+    light.color = *v;
+  }
+
+  if (r.require("power")) {
+    if (auto v = r.number("power", "a finite number > 0 (watts)", is_positive)) light.power = *v;
+  }
+  if (!r.failed() && light.power > 0) {
+    // Radiant exitance of the brightest channel. Irradiance never exceeds it (a form factor is at
+    // most 1); the bounds keep every lightmap value a normal 32-bit float.
+    const double area = is_rectangle ? light.width * light.height
+                        : is_sphere  ? 4 * std::numbers::pi * light.radius * light.radius
+                                     : std::numbers::pi * light.radius * light.radius;
+    const double exitance = light.power * light.color.maxCoeff() / area;
+    constexpr double kMaxExitance = 1e15;  // the Sun's surface: 6.3e7 W/m²
+    constexpr double kMinExitance = 1e-15;
+    if (!(exitance <= kMaxExitance) || !(exitance >= kMinExitance)) {
+      r.fail("power",
+             fmt::format("'power' {} W over {} m² is an exitance of {} W/m², outside "
+                         "the {} to {} W/m² a lightmap holds; check 'power' and the "
+                         "light's size",
+                         format_double(light.power), format_double(area), format_double(exitance),
+                         format_double(kMinExitance), format_double(kMaxExitance)));
+    }
+  }
+}
+
+// A local light's `texture` (refused on a sphere), `range` and `shadowmask_range`.
+void read_texture_and_range(TableReader& r, const std::filesystem::path& file, LightDesc& light) {
+  if (light.shape == LightShape::sphere) {
+    r.forbid("texture", "applies only to rectangle and disk lights, not sphere");
+  } else if (r.find("texture")) {
+    if (auto texture = existing_file(r, file, "texture", "texture image")) light.texture = *texture;
+  }
+  if (auto v = r.number("range", "a finite number > 0 (metres from its centre)", is_positive)) {
+    light.range = *v;
+    light.shadowmask_range = *v;
+  }
+  if (auto v = r.number("shadowmask_range", "a number > 0 (metres)", is_positive))
+    light.shadowmask_range = *v;
+}
+
 }  // namespace
 
 Status resolve_sky_suns(const std::filesystem::path& file, std::vector<LightDesc>& lights) {
@@ -201,41 +383,8 @@ Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::ta
   TableReader r(file, table, fmt::format("[[light]] #{}", index + 1));
   LightDesc light;
   light.line = static_cast<int>(r.line());
-  if (r.require("name")) {
-    if (auto name = r.string("name")) {
-      if (name->empty()) {
-        r.fail("name", "'name' must not be empty");
-      } else {
-        light.name = *name;
-        r.set_item(item_name("light", light.name));
-      }
-    }
-  }
-  r.check_known_keys({"name",
-                      "shape",
-                      "position",
-                      "normal",
-                      "up",
-                      "size",
-                      "radius",
-                      "color",
-                      "power",
-                      "texture",
-                      "shadowmask_range",
-                      "range",
-                      "direction",
-                      "angle_deg",
-                      "irradiance",
-                      "cone_deg",
-                      "blend",
-                      "strength",
-                      "map",
-                      "rotation_deg",
-                      "parts",
-                      "model",
-                      "turbidity",
-                      "sun",
-                      "sun_direction"});
+  read_light_name(r, light);
+  check_light_keys(r);
   bool spot = false;
   if (r.require("shape")) {
     if (auto shape = r.string("shape")) {
@@ -259,123 +408,14 @@ Expected<LightDesc> read_light(const std::filesystem::path& file, const toml::ta
   }
   if (r.failed()) return r.error();  // every later key depends on the shape
   const std::string shape_name = spot ? "spot" : to_string(light.shape);
-  for (const char* key : {"angle_deg", "irradiance"})
-    r.forbid(key, fmt::format("applies only to sun lights, not {}", shape_name));
-  for (const char* key :
-       {"strength", "map", "rotation_deg", "parts", "model", "turbidity", "sun", "sun_direction"})
-    r.forbid(key, fmt::format("applies only to sky lights, not {}", shape_name));
-  if (spot) {
-    read_cone(r, light);
-  } else {
-    for (const char* key : {"direction", "cone_deg", "blend"})
-      r.forbid(key, fmt::format("applies only to spot lights, not {}", shape_name));
-  }
-  const bool is_rectangle = light.shape == LightShape::rectangle;
-  const bool is_sphere = light.shape == LightShape::sphere;
-
+  read_spot_or_forbid(r, light, spot, shape_name);
   if (r.require("position")) {
     if (auto v = r.vec3("position", "3 finite numbers (metres)", is_finite)) light.position = *v;
   }
-
-  if (is_sphere) {
-    r.forbid("normal",
-             fmt::format("applies only to rectangle and disk lights, not {}", shape_name));
-  } else if (r.require("normal")) {
-    if (auto v = r.vec3("normal", "3 finite numbers, not all zero", is_finite)) {
-      if (v->isZero(0)) r.fail_got("normal", "3 finite numbers, not all zero");
-      light.normal = v->normalized();
-    }
-  }
-
-  if (!is_rectangle) {
-    r.forbid("up", fmt::format("applies only to rectangle lights, not {}", shape_name));
-    if (!is_sphere) light.up = default_up(light.normal);
-  } else if (r.find("up")) {
-    if (auto v = r.vec3("up", "3 finite numbers, not all zero", is_finite)) {
-      // Gram-Schmidt: keep only the part of up across the normal.
-      const Vec3 across = *v - v->dot(light.normal) * light.normal;
-      if (v->isZero(0)) {
-        r.fail_got("up", "3 finite numbers, not all zero");
-      } else if (across.norm() < parallel_sine * v->norm()) {
-        r.fail("up", fmt::format("'up' must not be parallel to 'normal', got {} with normal {}",
-                                 describe(*r.find("up")), describe(*r.find("normal"))));
-      } else {
-        light.up = across.normalized();
-      }
-    }
-  } else {
-    light.up = default_up(light.normal);
-  }
-
-  if (!is_rectangle) {
-    r.forbid("size", fmt::format("applies only to rectangle lights, not {}", shape_name));
-  } else if (r.require("size")) {
-    if (auto v =
-            r.numbers("size", 2, "2 positive numbers (width, height in metres)", is_positive)) {
-      light.width = (*v)[0];
-      light.height = (*v)[1];
-    }
-  }
-
-  if (is_rectangle) {
-    r.forbid("radius", "applies only to disk and sphere lights, not rectangle");
-  } else if (spot && !r.find("radius")) {
-    light.radius = kPointLightRadius;  // a spot is a point unless given a radius
-  } else if (r.require("radius")) {
-    // Both `radius = 0.1` and `radius = [0.1]` are accepted; a sphere's may be 0, a point light.
-    const std::string_view requirement = is_sphere
-                                             ? "a number >= 0 or [r] (metres; 0: a point light)"
-                                             : "a positive number or [r] (metres)";
-    const auto valid = [&](double x) {
-      return is_sphere ? std::isfinite(x) && x >= 0 : is_positive(x);
-    };
-    if (r.find("radius")->is_array()) {
-      if (auto v = r.numbers("radius", 1, requirement, valid)) light.radius = (*v)[0];
-    } else if (auto v = r.number("radius", requirement, valid)) {
-      light.radius = *v;
-    }
-    if (is_sphere && light.radius < kPointLightRadius) light.radius = kPointLightRadius;
-  }
-
-  const std::string_view color_requirement = "3 finite numbers >= 0, not all zero";
-  if (auto v =
-          r.vec3("color", color_requirement, [](double x) { return std::isfinite(x) && x >= 0; })) {
-    if (v->isZero(0)) r.fail_got("color", color_requirement);
-    light.color = *v;
-  }
-
-  if (r.require("power")) {
-    if (auto v = r.number("power", "a finite number > 0 (watts)", is_positive)) light.power = *v;
-  }
-  if (!r.failed() && light.power > 0) {
-    // Radiant exitance of the brightest channel. Irradiance never exceeds it (a form factor is at
-    // most 1); the bounds keep every lightmap value a normal 32-bit float.
-    const double area = is_rectangle ? light.width * light.height
-                        : is_sphere  ? 4 * std::numbers::pi * light.radius * light.radius
-                                     : std::numbers::pi * light.radius * light.radius;
-    const double exitance = light.power * light.color.maxCoeff() / area;
-    constexpr double kMaxExitance = 1e15;  // the Sun's surface: 6.3e7 W/m²
-    constexpr double kMinExitance = 1e-15;
-    if (!(exitance <= kMaxExitance) || !(exitance >= kMinExitance)) {
-      r.fail("power",
-             fmt::format("'power' {} W over {} m² is an exitance of {} W/m², outside "
-                         "the {} to {} W/m² a lightmap holds; check 'power' and the "
-                         "light's size",
-                         format_double(light.power), format_double(area), format_double(exitance),
-                         format_double(kMinExitance), format_double(kMaxExitance)));
-    }
-  }
-  if (is_sphere) {
-    r.forbid("texture", "applies only to rectangle and disk lights, not sphere");
-  } else if (r.find("texture")) {
-    if (auto texture = existing_file(r, file, "texture", "texture image")) light.texture = *texture;
-  }
-  if (auto v = r.number("range", "a finite number > 0 (metres from its centre)", is_positive)) {
-    light.range = *v;
-    light.shadowmask_range = *v;
-  }
-  if (auto v = r.number("shadowmask_range", "a number > 0 (metres)", is_positive))
-    light.shadowmask_range = *v;
+  read_orientation(r, light, shape_name);
+  read_extent(r, light, spot, shape_name);
+  read_emission(r, light);
+  read_texture_and_range(r, file, light);
   if (r.failed()) return r.error();
   return light;
 }

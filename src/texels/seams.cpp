@@ -105,6 +105,101 @@ void add_crossings(const Vec2& p0, const Vec2& p1, int width, int height,
   }
 }
 
+// One channel of an image as a right-hand side of the solve: its baked values x0, its bounds lo
+// and hi per unknown, the values the priors pull towards, and the solution.
+struct SeamChannel {
+  std::size_t c;
+  std::vector<double> x0, lo, hi, target;
+  Eigen::VectorXd x;
+};
+
+// The priors as a diagonal matrix. Added as a matrix: coeffRef on a diagonal entry the seam
+// terms lack would insert into the compressed storage, one shift of all entries each.
+Eigen::SparseMatrix<double> prior_matrix(const std::vector<double>& prior) {
+  const std::size_t n = prior.size();
+  std::vector<Eigen::Triplet<double>> diagonal;
+  diagonal.reserve(n);
+  for (std::size_t u = 0; u < n; ++u)
+    diagonal.emplace_back(Eigen::Index(u), Eigen::Index(u), prior[u]);
+  Eigen::SparseMatrix<double> priors(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
+  priors.setFromTriplets(diagonal.begin(), diagonal.end());
+  return priors;
+}
+
+// Holds each unknown some channel's solution put outside its bounds (a prior of kHeldPrior) at
+// the bound it crossed; returns whether any was.
+bool hold_out_of_bounds(std::vector<double>& prior, std::vector<SeamChannel>& rhs_of) {
+  bool held_more = false;
+  for (std::size_t u = 0; u < prior.size(); ++u) {
+    if (prior[u] >= kHeldPrior) continue;
+    bool out = false;
+    for (const SeamChannel& ch : rhs_of) {
+      const double slack = 1e-6 * (ch.hi[u] - ch.lo[u]);
+      const double x = ch.x[Eigen::Index(u)];
+      out = out || x < ch.lo[u] - slack || x > ch.hi[u] + slack;
+    }
+    if (!out) continue;
+    prior[u] = kHeldPrior;
+    for (SeamChannel& ch : rhs_of)
+      ch.target[u] = std::clamp(ch.x[Eigen::Index(u)], ch.lo[u], ch.hi[u]);
+    held_more = true;
+  }
+  return held_more;
+}
+
+// Solves (seam terms + priors) x = priors × target for every channel, in rounds that hold the
+// unknowns leaving their bounds; false where the solver fails (the image then stays as baked).
+//
+// Where the seams cannot be matched within the texel grid (a chart narrower than a bilinear
+// footprint, charts closer than one), the unconstrained solution overshoots: it would put
+// values into the lightmap that nothing baked (a visibility below 0). An active set keeps each
+// unknown within its bounds: the unknowns that left them are held at the bound they crossed
+// (a prior of kHeldPrior) and the system is solved again, until none leaves them.
+// A direct factorisation (LDLᵀ) where its factor stays sparse, as it does for seams between a
+// few dozen charts; else conjugate gradients, preconditioned by an incomplete Cholesky factor
+// and started from the baked values (then from the last round's solution). Where every edge is
+// a seam (Lightmap Pack's chart per quad couples texels all over the image) the factor fills in
+// almost completely: 95 s for Suzanne at 256², against 7 s by conjugate gradients; on Smart UV
+// Project's layouts the factorisation is 20 times faster than the iteration.
+bool solve_within_bounds(const Eigen::SparseMatrix<double>& seam_terms, std::vector<double>& prior,
+                         std::vector<SeamChannel>& rhs_of, SeamSolver solver) {
+  const std::size_t n = prior.size();
+  MeasuredLdlt ldlt;
+  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
+                           Eigen::IncompleteCholesky<double>>
+      iterative;
+  iterative.setTolerance(kSolveTolerance);
+  bool direct = true;
+  for (SeamChannel& ch : rhs_of)
+    ch.x = Eigen::Map<const Eigen::VectorXd>(ch.x0.data(), Eigen::Index(n));
+  for (int round = 0; round < kMaxRounds; ++round) {
+    const Eigen::SparseMatrix<double> priors = prior_matrix(prior);
+    const Eigen::SparseMatrix<double> normal = seam_terms + priors;
+    if (round == 0) {
+      ldlt.analyzePattern(normal);
+      direct = solver == SeamSolver::automatic
+                   ? ldlt.factor_entries() <= kMaxFactorEntriesPerUnknown * double(n)
+                   : solver == SeamSolver::factorised;
+    }
+    if (direct) {
+      ldlt.factorize(normal);
+      if (ldlt.info() != Eigen::Success) return false;
+    } else {
+      iterative.compute(normal);
+      if (iterative.info() != Eigen::Success) return false;
+    }
+    for (SeamChannel& ch : rhs_of) {
+      Eigen::VectorXd rhs(static_cast<Eigen::Index>(n));
+      for (std::size_t u = 0; u < n; ++u) rhs[Eigen::Index(u)] = prior[u] * ch.target[u];
+      const Eigen::VectorXd guess = ch.x;
+      ch.x = direct ? Eigen::VectorXd(ldlt.solve(rhs))
+                    : Eigen::VectorXd(iterative.solveWithGuess(rhs, guess));
+    }
+    if (!hold_out_of_bounds(prior, rhs_of)) break;
+  }
+  return true;
+}
+
 }  // namespace
 
 std::vector<SeamEdge> find_seams(const Mesh& mesh) {
@@ -229,17 +324,52 @@ SeamDifference SeamStitcher::difference(const Image& image,
   return out;
 }
 
-void SeamStitcher::stitch(Image& image, const std::vector<std::uint8_t>& arbitrary,
-                          SeamSolver solver) const {
+// Covered texels keep their baked values with kCoveredPrior, margin texels with kMarginPrior;
+// arbitrary texels keep theirs (kHeldPrior), and the samples that read them ask nothing.
+std::vector<double> SeamStitcher::prior_weights(const std::vector<std::uint8_t>& arbitrary) const {
   const std::size_t n = texel_.size();
-  if (n == 0) return;
-  // Covered texels keep their baked values with kCoveredPrior, margin texels with kMarginPrior;
-  // arbitrary texels keep theirs (kHeldPrior), and the samples that read them ask nothing.
   std::vector<double> prior(n);
   for (std::size_t u = 0; u < n; ++u) {
     const bool arbitrary_texel = !arbitrary.empty() && arbitrary[std::size_t(texel_[u])];
     prior[u] = arbitrary_texel ? kHeldPrior : covered_[u] ? kCoveredPrior : kMarginPrior;
   }
+  return prior;
+}
+
+// A channel's bounds per unknown, from its baked values x0: the smallest and largest x0 among the
+// covered texels that share a solved sample with the unknown, or among all its texels for a
+// sample that reads none; an unknown no solved sample reads is bound to its own x0.
+void SeamStitcher::channel_bounds(const std::vector<std::uint8_t>& arbitrary,
+                                  const std::vector<double>& prior, const std::vector<double>& x0,
+                                  std::vector<double>& lo_of, std::vector<double>& hi_of) const {
+  const std::size_t n = texel_.size();
+  lo_of.assign(n, std::numeric_limits<double>::infinity());
+  hi_of.assign(n, -std::numeric_limits<double>::infinity());
+  for (const Sample& s : samples_) {
+    if (!measured(s, arbitrary)) continue;
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (int pass = 0; pass < 2 && lo > hi; ++pass)
+      for (int k = 0; k < 8; ++k) {
+        const std::size_t u = std::size_t(s.unknown[k]);
+        if (pass == 0 && prior[u] != kCoveredPrior) continue;
+        lo = std::min(lo, x0[u]);
+        hi = std::max(hi, x0[u]);
+      }
+    for (int k = 0; k < 8; ++k) {
+      const std::size_t u = std::size_t(s.unknown[k]);
+      lo_of[u] = std::min(lo_of[u], lo);
+      hi_of[u] = std::max(hi_of[u], hi);
+    }
+  }
+  for (std::size_t u = 0; u < n; ++u)
+    if (lo_of[u] > hi_of[u]) lo_of[u] = hi_of[u] = x0[u];  // read by no sample solved for
+}
+
+void SeamStitcher::stitch(Image& image, const std::vector<std::uint8_t>& arbitrary,
+                          SeamSolver solver) const {
+  const std::size_t n = texel_.size();
+  if (n == 0) return;
+  std::vector<double> prior = prior_weights(arbitrary);
   std::vector<Eigen::Triplet<double>> entries;
   entries.reserve(samples_.size() * 8);
   Eigen::Index rows = 0;
@@ -255,111 +385,19 @@ void SeamStitcher::stitch(Image& image, const std::vector<std::uint8_t>& arbitra
   Eigen::SparseMatrix<double> a(rows, Eigen::Index(n));
   a.setFromTriplets(entries.begin(), entries.end());  // sums a texel read by both sides
   const Eigen::SparseMatrix<double> seam_terms = a.transpose() * a;
-  // Each channel is one right-hand side: its baked values x0 and its bounds, the smallest and
-  // largest x0 among the covered texels that share a solved sample with each unknown, or among
-  // all its texels for a sample that reads none.
-  struct Channel {
-    std::size_t c;
-    std::vector<double> x0, lo, hi, target;
-    Eigen::VectorXd x;
-  };
+  // Each channel is one right-hand side: its baked values x0 and its bounds.
   const std::size_t channels = std::size_t(image.channels);
-  std::vector<Channel> rhs_of;
+  std::vector<SeamChannel> rhs_of;
   for (std::size_t c = 0; c < channels; ++c) {
-    Channel ch{c, std::vector<double>(n), {}, {}, {}, {}};
+    SeamChannel ch{c, std::vector<double>(n), {}, {}, {}, {}};
     for (std::size_t u = 0; u < n; ++u)
       ch.x0[u] = image.pixels[std::size_t(texel_[u]) * channels + c];
-    ch.lo.assign(n, std::numeric_limits<double>::infinity());
-    ch.hi.assign(n, -std::numeric_limits<double>::infinity());
-    for (const Sample& s : samples_) {
-      if (!measured(s, arbitrary)) continue;
-      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-      for (int pass = 0; pass < 2 && lo > hi; ++pass)
-        for (int k = 0; k < 8; ++k) {
-          const std::size_t u = std::size_t(s.unknown[k]);
-          if (pass == 0 && prior[u] != kCoveredPrior) continue;
-          lo = std::min(lo, ch.x0[u]);
-          hi = std::max(hi, ch.x0[u]);
-        }
-      for (int k = 0; k < 8; ++k) {
-        const std::size_t u = std::size_t(s.unknown[k]);
-        ch.lo[u] = std::min(ch.lo[u], lo);
-        ch.hi[u] = std::max(ch.hi[u], hi);
-      }
-    }
-    for (std::size_t u = 0; u < n; ++u)
-      if (ch.lo[u] > ch.hi[u]) ch.lo[u] = ch.hi[u] = ch.x0[u];  // read by no sample solved for
+    channel_bounds(arbitrary, prior, ch.x0, ch.lo, ch.hi);
     ch.target = ch.x0;
     rhs_of.push_back(std::move(ch));
   }
-
-  // Where the seams cannot be matched within the texel grid (a chart narrower than a bilinear
-  // footprint, charts closer than one), the unconstrained solution overshoots: it would put
-  // values into the lightmap that nothing baked (a visibility below 0). An active set keeps each
-  // unknown within its bounds: the unknowns that left them are held at the bound they crossed
-  // (a prior of kHeldPrior) and the system is solved again, until none leaves them.
-  // A direct factorisation (LDLᵀ) where its factor stays sparse, as it does for seams between a
-  // few dozen charts; else conjugate gradients, preconditioned by an incomplete Cholesky factor
-  // and started from the baked values (then from the last round's solution). Where every edge is
-  // a seam (Lightmap Pack's chart per quad couples texels all over the image) the factor fills in
-  // almost completely: 95 s for Suzanne at 256², against 7 s by conjugate gradients; on Smart UV
-  // Project's layouts the factorisation is 20 times faster than the iteration.
-  MeasuredLdlt ldlt;
-  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
-                           Eigen::IncompleteCholesky<double>>
-      iterative;
-  iterative.setTolerance(kSolveTolerance);
-  bool direct = true;
-  for (Channel& ch : rhs_of)
-    ch.x = Eigen::Map<const Eigen::VectorXd>(ch.x0.data(), Eigen::Index(n));
-  for (int round = 0; round < kMaxRounds; ++round) {
-    // Added as a matrix: coeffRef on a diagonal entry the seam terms lack would insert into the
-    // compressed storage, one shift of all entries each.
-    std::vector<Eigen::Triplet<double>> diagonal;
-    diagonal.reserve(n);
-    for (std::size_t u = 0; u < n; ++u)
-      diagonal.emplace_back(Eigen::Index(u), Eigen::Index(u), prior[u]);
-    Eigen::SparseMatrix<double> priors(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
-    priors.setFromTriplets(diagonal.begin(), diagonal.end());
-    const Eigen::SparseMatrix<double> normal = seam_terms + priors;
-    if (round == 0) {
-      ldlt.analyzePattern(normal);
-      direct = solver == SeamSolver::automatic
-                   ? ldlt.factor_entries() <= kMaxFactorEntriesPerUnknown * double(n)
-                   : solver == SeamSolver::factorised;
-    }
-    if (direct) {
-      ldlt.factorize(normal);
-      if (ldlt.info() != Eigen::Success) return;  // leaves the image as baked
-    } else {
-      iterative.compute(normal);
-      if (iterative.info() != Eigen::Success) return;
-    }
-    for (Channel& ch : rhs_of) {
-      Eigen::VectorXd rhs(static_cast<Eigen::Index>(n));
-      for (std::size_t u = 0; u < n; ++u) rhs[Eigen::Index(u)] = prior[u] * ch.target[u];
-      const Eigen::VectorXd guess = ch.x;
-      ch.x = direct ? Eigen::VectorXd(ldlt.solve(rhs))
-                    : Eigen::VectorXd(iterative.solveWithGuess(rhs, guess));
-    }
-    bool held_more = false;
-    for (std::size_t u = 0; u < n; ++u) {
-      if (prior[u] >= kHeldPrior) continue;
-      bool out = false;
-      for (const Channel& ch : rhs_of) {
-        const double slack = 1e-6 * (ch.hi[u] - ch.lo[u]);
-        const double x = ch.x[Eigen::Index(u)];
-        out = out || x < ch.lo[u] - slack || x > ch.hi[u] + slack;
-      }
-      if (!out) continue;
-      prior[u] = kHeldPrior;
-      for (Channel& ch : rhs_of)
-        ch.target[u] = std::clamp(ch.x[Eigen::Index(u)], ch.lo[u], ch.hi[u]);
-      held_more = true;
-    }
-    if (!held_more) break;
-  }
-  for (const Channel& ch : rhs_of)
+  if (!solve_within_bounds(seam_terms, prior, rhs_of, solver)) return;  // leaves it as baked
+  for (const SeamChannel& ch : rhs_of)
     for (std::size_t u = 0; u < n; ++u) {
       if (!arbitrary.empty() && arbitrary[std::size_t(texel_[u])]) continue;  // as baked, exactly
       image.pixels[std::size_t(texel_[u]) * channels + ch.c] =

@@ -82,6 +82,11 @@ class SeamStitcher {
     double weight[8];
   };
   bool measured(const Sample& s, const std::vector<std::uint8_t>& arbitrary) const;
+  // The steps of stitch: each unknown's prior weight, and one channel's bounds on its unknowns.
+  std::vector<double> prior_weights(const std::vector<std::uint8_t>& arbitrary) const;
+  void channel_bounds(const std::vector<std::uint8_t>& arbitrary, const std::vector<double>& prior,
+                      const std::vector<double>& x0, std::vector<double>& lo_of,
+                      std::vector<double>& hi_of) const;
   std::vector<Sample> samples_;
   std::vector<int> texel_;             // the solve's unknowns: pixel indices
   std::vector<std::uint8_t> covered_;  // per unknown

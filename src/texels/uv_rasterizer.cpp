@@ -217,173 +217,250 @@ Texel make_texel(const FaceSurface& s, int face, int x, int y, const double bary
   return t;
 }
 
+// The footprint of triangle `tri` (face `face`) in a width × height lightmap; false when the face
+// has none worth rasterising: non-finite or collapsed UVs, or a footprint outside the lightmap.
+bool make_footprint(const Triangle& tri, int face, int width, int height, FaceFootprint& fp) {
+  fp.face = face;
+  bool finite = true;
+  for (int i = 0; i < 3; ++i) {
+    fp.uv[i] = tri.uv[i];
+    fp.texel_uv[i] = Vec2(tri.uv[i].x() * width, (1.0 - tri.uv[i].y()) * height);
+    finite = finite && fp.texel_uv[i].allFinite();
+  }
+  if (!finite) return false;
+  const double area2 = orient(fp.texel_uv[0], fp.texel_uv[1], fp.texel_uv[2]);
+  // Zero UV area (collapsed UVs) has no interior to shade. 1e-10 texel² is far below any sliver
+  // worth a texel; a nearly collinear triangle above it is still safe, as every texel it gets is
+  // a convex combination of its vertices.
+  if (std::abs(area2) <= 1e-10) return false;
+  const double orientation = area2 > 0.0 ? 1.0 : -1.0;
+  for (int i = 0; i < 3; ++i)
+    fp.edge[i] = EdgeFunction(fp.texel_uv[(i + 1) % 3], fp.texel_uv[(i + 2) % 3], orientation);
+  fp.lo = fp.texel_uv[0].cwiseMin(fp.texel_uv[1]).cwiseMin(fp.texel_uv[2]);
+  fp.hi = fp.texel_uv[0].cwiseMax(fp.texel_uv[1]).cwiseMax(fp.texel_uv[2]);
+  if (fp.hi.x() <= 0.0 || fp.hi.y() <= 0.0 || fp.lo.x() >= width || fp.lo.y() >= height)
+    return false;  // entirely outside the lightmap
+  return true;
+}
+
+// The world-space surface of triangle `tri`: its corners, vertex normals, unit face normal, and
+// whether its vertex normals curve it.
+void describe_surface(const Triangle& tri, FaceSurface& s) {
+  for (int i = 0; i < 3; ++i) {
+    s.position[i] = tri.p[i];
+    s.normal[i] = tri.n[i];
+  }
+  const Vec3 average_normal = tri.n[0] + tri.n[1] + tri.n[2];
+  s.face_normal = unit_or((tri.p[1] - tri.p[0]).cross(tri.p[2] - tri.p[0]),
+                          unit_or(average_normal, Vec3::UnitZ()));
+  // A point's height below corner i's tangent plane is linear over the face, so it is
+  // greatest at a corner: below that bound nothing lifts (a flat face's vertex normals, up to
+  // the rounding of its file's floats).
+  double longest = 0, highest = 0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      longest = std::max(longest, (tri.p[i] - tri.p[j]).norm());
+      highest = std::max(highest, (tri.p[i] - tri.p[j]).dot(tri.n[i]));
+    }
+  s.curved = highest > 1e-6 * longest;
+}
+
+// The rows of a height-texel lightmap that a footprint's bounding box crosses: [y0, y1].
+void footprint_rows(const FaceFootprint& fp, int height, int& y0, int& y1) {
+  y0 = int(std::clamp(std::floor(fp.lo.y()), 0.0, double(height - 1)));
+  y1 = int(std::clamp(std::ceil(fp.hi.y()) - 1.0, 0.0, double(height - 1)));
+}
+
+// Rows → footprints whose bounding box crosses them, in face order (compressed rows): row y's
+// footprints are those indexed by faces[begin[y]] up to faces[begin[y + 1]].
+struct RowFaces {
+  std::vector<std::size_t> begin;
+  std::vector<std::int32_t> faces;
+};
+
+// The row index of `footprints` over a height-texel lightmap, by counting then filling.
+RowFaces index_rows(const std::vector<FaceFootprint>& footprints, int height) {
+  RowFaces index;
+  std::vector<std::size_t>& row_begin = index.begin;
+  row_begin.assign(std::size_t(height) + 1, 0);
+  for (const FaceFootprint& fp : footprints) {
+    int y0, y1;
+    footprint_rows(fp, height, y0, y1);
+    for (int y = y0; y <= y1; ++y) ++row_begin[std::size_t(y) + 1];
+  }
+  for (int y = 0; y < height; ++y) row_begin[std::size_t(y) + 1] += row_begin[std::size_t(y)];
+  index.faces.resize(row_begin[std::size_t(height)]);
+  std::vector<std::size_t> next(row_begin.begin(), row_begin.end() - 1);
+  for (std::size_t i = 0; i < footprints.size(); ++i) {
+    int y0, y1;
+    footprint_rows(footprints[i], height, y0, y1);
+    for (int y = y0; y <= y1; ++y) index.faces[next[std::size_t(y)]++] = std::int32_t(i);
+  }
+  return index;
+}
+
 // Per-texel owner codes: no face, face f by centre (pass 1) as f, by overlap (pass 2) as -2 - f.
 constexpr std::int32_t kUncovered = -1;
 std::int32_t conservative_code(int face) { return -2 - face; }
 bool is_centre_code(std::int32_t code) { return code >= 0; }
 int face_of(std::int32_t code) { return code >= 0 ? code : -2 - code; }
 
-}  // namespace
+// Scratch of one task's rows in the passes, one entry per texel of a row.
+struct RowScratch {
+  std::vector<double> best_distance;      // pass 2: the UV distance of the owner's nearest point
+  std::vector<std::uint8_t> row_strict;   // pass 1: whether the owner holds the centre strictly
+  std::vector<std::uint8_t> row_overlap;  // pass 1: whether two faces' interiors hold the centre
+  explicit RowScratch(int width)
+      : best_distance(static_cast<std::size_t>(width)),
+        row_strict(static_cast<std::size_t>(width)),
+        row_overlap(static_cast<std::size_t>(width)) {}
+};
 
-TexelSpace rasterise_texels(const Mesh& mesh, int width, int height, RowRange rows) {
-  assert(width > 0 && height > 0);
-  TexelSpace space;
-  if (width <= 0 || height <= 0) return space;
-  space.width = width;
-  space.height = height;
-  const std::size_t texel_count = std::size_t(width) * std::size_t(height);
-  space.covered.assign(texel_count, 0);
-  // The rows rasterised: all, or a tile's (rows are independent, so a row's texels are the same).
-  const int row0 = std::clamp(rows.begin, 0, height), row1 = std::clamp(rows.end, row0, height);
-  const int window = row1 - row0;
-  if (!mesh.has_uv) return space;  // no lightmap UVs: nothing is covered
+// Texel i, whose shadow origin is its position lifted by `lift`, into its block's summary.
+void add_to_block(TexelSpace& space, std::size_t i, const Vec3f& lift) {
+  constexpr int kBlock = TexelBlock::kSide;
+  const Texel& t = space.texels[i];
+  TexelBlock& b = space.blocks[std::size_t(t.y / kBlock) * std::size_t(space.blocks_x) +
+                               std::size_t(t.x / kBlock)];
+  const Vec3f geometric = space.geometric_normal(i);
+  const bool flat = lift == Vec3f::Zero();
+  if (b.empty()) {
+    b.lo = b.hi = t.position;
+    b.texel_size = space.face_texel_sizes[std::size_t(t.face)];
+    b.uniform = flat;
+    b.normal = t.normal;
+    b.geometric = geometric;
+    return;
+  }
+  b.texel_size = std::max(b.texel_size, space.face_texel_sizes[std::size_t(t.face)]);
+  b.lo = b.lo.cwiseMin(t.position);
+  b.hi = b.hi.cwiseMax(t.position);
+  b.uniform = b.uniform && flat && t.normal == b.normal && geometric == b.geometric;
+}
 
-  // Footprints of the usable faces, in face order; surfaces indexed by face.
-  const TriMesh& tri_mesh = mesh.mesh;
-  std::vector<FaceFootprint> footprints;
-  std::vector<FaceSurface> surfaces(tri_mesh.n_faces());
+// The steps of rasterise_texels over the window of rows [row0, row1), sharing the usable faces'
+// footprints and the owner code of every texel of the window.
+struct Rasteriser {
+  const TriMesh& tri_mesh;
+  int width, height;
+  int row0, row1;
+  std::vector<FaceFootprint> footprints;  // of the usable faces, in face order
+  std::vector<FaceSurface> surfaces;      // indexed by face
+  RowFaces row_faces;
+  std::unique_ptr<std::int32_t[]> owner;  // row-major over the window
+  std::vector<std::size_t> row_count;  // covered texels per row (indexed from row0), then offsets
+
+  void collect_faces();
+  std::int64_t assign_owners();
+  void centre_pass(int y, std::int32_t* row_owner, RowScratch& scratch) const;
+  void conservative_pass(int y, std::int32_t* row_owner, RowScratch& scratch) const;
+  bool describe_faces(TexelSpace& space) const;
+  void emit_texels(TexelSpace& space, bool lifted) const;
+};
+
+// Footprints of the usable faces, in face order; surfaces indexed by face.
+void Rasteriser::collect_faces() {
+  surfaces.resize(tri_mesh.n_faces());
   footprints.reserve(tri_mesh.n_faces());
   for (const auto f : tri_mesh.faces()) {
     const Triangle tri = triangle(tri_mesh, f);
     FaceFootprint fp;
-    fp.face = f.idx();
-    bool finite = true;
-    for (int i = 0; i < 3; ++i) {
-      fp.uv[i] = tri.uv[i];
-      fp.texel_uv[i] = Vec2(tri.uv[i].x() * width, (1.0 - tri.uv[i].y()) * height);
-      finite = finite && fp.texel_uv[i].allFinite();
-    }
-    if (!finite) continue;
-    const double area2 = orient(fp.texel_uv[0], fp.texel_uv[1], fp.texel_uv[2]);
-    // Zero UV area (collapsed UVs) has no interior to shade. 1e-10 texel² is far below any sliver
-    // worth a texel; a nearly collinear triangle above it is still safe, as every texel it gets is
-    // a convex combination of its vertices.
-    if (std::abs(area2) <= 1e-10) continue;
-    const double orientation = area2 > 0.0 ? 1.0 : -1.0;
-    for (int i = 0; i < 3; ++i)
-      fp.edge[i] = EdgeFunction(fp.texel_uv[(i + 1) % 3], fp.texel_uv[(i + 2) % 3], orientation);
-    fp.lo = fp.texel_uv[0].cwiseMin(fp.texel_uv[1]).cwiseMin(fp.texel_uv[2]);
-    fp.hi = fp.texel_uv[0].cwiseMax(fp.texel_uv[1]).cwiseMax(fp.texel_uv[2]);
-    if (fp.hi.x() <= 0.0 || fp.hi.y() <= 0.0 || fp.lo.x() >= width || fp.lo.y() >= height)
-      continue;  // entirely outside the lightmap
-
-    FaceSurface& s = surfaces[f.idx()];
-    for (int i = 0; i < 3; ++i) {
-      s.position[i] = tri.p[i];
-      s.normal[i] = tri.n[i];
-    }
-    const Vec3 average_normal = tri.n[0] + tri.n[1] + tri.n[2];
-    s.face_normal = unit_or((tri.p[1] - tri.p[0]).cross(tri.p[2] - tri.p[0]),
-                            unit_or(average_normal, Vec3::UnitZ()));
-    // A point's height below corner i's tangent plane is linear over the face, so it is
-    // greatest at a corner: below that bound nothing lifts (a flat face's vertex normals, up to
-    // the rounding of its file's floats).
-    double longest = 0, highest = 0;
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) {
-        longest = std::max(longest, (tri.p[i] - tri.p[j]).norm());
-        highest = std::max(highest, (tri.p[i] - tri.p[j]).dot(tri.n[i]));
-      }
-    s.curved = highest > 1e-6 * longest;
+    if (!make_footprint(tri, f.idx(), width, height, fp)) continue;
+    describe_surface(tri, surfaces[f.idx()]);
     footprints.push_back(fp);
   }
+}
 
-  // Rows → footprints whose bounding box crosses them, in face order (compressed rows).
-  std::vector<std::size_t> row_begin(std::size_t(height) + 1, 0);
-  const auto row_range = [&](const FaceFootprint& fp, int& y0, int& y1) {
-    y0 = int(std::clamp(std::floor(fp.lo.y()), 0.0, double(height - 1)));
-    y1 = int(std::clamp(std::ceil(fp.hi.y()) - 1.0, 0.0, double(height - 1)));
-  };
-  for (const FaceFootprint& fp : footprints) {
-    int y0, y1;
-    row_range(fp, y0, y1);
-    for (int y = y0; y <= y1; ++y) ++row_begin[std::size_t(y) + 1];
-  }
-  for (int y = 0; y < height; ++y) row_begin[std::size_t(y) + 1] += row_begin[std::size_t(y)];
-  std::vector<std::int32_t> row_faces(row_begin[std::size_t(height)]);
-  {
-    std::vector<std::size_t> next(row_begin.begin(), row_begin.end() - 1);
-    for (std::size_t i = 0; i < footprints.size(); ++i) {
-      int y0, y1;
-      row_range(footprints[i], y0, y1);
-      for (int y = y0; y <= y1; ++y) row_faces[next[std::size_t(y)]++] = std::int32_t(i);
-    }
-  }
-
-  // Passes 1 and 2, row by row: the owner code of every texel of the window, and covered texels
-  // per row (indexed from row0).
+// Passes 1 and 2, row by row: the owner code of every texel of the window, and covered texels
+// per row (indexed from row0). Returns the texels whose centre two faces' interiors share.
+std::int64_t Rasteriser::assign_owners() {
+  const int window = row1 - row0;
   // Left unwritten here: each row fills its own, in parallel (a 4096² lightmap's are 67 MB of
   // fresh pages, whose first touch is a fault).
-  const std::unique_ptr<std::int32_t[]> owner(
-      new std::int32_t[std::size_t(window) * std::size_t(width)]);
-  std::vector<std::size_t> row_count(std::size_t(window) + 1, 0);
+  owner.reset(new std::int32_t[std::size_t(window) * std::size_t(width)]);
+  row_count.assign(std::size_t(window) + 1, 0);
   std::atomic<std::int64_t> overlapping{0};
   tbb::parallel_for(tbb::blocked_range<int>(row0, row1), [&](const tbb::blocked_range<int>& rows) {
-    std::vector<double> best_distance(static_cast<std::size_t>(width));
-    std::vector<std::uint8_t> row_strict(static_cast<std::size_t>(width));
-    std::vector<std::uint8_t> row_overlap(static_cast<std::size_t>(width));
+    RowScratch scratch(width);
     for (int y = rows.begin(); y != rows.end(); ++y) {
-      std::fill(row_overlap.begin(), row_overlap.end(), 0);
+      std::fill(scratch.row_overlap.begin(), scratch.row_overlap.end(), 0);
       std::int32_t* row_owner = &owner[std::size_t(y - row0) * std::size_t(width)];
       std::fill(row_owner, row_owner + width, kUncovered);
-      const auto faces_begin = row_faces.begin() + std::ptrdiff_t(row_begin[std::size_t(y)]);
-      const auto faces_end = row_faces.begin() + std::ptrdiff_t(row_begin[std::size_t(y) + 1]);
-      const double centre_y = y + 0.5;
-      for (auto it = faces_begin; it != faces_end; ++it) {
-        const FaceFootprint& fp = footprints[std::size_t(*it)];
-        int first, last;
-        if (!row_span(fp, y, width, first, last)) continue;
-        const double row_term[3] = {fp.edge[0].row_term(centre_y), fp.edge[1].row_term(centre_y),
-                                    fp.edge[2].row_term(centre_y)};
-        for (int x = first; x <= last; ++x) {
-          const double centre_x = x + 0.5;
-          const double e0 = fp.edge[0](centre_x, row_term[0]);
-          const double e1 = fp.edge[1](centre_x, row_term[1]);
-          const double e2 = fp.edge[2](centre_x, row_term[2]);
-          if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) continue;
-          const bool strictly = e0 > 0.0 && e1 > 0.0 && e2 > 0.0;
-          if (row_owner[x] == kUncovered) {
-            row_owner[x] = fp.face;
-            row_strict[std::size_t(x)] = strictly;
-          } else if (strictly || row_strict[std::size_t(x)]) {
-            // Two triangles share a centre on a common edge or vertex (inside neither strictly);
-            // one strictly inside means their interiors overlap.
-            row_overlap[std::size_t(x)] = 1;
-          }
-        }
-      }
-      const double centre_v = 1.0 - centre_y / height;
-      for (auto it = faces_begin; it != faces_end; ++it) {
-        const FaceFootprint& fp = footprints[std::size_t(*it)];
-        int first, last;
-        if (!row_span(fp, y, width, first, last)) continue;
-        for (int x = first; x <= last; ++x) {
-          const std::int32_t code = row_owner[x];
-          if (is_centre_code(code) || !overlaps_texel(fp, x, y)) continue;
-          double bary[3];
-          const Vec2 centre_uv((x + 0.5) / width, centre_v);
-          const double d = nearest_point(fp.uv[0], fp.uv[1], fp.uv[2], centre_uv, bary);
-          // Faces come in increasing order, so strict < keeps the lowest face index on ties.
-          if (code == kUncovered || d < best_distance[std::size_t(x)]) {
-            row_owner[x] = conservative_code(fp.face);
-            best_distance[std::size_t(x)] = d;
-          }
-        }
-      }
+      centre_pass(y, row_owner, scratch);
+      conservative_pass(y, row_owner, scratch);
       std::size_t count = 0;
       for (int x = 0; x < width; ++x) count += row_owner[x] != kUncovered;
       row_count[std::size_t(y - row0) + 1] = count;
       std::int64_t overlaps = 0;
-      for (const std::uint8_t o : row_overlap) overlaps += o;
+      for (const std::uint8_t o : scratch.row_overlap) overlaps += o;
       overlapping += overlaps;
     }
   });
+  return overlapping.load();
+}
 
-  space.overlapping_texels = overlapping.load();
+// Pass 1 on row y: each texel whose centre a footprint holds goes to the first such face.
+void Rasteriser::centre_pass(int y, std::int32_t* row_owner, RowScratch& scratch) const {
+  const auto faces_begin =
+      row_faces.faces.begin() + std::ptrdiff_t(row_faces.begin[std::size_t(y)]);
+  const auto faces_end =
+      row_faces.faces.begin() + std::ptrdiff_t(row_faces.begin[std::size_t(y) + 1]);
+  const double centre_y = y + 0.5;
+  for (auto it = faces_begin; it != faces_end; ++it) {
+    const FaceFootprint& fp = footprints[std::size_t(*it)];
+    int first, last;
+    if (!row_span(fp, y, width, first, last)) continue;
+    const double row_term[3] = {fp.edge[0].row_term(centre_y), fp.edge[1].row_term(centre_y),
+                                fp.edge[2].row_term(centre_y)};
+    for (int x = first; x <= last; ++x) {
+      const double centre_x = x + 0.5;
+      const double e0 = fp.edge[0](centre_x, row_term[0]);
+      const double e1 = fp.edge[1](centre_x, row_term[1]);
+      const double e2 = fp.edge[2](centre_x, row_term[2]);
+      if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) continue;
+      const bool strictly = e0 > 0.0 && e1 > 0.0 && e2 > 0.0;
+      if (row_owner[x] == kUncovered) {
+        row_owner[x] = fp.face;
+        scratch.row_strict[std::size_t(x)] = strictly;
+      } else if (strictly || scratch.row_strict[std::size_t(x)]) {
+        // Two triangles share a centre on a common edge or vertex (inside neither strictly);
+        // one strictly inside means their interiors overlap.
+        scratch.row_overlap[std::size_t(x)] = 1;
+      }
+    }
+  }
+}
 
-  // Offsets of each row's texels in the row-major output, then the texels themselves.
-  for (int y = 0; y < window; ++y) row_count[std::size_t(y) + 1] += row_count[std::size_t(y)];
-  space.texels.resize(row_count[std::size_t(window)]);
+// Pass 2 on row y: each texel no centre claimed goes to the overlapping face nearest its centre.
+void Rasteriser::conservative_pass(int y, std::int32_t* row_owner, RowScratch& scratch) const {
+  const auto faces_begin =
+      row_faces.faces.begin() + std::ptrdiff_t(row_faces.begin[std::size_t(y)]);
+  const auto faces_end =
+      row_faces.faces.begin() + std::ptrdiff_t(row_faces.begin[std::size_t(y) + 1]);
+  const double centre_y = y + 0.5;
+  const double centre_v = 1.0 - centre_y / height;
+  for (auto it = faces_begin; it != faces_end; ++it) {
+    const FaceFootprint& fp = footprints[std::size_t(*it)];
+    int first, last;
+    if (!row_span(fp, y, width, first, last)) continue;
+    for (int x = first; x <= last; ++x) {
+      const std::int32_t code = row_owner[x];
+      if (is_centre_code(code) || !overlaps_texel(fp, x, y)) continue;
+      double bary[3];
+      const Vec2 centre_uv((x + 0.5) / width, centre_v);
+      const double d = nearest_point(fp.uv[0], fp.uv[1], fp.uv[2], centre_uv, bary);
+      // Faces come in increasing order, so strict < keeps the lowest face index on ties.
+      if (code == kUncovered || d < scratch.best_distance[std::size_t(x)]) {
+        row_owner[x] = conservative_code(fp.face);
+        scratch.best_distance[std::size_t(x)] = d;
+      }
+    }
+  }
+}
+
+// The per-face outputs: normals, texel sizes and, where some face is smooth, its shading corners.
+// Returns whether some face is curved, so that its texels' shadow origins lift.
+bool Rasteriser::describe_faces(TexelSpace& space) const {
   space.face_normals.resize(tri_mesh.n_faces(), Vec3f::Zero());
   space.face_texel_sizes.resize(tri_mesh.n_faces(), 0.0f);
   bool lifted = false, smooth = false;
@@ -405,7 +482,12 @@ TexelSpace rasterise_texels(const Mesh& mesh, int width, int height, RowRange ro
       }
     }
   }
-  if (lifted) space.lifts.resize(space.texels.size());
+  return lifted;
+}
+
+// The texels of the window in row-major order, from their owner codes, with their lifts (when
+// `lifted`) and their blocks' summaries; marks them covered.
+void Rasteriser::emit_texels(TexelSpace& space, bool lifted) const {
   std::vector<int> footprint_of_face(tri_mesh.n_faces(), -1);
   for (std::size_t i = 0; i < footprints.size(); ++i)
     footprint_of_face[std::size_t(footprints[i].face)] = int(i);
@@ -414,26 +496,6 @@ TexelSpace rasterise_texels(const Mesh& mesh, int width, int height, RowRange ro
   space.blocks_x = (width + kBlock - 1) / kBlock;
   space.blocks.assign(std::size_t(space.blocks_x) * std::size_t((height + kBlock - 1) / kBlock),
                       TexelBlock());
-  // Texel i, whose shadow origin is its position lifted by `lift`, into its block's summary.
-  const auto add_to_block = [&](std::size_t i, const Vec3f& lift) {
-    const Texel& t = space.texels[i];
-    TexelBlock& b = space.blocks[std::size_t(t.y / kBlock) * std::size_t(space.blocks_x) +
-                                 std::size_t(t.x / kBlock)];
-    const Vec3f geometric = space.geometric_normal(i);
-    const bool flat = lift == Vec3f::Zero();
-    if (b.empty()) {
-      b.lo = b.hi = t.position;
-      b.texel_size = space.face_texel_sizes[std::size_t(t.face)];
-      b.uniform = flat;
-      b.normal = t.normal;
-      b.geometric = geometric;
-      return;
-    }
-    b.texel_size = std::max(b.texel_size, space.face_texel_sizes[std::size_t(t.face)]);
-    b.lo = b.lo.cwiseMin(t.position);
-    b.hi = b.hi.cwiseMax(t.position);
-    b.uniform = b.uniform && flat && t.normal == b.normal && geometric == b.geometric;
-  };
   tbb::parallel_for(
       tbb::blocked_range<int>(row0 / kBlock, (row1 + kBlock - 1) / kBlock),
       [&](const tbb::blocked_range<int>& block_rows) {
@@ -458,12 +520,40 @@ TexelSpace rasterise_texels(const Mesh& mesh, int width, int height, RowRange ro
             Vec3f lift = Vec3f::Zero();
             space.texels[out] = make_texel(surfaces[std::size_t(face)], face, x, y, bary, lift);
             if (lifted) space.lifts[out] = lift;
-            add_to_block(out, lift);  // make_texel's lift is 0 on a flat face
+            add_to_block(space, out, lift);  // make_texel's lift is 0 on a flat face
             ++out;
             space.covered[row_offset + std::size_t(x)] = 1;
           }
         }
       });
+}
+
+}  // namespace
+
+TexelSpace rasterise_texels(const Mesh& mesh, int width, int height, RowRange rows) {
+  assert(width > 0 && height > 0);
+  TexelSpace space;
+  if (width <= 0 || height <= 0) return space;
+  space.width = width;
+  space.height = height;
+  const std::size_t texel_count = std::size_t(width) * std::size_t(height);
+  space.covered.assign(texel_count, 0);
+  // The rows rasterised: all, or a tile's (rows are independent, so a row's texels are the same).
+  const int row0 = std::clamp(rows.begin, 0, height), row1 = std::clamp(rows.end, row0, height);
+  const int window = row1 - row0;
+  if (!mesh.has_uv) return space;  // no lightmap UVs: nothing is covered
+
+  Rasteriser r{mesh.mesh, width, height, row0, row1, {}, {}, {}, {}, {}};
+  r.collect_faces();
+  r.row_faces = index_rows(r.footprints, height);
+  space.overlapping_texels = r.assign_owners();
+
+  // Offsets of each row's texels in the row-major output, then the texels themselves.
+  for (int y = 0; y < window; ++y) r.row_count[std::size_t(y) + 1] += r.row_count[std::size_t(y)];
+  space.texels.resize(r.row_count[std::size_t(window)]);
+  const bool lifted = r.describe_faces(space);
+  if (lifted) space.lifts.resize(space.texels.size());
+  r.emit_texels(space, lifted);
   return space;
 }
 

@@ -203,16 +203,22 @@ class GroupPositions {
   const std::vector<int>& rest_;
 };
 
-// Frames, groups and root triples for one light part, appended to `plan`. A planar group (a
-// floor, one face plane of a bracket) is seen along its plane's normal: every texel then lies at
-// the same depth, the receiver plane of docs/design.md §2 is the group's own plane, and blockers
-// clipped to depth <= that plane are exactly those on the light's side of it. The other groups
-// share one frustum from the light's centre towards the middle of their texels (docs/design.md §3)
-// when it holds them all within kMaxFrustumHalfAngleDeg; otherwise (a light beside or among its
-// receiver) the six faces of a cube around the light, each its own frustum.
-void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part) {
-  const TexelSpace& space = *plan.space;
-  const LightPart& lp = plan.light_parts[light_part];
+namespace {
+
+// Each frame with the groups it serves: (index into `groups`, texels of that group in it).
+struct FrameGroups {
+  PlanFrame frame;
+  std::vector<std::pair<int, std::vector<std::size_t>>> members;
+};
+
+// Texel t's position, in double precision.
+Vec3 texel_position(const TexelSpace& space, std::size_t t) {
+  return Vec3(space.texels[t].position.cast<double>());
+}
+
+// The texels the light part reaches, less those the shaft test finds nothing in front of.
+std::vector<std::size_t> lit_texels(const TexelSpace& space, const PlanInputs& in,
+                                    const LightPart& lp) {
   const Light& light = lp.part;
   std::vector<std::size_t> lit;
   const std::vector<std::uint8_t>* maybe =
@@ -223,14 +229,13 @@ void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part) {
                       space.texels[t].normal.cast<double>()))
       lit.push_back(t);
   }
-  if (lit.empty()) return;
-  auto position = [&](std::size_t t) { return Vec3(space.texels[t].position.cast<double>()); };
-  const std::vector<TexelGroup> groups = group_texels(space, in, lit, light);
-  // Each frame with the groups it serves: (index into `groups`, texels of that group in it).
-  struct FrameGroups {
-    PlanFrame frame;
-    std::vector<std::pair<int, std::vector<std::size_t>>> members;
-  };
+  return lit;
+}
+
+// The frames that serve `groups` (add_frames says which), each with the texels it serves of
+// each group.
+std::vector<FrameGroups> choose_frames(const TexelSpace& space,
+                                       const std::vector<TexelGroup>& groups, const Light& light) {
   std::vector<FrameGroups> frames;
   std::vector<int> rest;
   for (std::size_t g = 0; g < groups.size(); ++g) {
@@ -244,101 +249,144 @@ void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part) {
       rest.push_back(int(g));
     }
   }
-  if (!rest.empty()) {
-    const GroupPositions rest_positions(space, groups, rest);
-    // Each leaf sizes its own pixels, so the tangent plane's stretch towards the widest angle
-    // costs image size, not accuracy.
-    if (const std::optional<ProjectionFrame> central =
-            central_frustum(light.centre(), rest_positions)) {
+  if (rest.empty()) return frames;
+  const GroupPositions rest_positions(space, groups, rest);
+  // Each leaf sizes its own pixels, so the tangent plane's stretch towards the widest angle
+  // costs image size, not accuracy.
+  if (const std::optional<ProjectionFrame> central =
+          central_frustum(light.centre(), rest_positions)) {
+    FrameGroups f;
+    f.frame.frame = *central;
+    for (int g : rest) f.members.emplace_back(g, groups[std::size_t(g)].texels);
+    frames.push_back(std::move(f));
+  } else {
+    const std::size_t first = frames.size();
+    for (int face = 0; face < kCubeFaces; ++face) {
       FrameGroups f;
-      f.frame.frame = *central;
-      for (int g : rest) f.members.emplace_back(g, groups[std::size_t(g)].texels);
+      f.frame.frame = cube_face_frame(light.centre(), face);
+      f.frame.face = cube_frame_face(face);
+      for (int g : rest) f.members.emplace_back(g, std::vector<std::size_t>{});
       frames.push_back(std::move(f));
-    } else {
-      const std::size_t first = frames.size();
-      for (int face = 0; face < kCubeFaces; ++face) {
-        FrameGroups f;
-        f.frame.frame = cube_face_frame(light.centre(), face);
-        f.frame.face = cube_frame_face(face);
-        for (int g : rest) f.members.emplace_back(g, std::vector<std::size_t>{});
-        frames.push_back(std::move(f));
-      }
-      for (std::size_t r = 0; r < rest.size(); ++r) {
-        for (std::size_t t : groups[std::size_t(rest[r])].texels) {
-          const int face = cube_face(light.centre(), position(t));
-          frames[first + std::size_t(face)].members[r].second.push_back(t);
-        }
+    }
+    for (std::size_t r = 0; r < rest.size(); ++r) {
+      for (std::size_t t : groups[std::size_t(rest[r])].texels) {
+        const int face = cube_face(light.centre(), texel_position(space, t));
+        frames[first + std::size_t(face)].members[r].second.push_back(t);
       }
     }
   }
+  return frames;
+}
+
+// Fills the frame's texels, depths and groups from its members, and sets its near depth from
+// the deepest texel; returns each group's convex component.
+std::vector<int> gather_frame_texels(const TexelSpace& space, const std::vector<TexelGroup>& groups,
+                                     FrameGroups& fg) {
+  PlanFrame& f = fg.frame;
+  std::vector<int> convex_component;
+  double deepest = 0;
+  std::size_t members = 0;
+  for (const auto& m : fg.members) members += m.second.size();
+  f.texels.reserve(members);
+  f.depth.reserve(members);
+  f.position.reserve(members);
+  f.tangent.reserve(members);
+  for (auto& [g, texels] : fg.members) {
+    if (texels.empty()) continue;
+    std::vector<int> members;
+    for (std::size_t t : texels) {
+      members.push_back(int(f.texels.size()));
+      f.texels.push_back(t);
+      f.depth.push_back(f.frame.depth(texel_position(space, t)));
+      deepest = std::max(deepest, f.depth.back());
+    }
+    f.groups.push_back(std::move(members));
+    convex_component.push_back(groups[std::size_t(g)].convex_component);
+  }
+  if (f.texels.empty()) return convex_component;
+  // Texels this close to the light's plane across D (or behind it) cannot be projected; they
+  // keep V = 1 and are counted. The choice of frusta keeps them rare.
+  f.near = std::max(1e-4, 1e-3 * deepest);
+  return convex_component;
+}
+
+// The frame's texels projected onto its tangent plane, those too near the light's plane left
+// out of its groups (and groups left empty dropped, with their convex components).
+void project_frame_texels(const TexelSpace& space, PlanFrame& f,
+                          std::vector<int>& convex_component) {
+  for (std::size_t i = 0; i < f.texels.size(); ++i) {
+    f.position.push_back(texel_position(space, f.texels[i]));
+    f.tangent.push_back(f.depth[i] > f.near ? f.frame.tangent(f.position.back()) : Vec2::Zero());
+    if (f.depth[i] <= f.near) ++f.outside_texels;
+  }
+  std::vector<std::vector<int>> kept;
+  std::vector<int> kept_component;
+  for (std::size_t k = 0; k < f.groups.size(); ++k) {
+    auto& g = f.groups[k];
+    std::erase_if(g, [&](int i) { return f.depth[std::size_t(i)] <= f.near; });
+    if (g.empty()) continue;
+    // The deepest texel last (evaluate_triple reads the group's depth there); a full sort by
+    // depth cost a tenth of the planning of a 2048² floor.
+    std::iter_swap(
+        std::max_element(g.begin(), g.end(), [&](int a, int b) { return f.depth[a] < f.depth[b]; }),
+        g.end() - 1);
+    kept.push_back(std::move(g));
+    kept_component.push_back(convex_component[k]);
+  }
+  f.groups = std::move(kept);
+  convex_component = std::move(kept_component);
+}
+
+// Appends a root triple per group of the frame plan.frames[index], each evaluated over the
+// blocker faces in its shaft.
+void add_roots(ConvolutionPlan& plan, const PlanInputs& in, const Light& light, int index,
+               const std::vector<int>& convex_component) {
+  PlanFrame& added = plan.frames[std::size_t(index)];
+  for (std::size_t g = 0; g < added.groups.size(); ++g) {
+    Triple root;
+    root.frame = index;
+    root.group = int(g);
+    root.slab_lo = 0;
+    root.slab_hi = std::numeric_limits<double>::infinity();
+    root.faces = group_faces(plan, in, added, added.groups[g], light, convex_component[g]);
+    for (int i : added.groups[g]) root.receiver_box.extend(added.position[std::size_t(i)]);
+    evaluate_triple(plan, in, root);
+    added.roots.push_back(int(plan.triples.size()));
+    plan.triples.push_back(std::move(root));
+  }
+}
+
+}  // namespace
+
+// Frames, groups and root triples for one light part, appended to `plan`. A planar group (a
+// floor, one face plane of a bracket) is seen along its plane's normal: every texel then lies at
+// the same depth, the receiver plane of docs/design.md §2 is the group's own plane, and blockers
+// clipped to depth <= that plane are exactly those on the light's side of it. The other groups
+// share one frustum from the light's centre towards the middle of their texels (docs/design.md §3)
+// when it holds them all within kMaxFrustumHalfAngleDeg; otherwise (a light beside or among its
+// receiver) the six faces of a cube around the light, each its own frustum.
+void add_frames(ConvolutionPlan& plan, const PlanInputs& in, int light_part) {
+  const TexelSpace& space = *plan.space;
+  const LightPart& lp = plan.light_parts[light_part];
+  const Light& light = lp.part;
+  const std::vector<std::size_t> lit = lit_texels(space, in, lp);
+  if (lit.empty()) return;
+  const std::vector<TexelGroup> groups = group_texels(space, in, lit, light);
+  std::vector<FrameGroups> frames = choose_frames(space, groups, light);
   for (FrameGroups& fg : frames) {
     PlanFrame& f = fg.frame;
     f.light = lp.light;
     f.light_part = light_part;
-    std::vector<int> convex_component;
-    double deepest = 0;
-    std::size_t members = 0;
-    for (const auto& m : fg.members) members += m.second.size();
-    f.texels.reserve(members);
-    f.depth.reserve(members);
-    f.position.reserve(members);
-    f.tangent.reserve(members);
-    for (auto& [g, texels] : fg.members) {
-      if (texels.empty()) continue;
-      std::vector<int> members;
-      for (std::size_t t : texels) {
-        members.push_back(int(f.texels.size()));
-        f.texels.push_back(t);
-        f.depth.push_back(f.frame.depth(position(t)));
-        deepest = std::max(deepest, f.depth.back());
-      }
-      f.groups.push_back(std::move(members));
-      convex_component.push_back(groups[std::size_t(g)].convex_component);
-    }
+    std::vector<int> convex_component = gather_frame_texels(space, groups, fg);
     if (f.texels.empty()) continue;
-    // Texels this close to the light's plane across D (or behind it) cannot be projected; they
-    // keep V = 1 and are counted. The choice of frusta keeps them rare.
-    f.near = std::max(1e-4, 1e-3 * deepest);
-    for (std::size_t i = 0; i < f.texels.size(); ++i) {
-      f.position.push_back(position(f.texels[i]));
-      f.tangent.push_back(f.depth[i] > f.near ? f.frame.tangent(f.position.back()) : Vec2::Zero());
-      if (f.depth[i] <= f.near) ++f.outside_texels;
-    }
-    std::vector<std::vector<int>> kept;
-    std::vector<int> kept_component;
-    for (std::size_t k = 0; k < f.groups.size(); ++k) {
-      auto& g = f.groups[k];
-      std::erase_if(g, [&](int i) { return f.depth[std::size_t(i)] <= f.near; });
-      if (g.empty()) continue;
-      // The deepest texel last (evaluate_triple reads the group's depth there); a full sort by
-      // depth cost a tenth of the planning of a 2048² floor.
-      std::iter_swap(std::max_element(g.begin(), g.end(),
-                                      [&](int a, int b) { return f.depth[a] < f.depth[b]; }),
-                     g.end() - 1);
-      kept.push_back(std::move(g));
-      kept_component.push_back(convex_component[k]);
-    }
-    f.groups = std::move(kept);
-    convex_component = std::move(kept_component);
+    project_frame_texels(space, f, convex_component);
     for (const auto& g : f.groups) {
       f.index.emplace_back();
       f.index.back().build(g, f.tangent, f.depth, f.position);
     }
     const int index = int(plan.frames.size());
     plan.frames.push_back(std::move(f));
-    PlanFrame& added = plan.frames.back();
-    for (std::size_t g = 0; g < added.groups.size(); ++g) {
-      Triple root;
-      root.frame = index;
-      root.group = int(g);
-      root.slab_lo = 0;
-      root.slab_hi = std::numeric_limits<double>::infinity();
-      root.faces = group_faces(plan, in, added, added.groups[g], light, convex_component[g]);
-      for (int i : added.groups[g]) root.receiver_box.extend(added.position[std::size_t(i)]);
-      evaluate_triple(plan, in, root);
-      added.roots.push_back(int(plan.triples.size()));
-      plan.triples.push_back(std::move(root));
-    }
+    add_roots(plan, in, light, index, convex_component);
   }
 }
 

@@ -87,36 +87,28 @@ double depth_half_spread(const Light& light, const ProjectionFrame& frame) {
   return light.shape() == LightShape::sphere ? 0.0 : spread;
 }
 
-SourceKernel source_kernel(const Light& light, const ProjectionFrame& frame,
-                           double tangent_per_metre, double pixel, const Vec2& view,
-                           double receiver_depth) {
-  SourceKernel kernel;
-  const double r = receiver_depth;
-  const double scale = tangent_per_metre / pixel;  // kernel pixels per metre at k = 1
-  const Vec2 radius_px = projected_half_extents(light, frame, view, r) * scale;
-  const int half_w = std::max(0, int(std::ceil(radius_px.x() - 0.5)));
-  const int half_h = std::max(0, int(std::ceil(radius_px.y() - 0.5)));
-  if ((half_w == 0 && half_h == 0) || tangent_per_metre <= 0) {
-    // The source is smaller than a pixel: a point light, whose kernel is a delta.
-    const Vec3 e = light.exitance();
-    for (int c = 0; c < 3; ++c) kernel.channels[c].assign(1, e[c] > 0 ? 1.0f : 0.0f);
-    kernel.width = kernel.height = 1;
-    kernel.grey = e.x() == e.y() && e.y() == e.z();
-    return kernel;
-  }
-  kernel.width = 2 * half_w + 1;
-  kernel.height = 2 * half_h + 1;
-  const int nw = kernel.width, nh = kernel.height;
-  std::array<std::vector<double>, 3> acc;
-  for (auto& c : acc) c.assign(std::size_t(nw) * nh, 0.0);
-  std::array<std::vector<double>, 2> moment;
-  for (auto& c : moment) c.assign(std::size_t(nw) * nh, 0.0);
-  Vec2 centroid = Vec2::Zero();
+namespace {
 
-  // Samples on the light's surface, several per kernel pixel along each of its axes (fewer for
-  // large kernels, whose edges are smooth at pixel scale anyway; a sphere is its silhouette disk
-  // seen along the view), equal area each.
-  const Vec3 along = view_ray(frame, view);
+// The kernel of a source smaller than a pixel: a point light, whose kernel is a delta.
+SourceKernel point_kernel(const Light& light) {
+  SourceKernel kernel;
+  const Vec3 e = light.exitance();
+  for (int c = 0; c < 3; ++c) kernel.channels[c].assign(1, e[c] > 0 ? 1.0f : 0.0f);
+  kernel.width = kernel.height = 1;
+  kernel.grey = e.x() == e.y() && e.y() == e.z();
+  return kernel;
+}
+
+// The axes across the light along which it is sampled, its extents along them, and whether it
+// is round (a disk, or a sphere's silhouette) or a polygon (cells outside it left out).
+struct SampleAxes {
+  Vec3 axis_u, axis_v;
+  double extent_u, extent_v;
+  bool round, polygon;
+};
+
+// The light's sample axes: its own, a sphere's across the view ray `along`.
+SampleAxes sample_axes(const Light& light, const Vec3& along) {
   Vec3 axis_u = light.right(), axis_v = light.up();
   double extent_u = light.desc().width, extent_v = light.desc().height;
   const bool round = light.shape() == LightShape::disk || light.shape() == LightShape::sphere;
@@ -132,6 +124,71 @@ SourceKernel source_kernel(const Light& light, const ProjectionFrame& frame,
     extent_u = 2 * half.x();
     extent_v = 2 * half.y();
   }
+  return {axis_u, axis_v, extent_u, extent_v, round, polygon};
+}
+
+// Calls visit(x, w) for each of the n pixels x that the interval [lo, hi] overlaps, w the width
+// of the overlap. The cell's extent is split over the kernel's pixels; what falls beyond an edge
+// goes to the edge pixel. The loops run over the kernel only: a light point near the receiver's
+// depth stretches its cell over millions of pixels (r / (r − z)), which must not cost as many.
+template <class Visit>
+void spans(double lo, double hi, int n, Visit&& visit) {
+  const int first = std::clamp(int(std::floor(lo + 0.5)), 0, n - 1);
+  const int last = std::clamp(int(std::floor(hi + 0.5)), 0, n - 1);
+  for (int x = first; x <= last; ++x) {
+    const double left = x == 0 ? -std::numeric_limits<double>::infinity() : x - 0.5;
+    const double right = x == n - 1 ? std::numeric_limits<double>::infinity() : x + 0.5;
+    const double w = std::min(hi, right) - std::max(lo, left);
+    if (w > 0) visit(x, w);
+  }
+}
+
+// The kernel's sums before normalisation: the emission per channel and pixel (channel 0 only
+// for a uniform light), its first moments, and the samples' emission-weighted centroid.
+struct KernelSums {
+  int nw, nh;
+  std::array<std::vector<double>, 3> acc;
+  std::array<std::vector<double>, 2> moment;
+  Vec2 centroid = Vec2::Zero();
+
+  KernelSums(int width, int height) : nw(width), nh(height) {
+    for (auto& c : acc) c.assign(std::size_t(nw) * nh, 0.0);
+    for (auto& c : moment) c.assign(std::size_t(nw) * nh, 0.0);
+  }
+
+  // Splats the sample at light offset (a, b), emission e (e0 in channel 0), as its cell's
+  // bounding box about `centre` with half extents `half` and area `area`, in kernel pixels.
+  void add_cell(const Vec2& centre, const Vec2& half, double area, bool uniform, const Vec3& e,
+                double e0, double a, double b) {
+    spans(centre.y() - half.y(), centre.y() + half.y(), nh, [&](int y, double wy) {
+      spans(centre.x() - half.x(), centre.x() + half.x(), nw, [&](int x, double wx) {
+        const std::size_t at = std::size_t(y) * nw + std::size_t(x);
+        const double wgt = wx * wy / area;
+        if (uniform) {
+          acc[0][at] += wgt;
+        } else {
+          for (int c = 0; c < 3; ++c) acc[c][at] += wgt * e[c];
+        }
+        moment[0][at] += wgt * e0 * a;
+        moment[1][at] += wgt * e0 * b;
+      });
+    });
+    centroid += e0 * Vec2(a, b);
+  }
+};
+
+// Splats samples of the light's surface into `sums`, mapped as source_kernel says and mirrored
+// about pixel (half_w, half_h); `scale` is in kernel pixels per metre at k = 1.
+void splat_light(const Light& light, const ProjectionFrame& frame, const Vec2& view, double r,
+                 double scale, int half_w, int half_h, KernelSums& sums) {
+  // Samples on the light's surface, several per kernel pixel along each of its axes (fewer for
+  // large kernels, whose edges are smooth at pixel scale anyway; a sphere is its silhouette disk
+  // seen along the view), equal area each.
+  const Vec3 along = view_ray(frame, view);
+  const SampleAxes axes = sample_axes(light, along);
+  const Vec3 axis_u = axes.axis_u, axis_v = axes.axis_v;
+  const double extent_u = axes.extent_u, extent_v = axes.extent_v;
+  const bool round = axes.round, polygon = axes.polygon;
   const double px_per_metre = scale * 1.5;  // perspective can stretch by r/(r − z)
   // Each sample stands for a cell of the light, and is splatted as that cell's bounding box
   // (area-weighted over the pixels it overlaps, 2 × 2 at most at this density): the kernel's edge
@@ -172,38 +229,19 @@ SourceKernel source_kernel(const Light& light, const ProjectionFrame& frame,
       }
       const double area = 4 * half.x() * half.y();
       if (!(area > 0)) continue;
-      // The cell's extent split over the kernel's pixels; what falls beyond an edge goes to the
-      // edge pixel. The loops run over the kernel only: a light point near the receiver's depth
-      // stretches its cell over millions of pixels (r / (r − z)), which must not cost as many.
-      const auto spans = [](double lo, double hi, int n, auto&& visit) {
-        const int first = std::clamp(int(std::floor(lo + 0.5)), 0, n - 1);
-        const int last = std::clamp(int(std::floor(hi + 0.5)), 0, n - 1);
-        for (int x = first; x <= last; ++x) {
-          const double left = x == 0 ? -std::numeric_limits<double>::infinity() : x - 0.5;
-          const double right = x == n - 1 ? std::numeric_limits<double>::infinity() : x + 0.5;
-          const double w = std::min(hi, right) - std::max(lo, left);
-          if (w > 0) visit(x, w);
-        }
-      };
-      spans(centre.y() - half.y(), centre.y() + half.y(), nh, [&](int y, double wy) {
-        spans(centre.x() - half.x(), centre.x() + half.x(), nw, [&](int x, double wx) {
-          const std::size_t at = std::size_t(y) * nw + std::size_t(x);
-          const double wgt = wx * wy / area;
-          if (uniform) {
-            acc[0][at] += wgt;
-          } else {
-            for (int c = 0; c < 3; ++c) acc[c][at] += wgt * e[c];
-          }
-          moment[0][at] += wgt * e0 * a;
-          moment[1][at] += wgt * e0 * b;
-        });
-      });
-      centroid += e0 * Vec2(a, b);
+      sums.add_cell(centre, half, area, uniform, e, e0, a, b);
     }
   }
   if (uniform) {
-    for (int c = 1; c < 3; ++c) acc[c] = acc[0];
+    for (int c = 1; c < 3; ++c) sums.acc[c] = sums.acc[0];
   }
+}
+
+// The kernel's channels from the sums, each normalised to sum 1, and, for a grey light other
+// than a sphere, its moments and centroid normalised by channel 0's sum.
+void normalise_kernel(const Light& light, const KernelSums& sums, SourceKernel& kernel) {
+  const auto& acc = sums.acc;
+  const auto& moment = sums.moment;
   for (int c = 0; c < 3; ++c) {
     double sum = 0;
     for (double v : acc[c]) sum += v;
@@ -221,8 +259,28 @@ SourceKernel source_kernel(const Light& light, const ProjectionFrame& frame,
       for (std::size_t k = 0; k < moment[m].size(); ++k)
         kernel.moments[m][k] = float(moment[m][k] / sum0);
     }
-    kernel.centroid = centroid / sum0;
+    kernel.centroid = sums.centroid / sum0;
   }
+}
+
+}  // namespace
+
+SourceKernel source_kernel(const Light& light, const ProjectionFrame& frame,
+                           double tangent_per_metre, double pixel, const Vec2& view,
+                           double receiver_depth) {
+  const double r = receiver_depth;
+  const double scale = tangent_per_metre / pixel;  // kernel pixels per metre at k = 1
+  const Vec2 radius_px = projected_half_extents(light, frame, view, r) * scale;
+  const int half_w = std::max(0, int(std::ceil(radius_px.x() - 0.5)));
+  const int half_h = std::max(0, int(std::ceil(radius_px.y() - 0.5)));
+  // The source is smaller than a pixel: a point light, whose kernel is a delta.
+  if ((half_w == 0 && half_h == 0) || tangent_per_metre <= 0) return point_kernel(light);
+  SourceKernel kernel;
+  kernel.width = 2 * half_w + 1;
+  kernel.height = 2 * half_h + 1;
+  KernelSums sums(kernel.width, kernel.height);
+  splat_light(light, frame, view, r, scale, half_w, half_h, sums);
+  normalise_kernel(light, sums, kernel);
   return kernel;
 }
 

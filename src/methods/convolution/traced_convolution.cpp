@@ -29,6 +29,88 @@ constexpr float kCertain = 2e-3f;
 // convolution placed up to its ε (1 texel at the default target) off.
 constexpr int kTraceMargin = 2;
 
+// The convolution's inputs with the budget that tracing sets: the convolution may cost at most
+// half what the reference at 64 samples would per texel (the method must never be slower than
+// the rays it replaces), or half what tracing the texel at `samples` would, where it traces.
+ConvolutionInputs budgeted_inputs(const TracedConvolutionInputs& in) {
+  ConvolutionInputs conv = in.convolution;
+  conv.plan.cost_budget_per_texel = 0.5 * 64 * kRayCostUnits;
+  if (in.rays) {
+    conv.plan.ray_cost_per_texel = in.samples * kRayCostUnits;
+    conv.plan.trace_error_texels = in.trace_error_texels;
+    conv.plan.cost_budget_per_texel =
+        std::min(conv.plan.cost_budget_per_texel, 0.5 * conv.plan.ray_cost_per_texel);
+  }
+  return conv;
+}
+
+// Per light and texel, whether a blocker may lie in the shaft between them (the culler's
+// answer); empty without a culler.
+std::vector<std::vector<std::uint8_t>> maybe_blocked(const TexelSpace& space,
+                                                     const TracedConvolutionInputs& in) {
+  const std::vector<Light>& lights = *in.convolution.plan.lights;
+  std::vector<std::vector<std::uint8_t>> maybe;
+  if (in.culler) {
+    const double offset = in.rays ? in.rays->surface_offset() : 0.0;
+    for (const Light& light : lights)
+      maybe.push_back(in.culler->maybe_blocked(space, light, offset));
+  }
+  return maybe;
+}
+
+// Per texel, whether light l's convolved value there cannot stand (bake_traced_convolution
+// says when): the seeds around which texels are traced.
+std::vector<std::uint8_t> trace_seeds(const TexelSpace& space, const TracedConvolutionInputs& in,
+                                      const ConvolutionVisibility& per_light,
+                                      const std::vector<std::vector<std::uint8_t>>& maybe,
+                                      std::size_t l) {
+  const std::size_t n = space.texels.size();
+  std::vector<std::uint8_t> seed(n, 0);
+  for (std::size_t t = 0; t < n; ++t) {
+    if (!maybe.empty() && !maybe[l][t]) continue;
+    const bool planned = !per_light.visible[l].empty() && per_light.reached[l][t];
+    const float e = planned ? per_light.error_texels[l][t] : -1.0f;
+    bool partial = false;
+    if (planned)
+      for (int c = 0; c < 3; ++c) {
+        const float v = per_light.visible[l][t][c];
+        partial = partial || (v > kCertain && v < 1 - kCertain);
+      }
+    seed[t] = e < 0 || e > in.trace_error_texels || partial;
+  }
+  return seed;
+}
+
+// Per light and texel, whether the pair is traced: each seed and the texels within
+// kTraceMargin of it that the shaft test keeps.
+std::vector<std::vector<std::uint8_t>> traced_pairs(
+    const TexelSpace& space, const TracedConvolutionInputs& in,
+    const ConvolutionVisibility& per_light, const std::vector<std::vector<std::uint8_t>>& maybe) {
+  const std::vector<Light>& lights = *in.convolution.plan.lights;
+  const std::size_t n = space.texels.size();
+  std::vector<std::vector<std::uint8_t>> trace(lights.size());
+  std::vector<std::int32_t> texel_at(std::size_t(space.width) * space.height, -1);
+  for (std::size_t t = 0; t < n; ++t)
+    texel_at[std::size_t(space.texels[t].y) * space.width + std::size_t(space.texels[t].x)] =
+        std::int32_t(t);
+  for (std::size_t l = 0; l < lights.size(); ++l) {
+    const std::vector<std::uint8_t> seed = trace_seeds(space, in, per_light, maybe, l);
+    trace[l].assign(n, 0);
+    for (std::size_t t = 0; t < n; ++t) {
+      if (!seed[t]) continue;
+      const int x = space.texels[t].x, y = space.texels[t].y;
+      for (int dy = -kTraceMargin; dy <= kTraceMargin; ++dy)
+        for (int dx = -kTraceMargin; dx <= kTraceMargin; ++dx) {
+          const int xx = x + dx, yy = y + dy;
+          if (xx < 0 || yy < 0 || xx >= space.width || yy >= space.height) continue;
+          const std::int32_t u = texel_at[std::size_t(yy) * space.width + std::size_t(xx)];
+          if (u >= 0 && (maybe.empty() || maybe[l][std::size_t(u)])) trace[l][std::size_t(u)] = 1;
+        }
+    }
+  }
+  return trace;
+}
+
 }  // namespace
 
 Expected<MixedImages> bake_traced_convolution(const TexelSpace& space,
@@ -38,24 +120,9 @@ Expected<MixedImages> bake_traced_convolution(const TexelSpace& space,
                                               TracedConvolutionStats* stats) {
   const std::vector<Light>& lights = *in.convolution.plan.lights;
   const std::size_t n = space.texels.size();
-  ConvolutionInputs conv = in.convolution;
-  // The convolution may cost at most half what the reference at 64 samples would per texel
-  // (the method must never be slower than the rays it replaces), or half what tracing the texel
-  // at `samples` would, where it traces.
-  conv.plan.cost_budget_per_texel = 0.5 * 64 * kRayCostUnits;
-  if (in.rays) {
-    conv.plan.ray_cost_per_texel = in.samples * kRayCostUnits;
-    conv.plan.trace_error_texels = in.trace_error_texels;
-    conv.plan.cost_budget_per_texel =
-        std::min(conv.plan.cost_budget_per_texel, 0.5 * conv.plan.ray_cost_per_texel);
-  }
-  std::vector<std::vector<std::uint8_t>> maybe;
-  if (in.culler) {
-    const double offset = in.rays ? in.rays->surface_offset() : 0.0;
-    for (const Light& light : lights)
-      maybe.push_back(in.culler->maybe_blocked(space, light, offset));
-    conv.plan.maybe_blocked = &maybe;
-  }
+  ConvolutionInputs conv = budgeted_inputs(in);
+  const std::vector<std::vector<std::uint8_t>> maybe = maybe_blocked(space, in);
+  if (in.culler) conv.plan.maybe_blocked = &maybe;
   ConvolutionVisibility per_light;
   if (in.convolve || !in.rays) {
     auto convolved = bake_convolution(space, conv, reports, plan);
@@ -73,40 +140,9 @@ Expected<MixedImages> bake_traced_convolution(const TexelSpace& space,
   // accounted for; its own answer stands only where it finds the light wholly seen or wholly
   // hidden, and not within kTraceMargin texels of a traced one (where a penumbra it placed up
   // to ε off may begin).
-  std::vector<std::vector<std::uint8_t>> trace(lights.size());
-  if (in.rays) {
-    std::vector<std::int32_t> texel_at(std::size_t(space.width) * space.height, -1);
-    for (std::size_t t = 0; t < n; ++t)
-      texel_at[std::size_t(space.texels[t].y) * space.width + std::size_t(space.texels[t].x)] =
-          std::int32_t(t);
-    for (std::size_t l = 0; l < lights.size(); ++l) {
-      std::vector<std::uint8_t> seed(n, 0);
-      for (std::size_t t = 0; t < n; ++t) {
-        if (!maybe.empty() && !maybe[l][t]) continue;
-        const bool planned = !per_light.visible[l].empty() && per_light.reached[l][t];
-        const float e = planned ? per_light.error_texels[l][t] : -1.0f;
-        bool partial = false;
-        if (planned)
-          for (int c = 0; c < 3; ++c) {
-            const float v = per_light.visible[l][t][c];
-            partial = partial || (v > kCertain && v < 1 - kCertain);
-          }
-        seed[t] = e < 0 || e > in.trace_error_texels || partial;
-      }
-      trace[l].assign(n, 0);
-      for (std::size_t t = 0; t < n; ++t) {
-        if (!seed[t]) continue;
-        const int x = space.texels[t].x, y = space.texels[t].y;
-        for (int dy = -kTraceMargin; dy <= kTraceMargin; ++dy)
-          for (int dx = -kTraceMargin; dx <= kTraceMargin; ++dx) {
-            const int xx = x + dx, yy = y + dy;
-            if (xx < 0 || yy < 0 || xx >= space.width || yy >= space.height) continue;
-            const std::int32_t u = texel_at[std::size_t(yy) * space.width + std::size_t(xx)];
-            if (u >= 0 && (maybe.empty() || maybe[l][std::size_t(u)])) trace[l][std::size_t(u)] = 1;
-          }
-      }
-    }
-  }
+  const std::vector<std::vector<std::uint8_t>> trace =
+      in.rays ? traced_pairs(space, in, per_light, maybe)
+              : std::vector<std::vector<std::uint8_t>>(lights.size());
 
   LightMix mix(space, lights, conv.quantity, LightMix::Order::texel_major, in.keep_per_light);
   std::atomic<std::int64_t> pairs{0}, clear{0}, traced{0}, rays_traced{0};
