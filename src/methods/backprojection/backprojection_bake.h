@@ -16,15 +16,6 @@
 
 namespace sb {
 
-// (light, texel) pairs by route (texel_routes.h), and the rays traced.
-struct RouteCounts {
-  std::array<std::int64_t, 7> pairs{};  // indexed by TexelRoute
-  std::int64_t rays = 0;
-  std::int64_t& operator[](TexelRoute r) { return pairs[std::size_t(r)]; }
-  std::int64_t operator[](TexelRoute r) const { return pairs[std::size_t(r)]; }
-  std::int64_t reached() const;  // every pair but none
-};
-
 // Bakes one receiver; lights combined by LightMix. `routes`, when given, gets its pairs' counts.
 MixedImages bake_backprojection(const TexelSpace& space, const BackprojectionInputs& in,
                                 RouteCounts* routes);

@@ -74,10 +74,6 @@ class PairSource {
   }
 };
 
-// The most candidates a tile lists (tile_shafts.h) before its texels search the hierarchy one by
-// one.
-inline constexpr std::size_t kTileCandidates = 1 << 16;
-
 // The evaluations of `light` over `space`, whose tiles' shaft tests are `tiles`.
 std::unique_ptr<PairSource> light_pairs(const TexelSpace& space, const Light& light,
                                         const BackprojectionInputs& in, const TileShafts& tiles);

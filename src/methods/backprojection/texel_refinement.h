@@ -1,8 +1,8 @@
 // Stage 3 of the `backprojection` bake (backprojection_bake.cpp), per light: adaptive texel
-// sampling over one receiver (texel_refinement.cpp): the exact
-// estimate at the corners and centres of cells of 8, 4 and 2 texels, interpolated inside a cell
-// only where its checks pass, and evaluated texel by texel where they fail. Possible only because
-// the estimates have no noise: a sample that disagrees with its neighbours' prediction is a real
+// sampling over one receiver (texel_refinement.cpp): stage 2's exact estimate (light_pairs.h) at
+// the corners and centres of cells of 8, 4 and 2 texels, interpolated inside a cell only where
+// its checks pass, and evaluated texel by texel where they fail. Possible only because the
+// estimates have no noise: a sample that disagrees with its neighbours' prediction is a real
 // change in the field, not chance.
 #pragma once
 

@@ -64,4 +64,18 @@ constexpr std::string_view to_string(TexelRoute r) {
   return "none";
 }
 
+// (light, texel) pairs by route, and the rays traced.
+struct RouteCounts {
+  std::array<std::int64_t, 7> pairs{};  // indexed by TexelRoute
+  std::int64_t rays = 0;
+  std::int64_t& operator[](TexelRoute r) { return pairs[std::size_t(r)]; }
+  std::int64_t operator[](TexelRoute r) const { return pairs[std::size_t(r)]; }
+  // Every pair but none.
+  std::int64_t reached() const {
+    std::int64_t sum = 0;
+    for (TexelRoute r : kTexelRoutes) sum += (*this)[r];
+    return sum;
+  }
+};
+
 }  // namespace sb

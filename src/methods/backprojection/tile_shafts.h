@@ -105,6 +105,9 @@ struct TileJoins {
   TileJoins(const TexelSpace& space, const TexelGrid& grid, double offset);
 };
 
+// The most candidates a tile lists before its texels search the hierarchy one by one.
+inline constexpr std::size_t kTileCandidates = 1 << 16;
+
 // The shaft test of each of the tiles `in_reach` (indices, ascending: the blocks the light's
 // lists give it, methods/light_lists.h; every other tile is empty) for `light`, patch by patch
 // (TileShafts; ShaftCuller::tile_candidates, at most `max` candidates a patch): clear, listed,
