@@ -451,9 +451,8 @@ MixedImages bake_shadow_map_filter(const TexelSpace& space, const BaselineInputs
     }
     std::vector<Vec3> visibility(lit.size(), Vec3::Ones());
     for (const ShadowFrustum& frustum : fit_frusta(light.centre(), positions, kFrustumMargin)) {
-      const ShadowMap map =
-          render_shadow_map(in.blockers, frustum.frame, frustum.half_extent,
-                            settings.shadow_map, frustum.near);
+      const ShadowMap map = render_shadow_map(in.blockers, frustum.frame, frustum.half_extent,
+                                              settings.shadow_map, frustum.near);
       ++maps;
       const LightOutline outline = outline_of(light, frustum.frame, filter == Filter::chun_oh);
       tbb::parallel_for(
@@ -472,8 +471,7 @@ MixedImages bake_shadow_map_filter(const TexelSpace& space, const BaselineInputs
               const ReceiverPoint r = receiver_point(map, origin, normal);
               ++c.lit;
               if (filter == Filter::pcf) {
-                visibility[p] =
-                    Vec3::Constant(pcf(map, r, settings.pcf_radius, c));
+                visibility[p] = Vec3::Constant(pcf(map, r, settings.pcf_radius, c));
                 continue;
               }
               const double k = search_blockers(map, r, outline);

@@ -13,9 +13,9 @@
 #include <memory>
 #include <string>
 
+#include "formats/outputs.h"
 #include "methods/convolution/pair_report.h"
 #include "pipeline/bake.h"
-#include "formats/outputs.h"
 
 namespace sb {
 namespace {

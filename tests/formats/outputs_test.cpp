@@ -14,10 +14,10 @@
 #include <sstream>
 
 #include "core/image_io.h"
-#include "lightmaps/encodings.h"
-#include "pipeline/bake.h"
 #include "formats/manifest.h"
 #include "formats/outputs.h"
+#include "lightmaps/encodings.h"
+#include "pipeline/bake.h"
 #include "pipeline/receiver_stages.h"
 #include "scene/mesh.h"
 

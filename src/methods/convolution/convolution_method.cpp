@@ -84,8 +84,8 @@ ConvolutionSettings convolution_settings(const BakeSettings& bake) {
   s.max_image = int(setting_whole(bake, "max_image"));
   s.max_triples = int(setting_whole(bake, "max_triples"));
   s.light_parts = int(setting_whole(bake, "light_parts"));
-  s.combine =
-      setting_word(bake, "blocker_combine") == "sum" ? BlockerCombine::sum : BlockerCombine::product;
+  s.combine = setting_word(bake, "blocker_combine") == "sum" ? BlockerCombine::sum
+                                                             : BlockerCombine::product;
   s.weighted = setting_word(bake, "weighting") == "irradiance";
   s.convolve = setting_flag(bake, "convolve");
   s.trace_error_texels = setting_number(bake, "trace_error_texels");
@@ -231,9 +231,9 @@ MethodEntry convolution_method() {
   e.local = false;   // its clusters span the scene's blockers
   e.plan = [](const BakeContext& context, const ReceiverInput& receiver) -> Expected<std::string> {
     const FftConvolver fft;
-    return describe_plan(
-        plan_convolution(*receiver.space, plan_inputs(context, convolution_settings(context.scene->bake),
-                                                     receiver.mesh, &fft)));
+    return describe_plan(plan_convolution(
+        *receiver.space,
+        plan_inputs(context, convolution_settings(context.scene->bake), receiver.mesh, &fft)));
   };
   return e;
 }

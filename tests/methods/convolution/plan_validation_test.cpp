@@ -57,8 +57,9 @@ std::unique_ptr<ScenePlans> plan_receivers(const Scene& scene) {
     if (!scene.objects[i].receiver) continue;
     p->spaces.push_back(std::make_unique<TexelSpace>(
         rasterise_texels(p->meshes[i], scene.bake.resolution, scene.bake.resolution)));
-    p->plans.push_back(
-        plan_convolution(*p->spaces.back(), plan_inputs(context, convolution_settings(context.scene->bake), &p->meshes[i], &fft)));
+    p->plans.push_back(plan_convolution(
+        *p->spaces.back(),
+        plan_inputs(context, convolution_settings(context.scene->bake), &p->meshes[i], &fft)));
   }
   return p;
 }
