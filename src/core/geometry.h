@@ -4,6 +4,8 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cmath>
+#include <limits>
 
 namespace sb {
 
@@ -37,5 +39,12 @@ struct Bounds3 {
     return (p.array() >= lo.array()).all() && (p.array() <= hi.array()).all();
   }
 };
+
+// Any unit vector orthogonal to the unit vector m: the x or y axis (whichever lies farther from
+// m) with its part along m taken out.
+inline Vec3 any_orthogonal(const Vec3& m) {
+  const Vec3 a = std::abs(m.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+  return (a - a.dot(m) * m).normalized();
+}
 
 }  // namespace sb

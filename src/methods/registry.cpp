@@ -161,10 +161,7 @@ std::string setting_word(const BakeSettings& bake, std::string_view key) {
 }
 
 void set_setting(BakeSettings& bake, std::string_view key, SettingValue value) {
-  const SettingSpec& spec = spec_of(key);
-  if (std::holds_alternative<double>(spec.fallback))
-    if (const auto* w = std::get_if<std::int64_t>(&value)) value = double(*w);
-  bake.own.insert_or_assign(std::string(key), std::move(value));
+  set_own_setting(bake, spec_of(key), std::move(value));
 }
 
 }  // namespace sb

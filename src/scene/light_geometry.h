@@ -1,6 +1,6 @@
 // Geometry that the lights' closed forms (lights.cpp) and their samplers for the reference
-// (light_sampling.cpp) share: a disk's regular polygon of equal area, and an axis across a
-// direction. Private to the scene module.
+// (light_sampling.cpp) share: a disk's regular polygon of equal area. Private to the scene
+// module.
 #pragma once
 
 #include <array>
@@ -19,8 +19,5 @@ struct DiskPolygon {
   double area_radius;
 };
 const DiskPolygon& disk_polygon();
-
-// Any unit vector orthogonal to m.
-Vec3 orthogonal_axis(const Vec3& m);
 
 }  // namespace sb

@@ -99,7 +99,7 @@ LightSample Light::sample(const Vec3& y, const Vec3& n, const Vec2& u) const {
       const double cos_t = 1.0 - u.x() * (1.0 - cos_max);
       const double sin_t = std::sqrt(std::max(0.0, 1.0 - cos_t * cos_t));
       const double phi = 2 * kPi * u.y();
-      const Vec3 a = orthogonal_axis(axis), b = axis.cross(a);
+      const Vec3 a = any_orthogonal(axis), b = axis.cross(a);
       const Vec3 dir = cos_t * axis + sin_t * (std::cos(phi) * a + std::sin(phi) * b);
       // Nearest intersection of the ray y + t·dir with the sphere.
       const double proj = dir.dot(c);
@@ -171,7 +171,7 @@ HorizonPart Light::above_horizon(const Vec3& y, const Vec3& n) const {
       const double d = c.norm(), r = desc_.radius;
       if (d <= r) break;
       const Vec3 axis = -c / d;
-      const Vec3 a = orthogonal_axis(axis);
+      const Vec3 a = any_orthogonal(axis);
       part.plane_ = (d * d - r * r) / d;
       polygon(c * (1.0 - r * r / (d * d)), a, axis.cross(a), r * std::sqrt(d * d - r * r) / d);
       break;

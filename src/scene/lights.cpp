@@ -108,11 +108,6 @@ const DiskPolygon& disk_polygon() {
   return polygon;
 }
 
-Vec3 orthogonal_axis(const Vec3& m) {
-  const Vec3 a = std::abs(m.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
-  return (a - a.dot(m) * m).normalized();
-}
-
 double polygon_form_factor(std::vector<Vec3> polygon, const Vec3& n) {
   return polygon_form_factor(polygon.data(), int(polygon.size()), n);
 }
@@ -341,7 +336,7 @@ double Light::form_factor(const Vec3& y, const Vec3& n) const {
       const Vec3 axis = -c / d;
       const Vec3 sil_centre = c * (1.0 - r * r / (d * d));
       const double sil_radius = r * std::sqrt(d * d - r * r) / d;
-      const Vec3 a = orthogonal_axis(axis);
+      const Vec3 a = any_orthogonal(axis);
       return disk_form_factor(sil_centre, axis, a, axis.cross(a), sil_radius, n);
     }
     case LightShape::mesh:

@@ -85,6 +85,10 @@ struct BakeSettings {
   std::map<std::string, SettingValue, std::less<>> own;
 };
 
+// Sets a method's own key in `bake` to `value`, a whole number made a number where `spec` takes
+// one; not checked against its range.
+void set_own_setting(BakeSettings& bake, const SettingSpec& spec, SettingValue value);
+
 struct ObjectDesc {
   std::string name;            // unique; the output file stem
   std::filesystem::path mesh;  // resolved against the scene file's folder

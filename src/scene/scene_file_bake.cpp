@@ -7,17 +7,11 @@
 
 namespace sb {
 
-namespace {
-
-// Sets a method's own key to a value the reader checked, a whole number made a number where the
-// key takes one.
-void set_own(BakeSettings& bake, const SettingSpec& spec, SettingValue value) {
+void set_own_setting(BakeSettings& bake, const SettingSpec& spec, SettingValue value) {
   if (std::holds_alternative<double>(spec.fallback))
     if (const auto* w = std::get_if<std::int64_t>(&value)) value = double(*w);
   bake.own.insert_or_assign(spec.key, std::move(value));
 }
-
-}  // namespace
 
 Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::table& table,
                                  const MethodVocabulary& methods) {
@@ -90,21 +84,21 @@ Expected<BakeSettings> read_bake(const std::filesystem::path& file, const toml::
     if (!r.find(spec.key)) continue;
     const auto valid = [&](const SettingValue& v) { return !spec.valid || spec.valid(v); };
     if (std::holds_alternative<bool>(spec.fallback)) {
-      if (auto v = r.boolean(spec.key)) set_own(bake, spec, *v);
+      if (auto v = r.boolean(spec.key)) set_own_setting(bake, spec, *v);
     } else if (std::holds_alternative<std::int64_t>(spec.fallback)) {
       if (auto v = r.integer(spec.key, spec.lo, spec.hi)) {
         if (valid(*v))
-          set_own(bake, spec, *v);
+          set_own_setting(bake, spec, *v);
         else
           r.fail_got(spec.key, spec.requirement);
       }
     } else if (std::holds_alternative<double>(spec.fallback)) {
       if (auto v = r.number(spec.key, spec.requirement,
                             [&](double x) { return std::isfinite(x) && valid(x); }))
-        set_own(bake, spec, *v);
+        set_own_setting(bake, spec, *v);
     } else if (auto v = r.string(spec.key)) {
       if (valid(*v))
-        set_own(bake, spec, *v);
+        set_own_setting(bake, spec, *v);
       else
         r.fail_got(spec.key, spec.requirement);
     }

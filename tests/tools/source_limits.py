@@ -32,7 +32,6 @@ ROOMS = [["core"], ["scene"], ["texels"], ["occluders"], ["lightmaps"], ["method
          ["pipeline", "formats"], ["evaluation"]]
 _INCLUDE = re.compile(r'^#include "([a-z_]+)/', re.M)
 
-_CONTROL = re.compile(r"\b(if|for|while|switch|catch|do|else|try)\s*(\(|$)")
 _SCOPE = re.compile(r"\b(namespace|class|struct|union|enum)\b[^()]*$")
 
 
@@ -100,7 +99,7 @@ def functions(text):
     for i, c in enumerate(code):
         if c == "\n":
             line += 1
-        elif c in ";":
+        elif c == ";":
             if not stack or stack[-1][0] == "scope":
                 header_start = i + 1
         elif c == "{":
@@ -131,24 +130,19 @@ def functions(text):
 
 
 def _is_initialiser(h):
-    """A brace that opens a value: `= {`, `x{`, `return {`, a table's `{ {`."""
+    """A brace at namespace or class level that opens a value: `x = {`, a lambda's `= [](...)
+    {`, a table's `{ {` or `{1}, {`."""
     head = h.split("(")[0]
     return (h.endswith("=") or ("=" in head and "operator" not in head) or h == "" or
             h.endswith(",") or h.startswith("return"))
 
 
 def _is_function_header(h):
-    if not h.rstrip().endswith(tuple(")abcdefghijklmnopqrstuvwxyz_0123456789>&*]")):
+    """A parameter list, then qualifiers (const, override, noexcept, a trailing return type) or
+    member initialisers; not a namespace, class or `extern "C"` (its quotes blanked) block."""
+    if "(" not in h or not h.endswith(tuple(")abcdefghijklmnopqrstuvwxyz_0123456789>&*]")):
         return False
-    if _SCOPE.search(h) or h.startswith("extern \"C\"") or re.search(r"\bextern\s*$", h):
-        return False
-    if "(" not in h:
-        return False
-    if _CONTROL.match(h.strip()):
-        return False
-    # Member initialisers (Foo() : a_(x), b_{y}) end in ')' too; a trailing-return or qualifier
-    # list is allowed.
-    return True
+    return not (_SCOPE.search(h) or re.search(r"\bextern\s*$", h))
 
 
 def _function_name(h):

@@ -16,11 +16,6 @@
 
 namespace sb {
 
-Vec3 any_orthogonal(const Vec3& m) {
-  const Vec3 a = std::abs(m.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
-  return (a - a.dot(m) * m).normalized();
-}
-
 std::uint64_t BlockedRows::cells_of(double enter, double leave, double a, double b) {
   const double width = leave - enter;
   if (!(width > 0)) return 0;

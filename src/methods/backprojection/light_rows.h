@@ -89,8 +89,6 @@ struct BlockedRows {
   void add_cells(const LightRows& lights, int r, std::uint64_t cells);
 };
 
-Vec3 any_orthogonal(const Vec3& m);
-
 // Everything a rasteriser needs of one texel's evaluation.
 struct RasterTarget {
   const LightFrame* frame = nullptr;

@@ -136,10 +136,10 @@ DenseMeshes sort_candidates(const ShaftCuller& culler, const std::vector<std::ui
 }
 
 // Each dense mesh's triangles through their outline, or one by one where they are few or large.
-void add_dense_meshes(const ShaftCuller& culler, const Light& light, DenseMeshes& dense,
+void add_dense_meshes(const ShaftCuller& culler, const Light& light, const DenseMeshes& dense,
                       const Bounds3& origins, double offset, TileBlockers& out) {
   for (std::size_t k = 0; k < dense.keys.size(); ++k) {
-    std::vector<std::uint32_t>& list = dense.triangles[k];
+    const std::vector<std::uint32_t>& list = dense.triangles[k];
     // A sphere light's outline is made anew per texel (penumbra_estimator.h): it pays where the
     // mesh's triangles are small beside the tile (a knot's), not where they are as large as a
     // level's walls and floors (OpenArena's oacmpctf3: the evaluations took 11 % longer so).
@@ -240,7 +240,7 @@ TileBlockers tile_blockers(const ShaftCuller& culler, const Light& light,
   solids_and_distances(culler, candidates, origins, keys, distances);
   const std::vector<std::uint8_t> whole =
       whole_solids(culler, candidates, keys, distances, offset, piercing);
-  DenseMeshes dense = sort_candidates(culler, candidates, keys, whole, piercing, out);
+  const DenseMeshes dense = sort_candidates(culler, candidates, keys, whole, piercing, out);
   add_dense_meshes(culler, light, dense, origins, offset, out);
   add_whole_solids(culler, light, candidates, keys, distances, whole, origins, offset, out);
   link_solids(light, out);
